@@ -1,0 +1,423 @@
+"""Typed, validated configuration: defaults in code, YAML holds overrides.
+
+Every section is a frozen dataclass checked in ``__post_init__``; a bad value raises
+:class:`~sumo_ayss.errors.ConfigError` naming the dotted field and the allowed values. YAML
+files are merged over the defaults by :func:`load_config`; unknown keys are rejected with a
+suggestion, relative paths resolve against the YAML file's folder.
+
+Units: lengths m, speeds m/s, accelerations m/s², times s. Sign convention: accelerations
+are positive forward, braking is negative (the POV actuator bounds are ``[-6, 6]`` m/s²).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import math
+import types
+import typing
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar, Literal
+
+import yaml
+
+from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE, VehicleType
+from sumo_ayss.errors import ConfigError
+
+Case = Literal["car_following", "cut_in"]
+ShapeKind = Literal["linear", "quadratic", "exponential"]
+
+#: Repository root (holds networks/, configs/, routes/) when running from a checkout.
+PROJECT_ROOT = Path(__file__).resolve().parent.parent
+
+
+def _require(cond: bool, message: str) -> None:
+    if not cond:
+        raise ConfigError(message)
+
+
+def _check_range(where: str, value: tuple[float, float], low: float = -math.inf) -> None:
+    _require(
+        len(value) == 2 and all(math.isfinite(v) for v in value),
+        f"{where} must be [min, max] with finite numbers, got {list(value)}",
+    )
+    _require(value[0] <= value[1], f"{where} must have min <= max, got {list(value)}")
+    _require(value[0] >= low, f"{where} min must be >= {low}, got {value[0]}")
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """How SUMO runs. Section ``env.sim``."""
+
+    SECTION: ClassVar[str] = "env.sim"
+
+    step_length_s: float = 0.2
+    """SUMO step [s]; the policy acts every ``env.decision_period_s``."""
+    lanechange_duration_s: float = 1.0
+    """Duration of a POV lane change [s] (continuous lateral motion, ``--lanechange.duration``)."""
+    collision_mingap_factor: float = 0.0
+    """0: only physical overlap counts as a collision (SUMO's default flags a 0.3 m gap)."""
+    extra_args: tuple[str, ...] = ()
+    """Extra SUMO command-line arguments, appended verbatim."""
+
+    def __post_init__(self) -> None:
+        s = self.SECTION
+        _require(self.step_length_s > 0, f"{s}.step_length_s must be > 0, got {self.step_length_s}")
+        _require(
+            self.lanechange_duration_s > 0,
+            f"{s}.lanechange_duration_s must be > 0, got {self.lanechange_duration_s}",
+        )
+        _require(
+            0 <= self.collision_mingap_factor <= 1,
+            f"{s}.collision_mingap_factor must be in [0, 1], got {self.collision_mingap_factor}",
+        )
+
+
+@dataclass(frozen=True)
+class ActuatorConfig:
+    """The POV's speed controller: ``a = clip((v_target - v) / time_constant_s, min, max)``.
+
+    highway-env uses the same law with a 0.6 s time constant but no clipping; we clip to
+    the VUT's physical range [-6, 6] m/s² by default. Section ``env.actuator``.
+    """
+
+    SECTION: ClassVar[str] = "env.actuator"
+
+    time_constant_s: float = 0.6
+    accel_min_mps2: float = -6.0
+    accel_max_mps2: float = 6.0
+    max_speed_mps: float = 40.0
+
+    def __post_init__(self) -> None:
+        s = self.SECTION
+        _require(
+            self.time_constant_s > 0, f"{s}.time_constant_s must be > 0, got {self.time_constant_s}"
+        )
+        _require(
+            self.accel_min_mps2 < 0 < self.accel_max_mps2,
+            f"{s}.accel_min_mps2 must be < 0 < accel_max_mps2, got "
+            f"[{self.accel_min_mps2}, {self.accel_max_mps2}]",
+        )
+        _require(self.max_speed_mps > 0, f"{s}.max_speed_mps must be > 0, got {self.max_speed_mps}")
+
+
+@dataclass(frozen=True)
+class OddConfig:
+    """Initial conditions are drawn uniformly from these ranges. Section ``env.odd``.
+
+    Defaults: both speeds in [10, 30] m/s (30 m/s = the speed limit) and a bumper-to-bumper
+    gap in [2, 25] m, so that most episodes start where the adversarial reward (zero beyond
+    20 m) can be earned within the 5 s episode.
+    """
+
+    SECTION: ClassVar[str] = "env.odd"
+
+    pov_speed_mps: tuple[float, float] = (10.0, 30.0)
+    vut_speed_mps: tuple[float, float] = (10.0, 30.0)
+    gap_m: tuple[float, float] = (2.0, 25.0)
+    """Longitudinal gap POV rear bumper - VUT front bumper [m]."""
+
+    def __post_init__(self) -> None:
+        for name in ("pov_speed_mps", "vut_speed_mps", "gap_m"):
+            value = tuple(float(v) for v in getattr(self, name))
+            object.__setattr__(self, name, value)
+            _check_range(f"{self.SECTION}.{name}", value, low=0.0)
+
+
+@dataclass(frozen=True)
+class RewardShape:
+    """Adversarial reward R_A as a function of headway h [m], 0 <= R_A <= 1.
+
+    ``R_A(peak_m) = 1``; for ``h >= zero_m`` it is 0; between the two it falls as
+    ``1 - u`` (linear), ``(1 - u)²`` (quadratic) or ``exp(-3u)`` rescaled to reach 0 at
+    ``u = 1`` (exponential), with ``u = (h - peak_m) / (zero_m - peak_m)``. Below the peak it
+    rises linearly from ``value_at_contact`` at h = 0 to 1 at the peak. The paper shows these
+    curves only as figures; the defaults are ours and are drawn in ``docs/reward_shapes.png``.
+    """
+
+    kind: ShapeKind = "linear"
+    peak_m: float = 0.25
+    zero_m: float = 20.0
+    value_at_contact: float = 0.5
+
+    def validate(self, where: str) -> None:
+        _require(
+            self.kind in typing.get_args(ShapeKind),
+            f"{where}.kind must be one of {list(typing.get_args(ShapeKind))}, got {self.kind!r}",
+        )
+        _require(self.peak_m >= 0, f"{where}.peak_m must be >= 0, got {self.peak_m}")
+        _require(
+            self.zero_m > self.peak_m,
+            f"{where}.zero_m must be > peak_m ({self.peak_m}), got {self.zero_m}",
+        )
+        _require(
+            0 <= self.value_at_contact <= 1,
+            f"{where}.value_at_contact must be in [0, 1], got {self.value_at_contact}",
+        )
+
+
+@dataclass(frozen=True)
+class RewardConfig:
+    """R = alpha_adversarial·R_A + alpha_collision·R_C with R_C = -1 on a collision, else 0.
+
+    A collision therefore gets the minimum reward ``-alpha_collision`` (R_A is 0 then) and
+    ends the episode. Section ``env.reward``.
+    """
+
+    SECTION: ClassVar[str] = "env.reward"
+
+    alpha_adversarial: float = 1.0
+    alpha_collision: float = 10.0
+    same_lane: RewardShape = field(default_factory=RewardShape)
+    """R_A while POV and VUT share a lane (car-following, and cut-in after the change)."""
+    lane_change: RewardShape = field(
+        default_factory=lambda: RewardShape(peak_m=1.0, zero_m=5.0, value_at_contact=0.5)
+    )
+    """R_A while the POV changes lanes (cut-in only)."""
+
+    def __post_init__(self) -> None:
+        s = self.SECTION
+        _require(
+            self.alpha_adversarial > 0,
+            f"{s}.alpha_adversarial must be > 0, got {self.alpha_adversarial}",
+        )
+        _require(
+            self.alpha_collision > 0, f"{s}.alpha_collision must be > 0, got {self.alpha_collision}"
+        )
+        self.same_lane.validate(f"{s}.same_lane")
+        self.lane_change.validate(f"{s}.lane_change")
+
+    @property
+    def min_reward(self) -> float:
+        """The reward of a collision step (the smallest reward there is)."""
+        return -self.alpha_collision
+
+    @property
+    def max_reward(self) -> float:
+        return self.alpha_adversarial
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """One testing environment: case, VUT, timing, ODD, reward, actuator and SUMO options."""
+
+    SECTION: ClassVar[str] = "env"
+
+    case: Case = "car_following"
+    vut: str = "pi1"
+    """Name of the VUT in ``vuts`` (built-ins: pi1, pi2)."""
+    vuts: Mapping[str, VehicleType] = field(default_factory=lambda: dict(BUILTIN_VUTS))
+    """VUT catalog: the built-ins plus any defined in YAML."""
+    pov: VehicleType = POV_TYPE
+    episode_s: float = 5.0
+    decision_period_s: float = 0.2
+    """Policy period [s] (5 Hz in the paper); a multiple of ``sim.step_length_s``."""
+    network: Path | None = None
+    """SUMO .net.xml; None = the built-in network of the case."""
+    odd: OddConfig = field(default_factory=OddConfig)
+    reward: RewardConfig = field(default_factory=RewardConfig)
+    actuator: ActuatorConfig = field(default_factory=ActuatorConfig)
+    sim: SimConfig = field(default_factory=SimConfig)
+
+    def __post_init__(self) -> None:
+        s = self.SECTION
+        _require(
+            self.case in typing.get_args(Case),
+            f"{s}.case must be one of {list(typing.get_args(Case))}, got {self.case!r}",
+        )
+        object.__setattr__(self, "vuts", types.MappingProxyType(dict(self.vuts)))
+        for name, vt in self.vuts.items():
+            vt.validate(f"{s}.vuts.{name}")
+        self.pov.validate(f"{s}.pov")
+        if self.vut not in self.vuts:
+            close = difflib.get_close_matches(self.vut, list(self.vuts), n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise ConfigError(f"{s}.vut must be one of {sorted(self.vuts)}, got {self.vut!r}{hint}")
+        _require(self.episode_s > 0, f"{s}.episode_s must be > 0, got {self.episode_s}")
+        ratio = self.decision_period_s / self.sim.step_length_s
+        _require(
+            self.decision_period_s > 0 and abs(ratio - round(ratio)) < 1e-9 and round(ratio) >= 1,
+            f"{s}.decision_period_s must be a positive multiple of sim.step_length_s "
+            f"({self.sim.step_length_s}), got {self.decision_period_s}",
+        )
+        if self.network is not None:
+            path = Path(self.network)
+            object.__setattr__(self, "network", path)
+            _require(path.is_file(), f"{s}.network: file not found: {path}")
+
+    @property
+    def vut_type(self) -> VehicleType:
+        return self.vuts[self.vut]
+
+    @property
+    def steps_per_decision(self) -> int:
+        return round(self.decision_period_s / self.sim.step_length_s)
+
+    @property
+    def max_decisions(self) -> int:
+        """Decisions per episode (25 for 5 s at 5 Hz)."""
+        return round(self.episode_s / self.decision_period_s)
+
+
+# ----------------------------------------------------------------------------------------
+# Generic mapping -> dataclass construction (used for YAML and for run folders).
+# ----------------------------------------------------------------------------------------
+
+
+def _unknown_key(where: str, key: str, allowed: list[str]) -> ConfigError:
+    close = difflib.get_close_matches(key, allowed, n=1)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    return ConfigError(f"{where}: unknown key {key!r}{hint}; allowed: {sorted(allowed)}")
+
+
+def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> Any:
+    origin = typing.get_origin(tp)
+    args = typing.get_args(tp)
+    if dataclasses.is_dataclass(tp) and isinstance(tp, type):
+        if isinstance(value, tp):
+            return value
+        return build(tp, value, where, base_dir, default)
+    if tp is VehicleType:
+        return _vehicle_type(value, where)
+    if origin in (types.UnionType, typing.Union):
+        if value is None and type(None) in args:
+            return None
+        non_none = [a for a in args if a is not type(None)]
+        return _convert(non_none[0], value, where, base_dir, default)
+    if origin is Literal:
+        if value not in args:
+            raise ConfigError(f"{where} must be one of {list(args)}, got {value!r}")
+        return value
+    if tp is Path:
+        if not isinstance(value, str | Path):
+            raise ConfigError(f"{where} must be a path string, got {value!r}")
+        path = Path(value).expanduser()
+        return path if path.is_absolute() else (base_dir / path).resolve()
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(f"{where} must be true or false, got {value!r}")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{where} must be an integer, got {value!r}")
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ConfigError(f"{where} must be a number, got {value!r}")
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str):
+            raise ConfigError(f"{where} must be a string, got {value!r}")
+        return value
+    if origin is tuple:
+        if not isinstance(value, list | tuple):
+            raise ConfigError(f"{where} must be a list, got {value!r}")
+        item_types = [args[0]] * len(value) if (len(args) == 2 and args[1] is Ellipsis) else args
+        if len(item_types) != len(value):
+            raise ConfigError(f"{where} must have {len(item_types)} items, got {list(value)}")
+        return tuple(
+            _convert(t, v, f"{where}[{i}]", base_dir, None)
+            for i, (t, v) in enumerate(zip(item_types, value, strict=True))
+        )
+    if origin in (Mapping, dict) or tp is dict:
+        if not isinstance(value, Mapping):
+            raise ConfigError(f"{where} must be a mapping, got {value!r}")
+        merged = dict(default or {})
+        for k, v in value.items():
+            merged[str(k)] = _convert(args[1], v, f"{where}.{k}", base_dir, merged.get(str(k)))
+        return merged
+    raise ConfigError(f"{where}: unsupported type {tp!r}")  # pragma: no cover
+
+
+def _vehicle_type(value: Any, where: str) -> VehicleType:
+    if isinstance(value, VehicleType):
+        return value
+    if not isinstance(value, Mapping):
+        raise ConfigError(f"{where} must be a mapping with model and params, got {value!r}")
+    allowed = ["model", "params", "description"]
+    for key in value:
+        if key not in allowed:
+            raise _unknown_key(where, str(key), allowed)
+    params = value.get("params", {}) or {}
+    if not isinstance(params, Mapping):
+        raise ConfigError(f"{where}.params must be a mapping, got {params!r}")
+    vt = VehicleType(
+        model=str(value.get("model", "IDM")),
+        params=dict(params),
+        description=str(value.get("description", "")),
+    )
+    vt.validate(where)
+    return vt
+
+
+def build(cls: type, data: Any, where: str, base_dir: Path, default: Any = None) -> Any:
+    """Build dataclass ``cls`` from a mapping, over ``default`` (or the class defaults)."""
+    if data is None:
+        data = {}
+    if not isinstance(data, Mapping):
+        raise ConfigError(f"{where or 'config'} must be a mapping, got {data!r}")
+    hints = typing.get_type_hints(cls)
+    names = [f.name for f in dataclasses.fields(cls)]
+    base = default if default is not None else None
+    kwargs: dict[str, Any] = {}
+    for key, value in data.items():
+        if key not in names:
+            raise _unknown_key(where or "config", str(key), names)
+        sub_default = getattr(base, key) if base is not None else _field_default(cls, key)
+        child = f"{where}.{key}" if where else str(key)
+        kwargs[key] = _convert(hints[key], value, child, base_dir, sub_default)
+    if base is not None:
+        return dataclasses.replace(base, **kwargs)
+    return cls(**kwargs)
+
+
+def _field_default(cls: type, name: str) -> Any:
+    f = next(f for f in dataclasses.fields(cls) if f.name == name)
+    if f.default is not dataclasses.MISSING:
+        return f.default
+    if f.default_factory is not dataclasses.MISSING:
+        return f.default_factory()
+    return None
+
+
+def to_dict(obj: Any) -> Any:
+    """Plain YAML-safe form of a config (the exact resolved config a run used)."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: to_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, VehicleType):
+        return {"model": obj.model, "params": dict(obj.params), "description": obj.description}
+    if isinstance(obj, Mapping):
+        return {str(k): to_dict(v) for k, v in obj.items()}
+    if isinstance(obj, tuple | list):
+        return [to_dict(v) for v in obj]
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def read_yaml(path: str | Path) -> dict[str, Any]:
+    """Read a YAML mapping; a missing file or a non-mapping gives a ConfigError."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"config file not found: {path}")
+    try:
+        data = yaml.safe_load(path.read_text()) or {}
+    except yaml.YAMLError as e:
+        raise ConfigError(f"{path}: invalid YAML: {e}") from e
+    if not isinstance(data, Mapping):
+        raise ConfigError(f"{path}: top level must be a mapping, got {type(data).__name__}")
+    return dict(data)
+
+
+def env_config_from_mapping(data: Mapping[str, Any], base_dir: Path | None = None) -> EnvConfig:
+    """Build an :class:`EnvConfig` from the contents of an ``env:`` section."""
+    return build(EnvConfig, data, "env", base_dir or Path.cwd())
+
+
+def write_yaml(path: Path, data: Any) -> None:
+    """Write YAML atomically (temp file + rename), so a kill never leaves half a file."""
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(yaml.safe_dump(data, sort_keys=False))
+    tmp.replace(path)

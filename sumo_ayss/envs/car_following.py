@@ -1,0 +1,78 @@
+"""``sumo_ayss/CarFollowing-v0``: the POV drives ahead of the VUT in one lane (paper V-A).
+
+Observation ``(v_pov, v_vut, h)``: POV and VUT speeds [m/s] and the headway h [m], POV rear
+bumper minus VUT front bumper (from SUMO positions and lengths, not ``getLeader``, whose gap
+already subtracts the follower's minGap). Action k ∈ {0..20} sets the POV's target speed to
+``0.5·k·v_pov`` (k = 2 holds speed, k = 0 asks for a stop); the actuator turns it into a
+bounded acceleration. Reward: ``α_A·R_A(h)`` with the ``same_lane`` shape, or the minimum
+``-α_C`` at a collision, which ends the episode.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+import numpy.typing as npt
+from gymnasium import spaces
+
+from sumo_ayss.config import EnvConfig
+from sumo_ayss.envs.odd import InitialCondition
+from sumo_ayss.envs.pair_env import (
+    HEADWAY_HIGH_M,
+    HEADWAY_LOW_M,
+    SPEED_HIGH_MPS,
+    VUT_START_POS_M,
+    PairEnv,
+    PairKinematics,
+)
+from sumo_ayss.envs.rewards import adversarial_reward
+from sumo_ayss.sim.pair import PairPlacement
+
+#: Number of actions and the factor per action index: target = TARGET_STEP·k·v_pov.
+N_ACTIONS = 21
+TARGET_STEP = 0.5
+
+
+def target_speed_mps(action: int, pov_speed_mps: float) -> float:
+    """Target speed [m/s] of car-following action ``action`` at POV speed ``pov_speed_mps``."""
+    return TARGET_STEP * action * pov_speed_mps
+
+
+class CarFollowingEnv(PairEnv):
+    """One-lane car-following: POV ahead of the VUT in the same lane."""
+
+    CASE: ClassVar[str] = "car_following"
+
+    def __init__(
+        self,
+        config: EnvConfig | None = None,
+        *,
+        vut: str | None = None,
+        sumo_seed: int | None = None,
+    ) -> None:
+        super().__init__(config, vut=vut, sumo_seed=sumo_seed)
+        self.observation_space = spaces.Box(
+            low=np.array([0.0, 0.0, HEADWAY_LOW_M], dtype=np.float32),
+            high=np.array([SPEED_HIGH_MPS, SPEED_HIGH_MPS, HEADWAY_HIGH_M], dtype=np.float32),
+            dtype=np.float32,
+        )
+        self.action_space = spaces.Discrete(N_ACTIONS)
+        self._low = self.observation_space.low
+        self._high = self.observation_space.high
+
+    def _placement(self, ic: InitialCondition) -> PairPlacement:
+        pov_front = VUT_START_POS_M + ic.gap_m + self._pov_length_m
+        return PairPlacement(
+            VUT_START_POS_M, ic.vut_speed_mps, 0, pov_front, ic.pov_speed_mps, 0
+        )
+
+    def _observation(self, k: PairKinematics) -> npt.NDArray[np.float32]:
+        obs = np.array([k.pov_speed_mps, k.vut_speed_mps, k.headway_m], dtype=np.float32)
+        return np.clip(obs, self._low, self._high)
+
+    def _apply_action(self, action: int, k: PairKinematics) -> float:
+        return target_speed_mps(action, k.pov_speed_mps)
+
+    def _reward_terms(self, k: PairKinematics, collided: bool) -> tuple[float, dict[str, Any]]:
+        return adversarial_reward(k.headway_m, self.config.reward.same_lane), {}

@@ -1,0 +1,246 @@
+"""Shared machinery of the VUT-POV Gymnasium envs: SUMO ownership, reset, stepping.
+
+A case (car-following, cut-in) subclasses :class:`PairEnv` and supplies its observation,
+action decoding and reward. Timing: the policy acts every ``decision_period_s`` (0.2 s,
+5 Hz); an episode lasts ``episode_s`` (5 s, 25 decisions) and ends *truncated* after the
+last decision, or *terminated* at a collision.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from abc import abstractmethod
+from dataclasses import dataclass
+from typing import Any, ClassVar, SupportsFloat, SupportsInt
+
+import gymnasium as gym
+import numpy as np
+import numpy.typing as npt
+
+from sumo_ayss.config import EnvConfig
+from sumo_ayss.envs.odd import InitialCondition, sample_initial_condition
+from sumo_ayss.envs.rewards import total_reward
+from sumo_ayss.errors import ActionError, ConfigError
+from sumo_ayss.sim.actuator import next_speed, pov_acceleration
+from sumo_ayss.sim.network import ROAD_EDGE, ROAD_LENGTH_M, network_path
+from sumo_ayss.sim.pair import PairPlacement, VehiclePair
+from sumo_ayss.sim.session import SumoSession
+
+#: Front-bumper position of the VUT at the start of every episode [m].
+VUT_START_POS_M = 150.0
+#: Finite observation bounds: speeds [m/s] and headway [m] are clipped into them.
+SPEED_HIGH_MPS = 50.0
+HEADWAY_LOW_M = -20.0
+HEADWAY_HIGH_M = 500.0
+
+
+def time_to_collision_s(gap_m: float, v_follower_mps: float, v_leader_mps: float) -> float:
+    """Longitudinal TTC [s]: gap / closing speed; +inf when the gap is not closing."""
+    closing = v_follower_mps - v_leader_mps
+    if gap_m <= 0.0:
+        return 0.0
+    return gap_m / closing if closing > 0.0 else math.inf
+
+
+@dataclass(frozen=True)
+class PairKinematics:
+    """What a step reads back from SUMO (front-bumper positions, m; speeds, m/s)."""
+
+    pov_pos_m: float
+    pov_speed_mps: float
+    vut_pos_m: float
+    vut_speed_mps: float
+    headway_m: float
+
+
+class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
+    """Base env: one VUT and one POV in the process's SUMO simulation.
+
+    Args:
+        config: environment configuration; defaults to :class:`EnvConfig` of the case.
+        vut: shortcut to override ``config.vut`` (a name from ``config.vuts``).
+        sumo_seed: SUMO's ``--seed``; default: drawn from the env's RNG at the first reset.
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
+    CASE: ClassVar[str]
+
+    def __init__(
+        self,
+        config: EnvConfig | None = None,
+        *,
+        vut: str | None = None,
+        sumo_seed: int | None = None,
+    ) -> None:
+        super().__init__()
+        config = config if config is not None else EnvConfig(case=self.CASE)  # type: ignore[arg-type]
+        if config.case != self.CASE:
+            raise ConfigError(f"env.case must be {self.CASE!r} for {type(self).__name__}")
+        if vut is not None:
+            config = dataclasses.replace(config, vut=vut)
+        self._check_road(config)
+        self.config = config
+        self.sumo_seed = sumo_seed
+        self._session: SumoSession | None = None
+        self._pair: VehiclePair | None = None
+        self._pov_length_m = config.pov.length_m
+        self._dt_s = config.sim.step_length_s
+        self._decisions = 0
+        self._v_pov = 0.0
+        self.initial_condition: InitialCondition | None = None
+
+    # ------------------------------------------------------------------ case hooks
+
+    @abstractmethod
+    def _placement(self, ic: InitialCondition) -> PairPlacement: ...
+
+    @abstractmethod
+    def _observation(self, k: PairKinematics) -> npt.NDArray[np.float32]: ...
+
+    @abstractmethod
+    def _apply_action(self, action: int, k: PairKinematics) -> float:
+        """Issue lane commands if any and return the POV's target speed [m/s]."""
+
+    @abstractmethod
+    def _reward_terms(self, k: PairKinematics, collided: bool) -> tuple[float, dict[str, Any]]:
+        """R_A for this step and case-specific info entries."""
+
+    # ------------------------------------------------------------------ gym API
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[npt.NDArray[np.float32], dict[str, Any]]:
+        """Start an episode.
+
+        Args:
+            seed: seeds the env's RNG (ODD sampling).
+            options: ``{"initial_condition": InitialCondition}`` to start from a given state
+                instead of sampling the ODD (scenario sets, Monte Carlo, replays).
+        """
+        super().reset(seed=seed)
+        ic = (options or {}).get("initial_condition")
+        if ic is None:
+            ic = sample_initial_condition(self.config.odd, self.np_random)
+        elif not isinstance(ic, InitialCondition):
+            raise ConfigError(
+                f"reset options['initial_condition'] must be an InitialCondition, got {ic!r}"
+            )
+        pair = self._ensure_sim()
+        pair.add()
+        pair.session.step()  # inserts the fresh vehicles (they do not move in this step)
+        pair.place(self._placement(ic))
+        self.initial_condition = ic
+        self._decisions = 0
+        self._v_pov = ic.pov_speed_mps
+        k = self._kinematics()
+        info = {
+            "headway_m": k.headway_m,
+            "ttc_s": time_to_collision_s(k.headway_m, k.vut_speed_mps, k.pov_speed_mps),
+            "sumo_seed": self.sumo_seed,
+            "initial_condition": ic,
+        }
+        return self._observation(k), info
+
+    def step(
+        self, action: SupportsInt
+    ) -> tuple[npt.NDArray[np.float32], SupportsFloat, bool, bool, dict[str, Any]]:
+        pair = self._pair
+        if pair is None or self.initial_condition is None:
+            raise ActionError("step() called before reset()")
+        a = self._validate_action(action)
+        k0 = self._kinematics()
+        target = self._apply_action(a, k0)
+        cfg = self.config
+        session = pair.session
+        v = self._v_pov
+        collided = False
+        accel = 0.0
+        for _ in range(cfg.steps_per_decision):
+            accel = pov_acceleration(v, target, cfg.actuator)
+            v = next_speed(v, accel, self._dt_s, cfg.actuator)
+            pair.command_pov_speed(v)
+            session.step()
+            if pair.collided(session.colliding_ids()):
+                collided = True
+                break
+        self._v_pov = v
+        self._decisions += 1
+        k = self._kinematics()
+        r_a, extra = self._reward_terms(k, collided)
+        if collided:
+            r_a = 0.0
+        reward = total_reward(r_a, collided, cfg.reward)
+        terminated = collided
+        truncated = not terminated and self._decisions >= cfg.max_decisions
+        info = {
+            "headway_m": k.headway_m,
+            "ttc_s": time_to_collision_s(k.headway_m, k.vut_speed_mps, k.pov_speed_mps),
+            "pov_accel_mps2": accel,
+            "vut_accel_mps2": pair.vut_accel_mps2(),
+            "target_speed_mps": target,
+            "collision": collided,
+            "reward_adversarial": r_a,
+            "reward_collision": -1.0 if collided else 0.0,
+            "sumo_seed": self.sumo_seed,
+            **extra,
+        }
+        return self._observation(k), reward, terminated, truncated, info
+
+    def close(self) -> None:
+        """Close SUMO; safe to call twice."""
+        if self._session is not None:
+            self._session.close()
+        self._session = None
+        self._pair = None
+        super().close()
+
+    # ------------------------------------------------------------------ internals
+
+    def _validate_action(self, action: SupportsInt) -> int:
+        try:
+            a = int(action)
+        except (TypeError, ValueError) as e:
+            raise ActionError(f"action must be an integer, got {action!r}") from e
+        n = int(self.action_space.n)  # type: ignore[attr-defined]
+        if not 0 <= a < n or a != action:
+            raise ActionError(f"action must be an integer in [0, {n - 1}], got {action!r}")
+        return a
+
+    def _kinematics(self) -> PairKinematics:
+        assert self._pair is not None
+        pov_pos, v_pov, vut_pos, v_vut = self._pair.longitudinal()
+        headway = pov_pos - self._pov_length_m - vut_pos
+        return PairKinematics(pov_pos, v_pov, vut_pos, v_vut, headway)
+
+    def _ensure_sim(self) -> VehiclePair:
+        if self._pair is not None:
+            return self._pair
+        cfg = self.config
+        if self.sumo_seed is None:
+            self.sumo_seed = int(self.np_random.integers(0, 2**31 - 1))
+        vtypes = {f"vut_{name}": vt for name, vt in cfg.vuts.items()}
+        vtypes["pov"] = cfg.pov
+        network = cfg.network if cfg.network is not None else network_path(cfg.case)  # type: ignore[arg-type]
+        session = SumoSession(
+            network, vtypes, cfg.sim, self.sumo_seed, owner=f"{type(self).__name__}({cfg.vut})"
+        )
+        session.start()
+        self._session = session
+        self._pair = VehiclePair(session, vut_type=f"vut_{cfg.vut}", pov_type="pov", edge=ROAD_EDGE)
+        return self._pair
+
+    @staticmethod
+    def _check_road(cfg: EnvConfig) -> None:
+        """The POV must not reach the road's end within an episode at full speed."""
+        reach = (
+            VUT_START_POS_M
+            + cfg.odd.gap_m[1]
+            + cfg.pov.length_m
+            + cfg.actuator.max_speed_mps * cfg.episode_s
+        )
+        if cfg.network is None and reach > ROAD_LENGTH_M - 50.0:
+            raise ConfigError(
+                f"env.odd.gap_m max ({cfg.odd.gap_m[1]}) with env.episode_s ({cfg.episode_s}) "
+                f"lets the POV reach {reach:.0f} m, beyond the {ROAD_LENGTH_M:.0f} m road"
+            )

@@ -1,0 +1,28 @@
+"""Exception tree of sumo_ayss.
+
+Every error the package raises on purpose derives from :class:`AyssError`, so a caller can
+catch the whole family at once; :class:`ConfigError` is also a :class:`ValueError` so that
+input-validation code written against the standard library keeps working.
+"""
+
+from __future__ import annotations
+
+
+class AyssError(Exception):
+    """Base class of every error raised by sumo_ayss."""
+
+
+class ConfigError(AyssError, ValueError):
+    """Invalid configuration or input: the message names the dotted field and allowed values."""
+
+
+class SimulationError(AyssError, RuntimeError):
+    """SUMO failed, or was used in a way it does not support (e.g. a second live simulation)."""
+
+
+class CheckpointError(AyssError, RuntimeError):
+    """A checkpoint or run folder cannot be read back or resumed."""
+
+
+class ActionError(AyssError, ValueError):
+    """An action outside the env's action space, or a step before reset."""

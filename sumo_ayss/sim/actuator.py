@@ -1,0 +1,41 @@
+"""The POV's actuator: target speed -> bounded acceleration -> next speed.
+
+SUMO's own checks are switched off for the POV (speed mode 0), which removes every limit
+(a ``setSpeed(pov, 0)`` would stop it from 25 m/s in one 0.2 s step). This module is the
+one place that bounds it. Pure math, no SUMO: the env and the Monte Carlo AYSS stage both
+call it, so the acceleration an action implies is computed by the same code everywhere.
+
+Sign convention: acceleration > 0 speeds up, < 0 brakes. Units m/s, m/s², s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from sumo_ayss.config import ActuatorConfig
+
+
+def pov_acceleration(speed_mps: float, target_speed_mps: float, cfg: ActuatorConfig) -> float:
+    """Acceleration [m/s²] that drives ``speed_mps`` toward ``target_speed_mps``.
+
+    ``a = clip((v_target - v) / time_constant_s, accel_min_mps2, accel_max_mps2)``, with the
+    target first clipped to ``[0, max_speed_mps]``.
+    """
+    target = min(max(target_speed_mps, 0.0), cfg.max_speed_mps)
+    accel = (target - speed_mps) / cfg.time_constant_s
+    return min(max(accel, cfg.accel_min_mps2), cfg.accel_max_mps2)
+
+
+def pov_acceleration_array(
+    speed_mps: npt.ArrayLike, target_speed_mps: npt.ArrayLike, cfg: ActuatorConfig
+) -> npt.NDArray[np.float64]:
+    """Vectorised :func:`pov_acceleration` (same law, elementwise)."""
+    target = np.clip(np.asarray(target_speed_mps, dtype=float), 0.0, cfg.max_speed_mps)
+    accel = (target - np.asarray(speed_mps, dtype=float)) / cfg.time_constant_s
+    return np.clip(accel, cfg.accel_min_mps2, cfg.accel_max_mps2)
+
+
+def next_speed(speed_mps: float, accel_mps2: float, dt_s: float, cfg: ActuatorConfig) -> float:
+    """Speed [m/s] after ``dt_s`` at constant ``accel_mps2``, kept in ``[0, max_speed_mps]``."""
+    return min(max(speed_mps + accel_mps2 * dt_s, 0.0), cfg.max_speed_mps)

@@ -1,0 +1,172 @@
+"""One VUT-POV pair on one road of the process's SUMO simulation.
+
+Positions are SUMO lane positions of the *front* bumper along the road [m]; speeds m/s;
+lateral positions are world y [m] of the front bumper's centre (lanes run along +x).
+
+Placement recipe (see DESIGN.md, "SUMO facts"): a vehicle added too close to its leader is
+silently not inserted, so every episode adds two *fresh* vehicles (stateful car-following
+models such as EIDM or ACC start clean) at a far-apart, always-insertable spot upstream,
+lets one SUMO step insert them, then ``moveTo`` + ``setPreviousSpeed`` put them exactly at
+the requested state. The previous episode's vehicles are removed in that same step; they
+are always downstream of the insertion spot, so they cannot block the insertion.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import libsumo
+
+from sumo_ayss.errors import SimulationError
+from sumo_ayss.sim.session import SUMO_ERRORS, SumoSession
+
+# libsumo functions bound once: attribute lookups are a measurable part of a 30 µs step.
+_get_lane_pos = libsumo.vehicle.getLanePosition
+_get_speed = libsumo.vehicle.getSpeed
+_get_accel = libsumo.vehicle.getAcceleration
+_get_lane_index = libsumo.vehicle.getLaneIndex
+_get_position = libsumo.vehicle.getPosition
+_set_speed = libsumo.vehicle.setSpeed
+
+#: Where new vehicles are inserted (front positions [m]) before being moved into place.
+_INSERT_VUT_POS_M = 10.0
+_INSERT_POV_POS_M = 60.0
+
+#: SUMO lane-change mode 0: no autonomous lane changes at all (bits 0-7 off), and a
+#: TraCI ``changeLane`` request is executed without respecting other drivers (bits 8-9 = 0):
+#: the VUT keeps its lane perfectly; the POV changes lane only when commanded, and then
+#: by force, because it is the adversary.
+LC_MODE_NONE = 0
+#: SUMO speed mode 0: every speed check off (safe speed, max accel/decel, speed limit).
+#: The POV's limits are ours (:mod:`sumo_ayss.sim.actuator`).
+SPEED_MODE_UNCHECKED = 0
+
+
+@dataclass(frozen=True)
+class PairPlacement:
+    """Requested state of a pair at the start of an episode.
+
+    Attributes:
+        vut_pos_m: VUT front bumper lane position [m].
+        vut_speed_mps: VUT speed [m/s].
+        vut_lane: VUT lane index (0 = rightmost).
+        pov_pos_m: POV front bumper lane position [m].
+        pov_speed_mps: POV speed [m/s].
+        pov_lane: POV lane index.
+    """
+
+    vut_pos_m: float
+    vut_speed_mps: float
+    vut_lane: int
+    pov_pos_m: float
+    pov_speed_mps: float
+    pov_lane: int
+
+
+class VehiclePair:
+    """A VUT and a POV on ``edge`` of a running :class:`SumoSession`.
+
+    Args:
+        session: the process's simulation.
+        vut_type: vType id of the VUT (loaded by the session).
+        pov_type: vType id of the POV.
+        edge: road edge id.
+        prefix: vehicle-id prefix, unique per pair in the simulation.
+    """
+
+    def __init__(
+        self,
+        session: SumoSession,
+        vut_type: str,
+        pov_type: str,
+        edge: str = "road",
+        prefix: str = "p0",
+    ) -> None:
+        self.session = session
+        self.vut_type = vut_type
+        self.pov_type = pov_type
+        self.edge = edge
+        self.prefix = prefix
+        self.route = f"route_{edge}"
+        self.episode = 0
+        self.vut = ""
+        self.pov = ""
+
+    # ------------------------------------------------------------------ episode set-up
+
+    def add(self) -> None:
+        """Remove the last episode's vehicles and add fresh ones (inserted by the next step)."""
+        self.session.add_route(self.route, [self.edge])
+        self.remove()
+        self.episode += 1
+        self.vut = f"{self.prefix}.vut.{self.episode}"
+        self.pov = f"{self.prefix}.pov.{self.episode}"
+        add = libsumo.vehicle.add
+        try:
+            add(self.pov, self.route, self.pov_type, "now", "0", str(_INSERT_POV_POS_M), "0")
+            add(self.vut, self.route, self.vut_type, "now", "0", str(_INSERT_VUT_POS_M), "0")
+        except SUMO_ERRORS as e:
+            raise SimulationError(f"adding pair {self.prefix} failed: {e}") from e
+
+    def place(self, p: PairPlacement) -> None:
+        """Put the freshly inserted vehicles exactly at ``p`` (call after one step)."""
+        try:
+            for vid in (self.vut, self.pov):
+                libsumo.vehicle.setLaneChangeMode(vid, LC_MODE_NONE)
+            libsumo.vehicle.setSpeedMode(self.pov, SPEED_MODE_UNCHECKED)
+            libsumo.vehicle.moveTo(self.pov, f"{self.edge}_{p.pov_lane}", p.pov_pos_m)
+            libsumo.vehicle.moveTo(self.vut, f"{self.edge}_{p.vut_lane}", p.vut_pos_m)
+            libsumo.vehicle.setPreviousSpeed(self.pov, p.pov_speed_mps)
+            libsumo.vehicle.setPreviousSpeed(self.vut, p.vut_speed_mps)
+        except SUMO_ERRORS as e:
+            raise SimulationError(
+                f"placing pair {self.prefix} at {p} failed ({e}); was it inserted? "
+                "(a vehicle SUMO could not insert is silently kept waiting)"
+            ) from e
+
+    def remove(self) -> None:
+        """Remove the pair's vehicles if they are still in the simulation."""
+        for vid in (self.vut, self.pov):
+            if not vid:
+                continue
+            try:
+                libsumo.vehicle.remove(vid)
+            except SUMO_ERRORS:
+                pass  # already gone (left the network, or never inserted)
+        self.vut = self.pov = ""
+
+    # ------------------------------------------------------------------ per step
+
+    def command_pov_speed(self, speed_mps: float) -> None:
+        """The POV drives at exactly ``speed_mps`` during the next step (checks are off)."""
+        _set_speed(self.pov, speed_mps)
+
+    def longitudinal(self) -> tuple[float, float, float, float]:
+        """``(pov_pos_m, pov_speed_mps, vut_pos_m, vut_speed_mps)``, front bumpers."""
+        pov, vut = self.pov, self.vut
+        try:
+            return _get_lane_pos(pov), _get_speed(pov), _get_lane_pos(vut), _get_speed(vut)
+        except SUMO_ERRORS as e:
+            raise SimulationError(
+                f"pair {self.prefix} vanished from SUMO ({e}): did a vehicle leave the road?"
+            ) from e
+
+    def vut_accel_mps2(self) -> float:
+        """The VUT's acceleration during the last step [m/s²] (SUMO's model)."""
+        return float(_get_accel(self.vut))
+
+    def lanes(self) -> tuple[int, int]:
+        """``(pov_lane, vut_lane)`` indices (the lane of the vehicle's front)."""
+        return _get_lane_index(self.pov), _get_lane_index(self.vut)
+
+    def positions_xy(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """World ``(x, y)`` of the POV's and the VUT's front bumper centre [m]."""
+        return _get_position(self.pov), _get_position(self.vut)
+
+    def change_pov_lane(self, lane: int, duration_s: float) -> None:
+        """Start a forced change of the POV to ``lane`` (continuous lateral motion)."""
+        libsumo.vehicle.changeLane(self.pov, lane, duration_s)
+
+    def collided(self, colliding: tuple[str, ...] | list[str] | object) -> bool:
+        """Whether either vehicle of the pair is in ``colliding`` (ids from the session)."""
+        return self.vut in colliding or self.pov in colliding  # type: ignore[operator]

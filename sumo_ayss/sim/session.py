@@ -1,0 +1,157 @@
+"""The process's one libsumo simulation.
+
+libsumo holds exactly one simulation per process (SUMO maintainers, eclipse-sumo/sumo
+#7694). :class:`SumoSession` makes that explicit: it starts SUMO lazily, knows its owner,
+and a second owner asking for a live simulation gets a clear :class:`SimulationError`
+instead of a libsumo crash or, worse, silently sharing (and corrupting) the first one.
+"""
+
+from __future__ import annotations
+
+import logging
+import tempfile
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any, ClassVar
+
+import libsumo
+
+from sumo_ayss.catalog import VehicleType, vtypes_xml
+from sumo_ayss.config import SimConfig
+from sumo_ayss.errors import SimulationError
+from sumo_ayss.sim.network import sumo_binary
+
+logger = logging.getLogger(__name__)
+
+#: libsumo's exception types; wrapped into SimulationError at this layer's boundary.
+SUMO_ERRORS: tuple[type[BaseException], ...] = (libsumo.TraCIException, libsumo.FatalTraCIError)
+
+
+def sumo_version() -> str:
+    """Version string of the libsumo in use (e.g. ``1.28.0``)."""
+    return str(libsumo.__version__) if hasattr(libsumo, "__version__") else "unknown"
+
+
+class SumoSession:
+    """Owner of the process's libsumo simulation.
+
+    Args:
+        network: ``.net.xml`` to load.
+        vtypes: vehicle types to load, by type id.
+        sim: SUMO options.
+        seed: SUMO's ``--seed`` (SUMO is deterministic for a fixed seed).
+        owner: a short description of who owns it, shown in the error a second owner gets.
+    """
+
+    _live: ClassVar[SumoSession | None] = None
+
+    def __init__(
+        self,
+        network: Path,
+        vtypes: Mapping[str, VehicleType],
+        sim: SimConfig,
+        seed: int,
+        owner: str,
+    ) -> None:
+        if not Path(network).is_file():
+            raise SimulationError(f"network file not found: {network}")
+        self.network = Path(network)
+        self.vtypes = dict(vtypes)
+        self.sim = sim
+        self.seed = int(seed)
+        self.owner = owner
+        self._tmp: tempfile.TemporaryDirectory[str] | None = None
+
+    @property
+    def running(self) -> bool:
+        return SumoSession._live is self
+
+    def command(self, additional: Path) -> list[str]:
+        """The SUMO command line (without starting it)."""
+        s = self.sim
+        return [
+            str(sumo_binary("sumo")),
+            "--net-file", str(self.network),
+            "--additional-files", str(additional),
+            "--step-length", repr(s.step_length_s),
+            "--seed", str(self.seed),
+            # A collision is reported and the vehicles keep driving (they pass through each
+            # other); the default action teleports them away and hides the crash.
+            "--collision.action", "warn",
+            # 0: only physical overlap is a collision (the default flags a 0.3 m gap).
+            "--collision.mingap-factor", repr(s.collision_mingap_factor),
+            "--time-to-teleport", "-1",
+            # Continuous lateral motion for lane changes (the POV's cut-in has a real
+            # lateral velocity); without it SUMO changes lanes instantaneously.
+            "--lanechange.duration", repr(s.lanechange_duration_s),
+            "--no-step-log", "true",
+            "--no-warnings", "true",
+            "--duration-log.disable", "true",
+            "--begin", "0",
+            *s.extra_args,
+        ]  # fmt: skip
+
+    def start(self) -> None:
+        """Start SUMO if it is not running; raise if another owner holds the simulation."""
+        if self.running:
+            return
+        live = SumoSession._live
+        if live is not None:
+            raise SimulationError(
+                f"a libsumo simulation is already running in this process (owner: "
+                f"{live.owner}); libsumo holds one simulation per process. Close it first "
+                f"(env.close()) or run the second one in another process."
+            )
+        self._tmp = tempfile.TemporaryDirectory(prefix="sumo_ayss_")
+        additional = Path(self._tmp.name) / "vtypes.add.xml"
+        additional.write_text(vtypes_xml(self.vtypes))
+        cmd = self.command(additional)
+        logger.debug("starting SUMO: %s", " ".join(cmd))
+        try:
+            libsumo.start(cmd)
+        except SUMO_ERRORS as e:
+            self._cleanup()
+            raise SimulationError(f"SUMO failed to start ({e}); command: {' '.join(cmd)}") from e
+        SumoSession._live = self
+
+    def close(self) -> None:
+        """Close the simulation; safe to call twice and on a session that never started."""
+        if self.running:
+            try:
+                libsumo.close()
+            except SUMO_ERRORS as e:  # pragma: no cover - SUMO already gone
+                logger.warning("libsumo.close() failed: %s", e)
+            finally:
+                SumoSession._live = None
+        self._cleanup()
+
+    def _cleanup(self) -> None:
+        if self._tmp is not None:
+            self._tmp.cleanup()
+            self._tmp = None
+
+    # ------------------------------------------------------------------ simulation calls
+
+    def step(self) -> None:
+        """Advance SUMO by one ``step_length_s``."""
+        libsumo.simulationStep()
+
+    def time_s(self) -> float:
+        return float(libsumo.simulation.getTime())
+
+    def colliding_ids(self) -> Sequence[str]:
+        """Ids of vehicles involved in a collision during the last step."""
+        if libsumo.simulation.getCollidingVehiclesNumber() == 0:
+            return ()
+        return tuple(libsumo.simulation.getCollidingVehiclesIDList())
+
+    def add_route(self, route_id: str, edges: Sequence[str]) -> None:
+        if route_id not in libsumo.route.getIDList():
+            libsumo.route.add(route_id, list(edges))
+
+    def call(self, fn: Any, *args: Any) -> Any:
+        """Call a libsumo function, turning its errors into :class:`SimulationError`."""
+        try:
+            return fn(*args)
+        except SUMO_ERRORS as e:
+            raise SimulationError(f"SUMO call {getattr(fn, '__name__', fn)}{args} failed: {e}") from e
