@@ -29,16 +29,18 @@ class InitialCondition:
 
 
 def sample_initial_condition(odd: OddConfig, rng: np.random.Generator) -> InitialCondition:
-    """Uniform draw from the ODD's speed and gap ranges (three draws, in field order)."""
-    lo = np.array([odd.pov_speed_mps[0], odd.vut_speed_mps[0], odd.gap_m[0]])
-    hi = np.array([odd.pov_speed_mps[1], odd.vut_speed_mps[1], odd.gap_m[1]])
-    v_pov, v_vut, gap = rng.uniform(lo, hi)
-    return InitialCondition(float(v_pov), float(v_vut), float(gap))
+    """Uniform draw from the ODD's speed and gap ranges (one ``rng.random(3)``, field order)."""
+    u_pov, u_vut, u_gap = rng.random(3).tolist()
+    return InitialCondition(
+        _lerp(odd.pov_speed_mps, u_pov), _lerp(odd.vut_speed_mps, u_vut), _lerp(odd.gap_m, u_gap)
+    )
 
 
-def sample_initial_conditions(
-    odd: OddConfig, n: int, seed: int
-) -> list[InitialCondition]:
+def _lerp(bounds: tuple[float, float], u: float) -> float:
+    return bounds[0] + (bounds[1] - bounds[0]) * u
+
+
+def sample_initial_conditions(odd: OddConfig, n: int, seed: int) -> list[InitialCondition]:
     """``n`` initial conditions from a seed: the fixed scenario set shared by every VUT."""
     rng = np.random.default_rng(seed)
     return [sample_initial_condition(odd, rng) for _ in range(n)]

@@ -11,8 +11,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from abc import abstractmethod
-from dataclasses import dataclass
-from typing import Any, ClassVar, SupportsFloat, SupportsInt
+from typing import Any, ClassVar, NamedTuple, SupportsFloat, SupportsInt
 
 import gymnasium as gym
 import numpy as np
@@ -43,9 +42,12 @@ def time_to_collision_s(gap_m: float, v_follower_mps: float, v_leader_mps: float
     return gap_m / closing if closing > 0.0 else math.inf
 
 
-@dataclass(frozen=True)
-class PairKinematics:
-    """What a step reads back from SUMO (front-bumper positions, m; speeds, m/s)."""
+class PairKinematics(NamedTuple):
+    """What a step reads back from SUMO (front-bumper positions, m; speeds, m/s).
+
+    A NamedTuple, not a dataclass: it is built on every step and a frozen dataclass costs
+    several times more to construct.
+    """
 
     pov_pos_m: float
     pov_speed_mps: float
@@ -84,10 +86,16 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         self.sumo_seed = sumo_seed
         self._session: SumoSession | None = None
         self._pair: VehiclePair | None = None
+        # Per-step constants, looked up once (config properties compute on each access).
         self._pov_length_m = config.pov.length_m
         self._dt_s = config.sim.step_length_s
+        self._substeps = config.steps_per_decision
+        self._max_decisions = config.max_decisions
+        self._actuator = config.actuator
+        self._reward_cfg = config.reward
         self._decisions = 0
         self._v_pov = 0.0
+        self._k: PairKinematics | None = None
         self.initial_condition: InitialCondition | None = None
 
     # ------------------------------------------------------------------ case hooks
@@ -133,7 +141,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         self.initial_condition = ic
         self._decisions = 0
         self._v_pov = ic.pov_speed_mps
-        k = self._kinematics()
+        k = self._k = self._kinematics()
         info = {
             "headway_m": k.headway_m,
             "ttc_s": time_to_collision_s(k.headway_m, k.vut_speed_mps, k.pov_speed_mps),
@@ -146,19 +154,18 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         self, action: SupportsInt
     ) -> tuple[npt.NDArray[np.float32], SupportsFloat, bool, bool, dict[str, Any]]:
         pair = self._pair
-        if pair is None or self.initial_condition is None:
+        if pair is None or self._k is None:
             raise ActionError("step() called before reset()")
         a = self._validate_action(action)
-        k0 = self._kinematics()
-        target = self._apply_action(a, k0)
-        cfg = self.config
+        target = self._apply_action(a, self._k)
         session = pair.session
+        actuator = self._actuator
         v = self._v_pov
         collided = False
         accel = 0.0
-        for _ in range(cfg.steps_per_decision):
-            accel = pov_acceleration(v, target, cfg.actuator)
-            v = next_speed(v, accel, self._dt_s, cfg.actuator)
+        for _ in range(self._substeps):
+            accel = pov_acceleration(v, target, actuator)
+            v = next_speed(v, accel, self._dt_s, actuator)
             pair.command_pov_speed(v)
             session.step()
             if pair.collided(session.colliding_ids()):
@@ -166,13 +173,13 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
                 break
         self._v_pov = v
         self._decisions += 1
-        k = self._kinematics()
+        k = self._k = self._kinematics()
         r_a, extra = self._reward_terms(k, collided)
         if collided:
             r_a = 0.0
-        reward = total_reward(r_a, collided, cfg.reward)
+        reward = total_reward(r_a, collided, self._reward_cfg)
         terminated = collided
-        truncated = not terminated and self._decisions >= cfg.max_decisions
+        truncated = not terminated and self._decisions >= self._max_decisions
         info = {
             "headway_m": k.headway_m,
             "ttc_s": time_to_collision_s(k.headway_m, k.vut_speed_mps, k.pov_speed_mps),
@@ -198,12 +205,18 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
     # ------------------------------------------------------------------ internals
 
     def _validate_action(self, action: SupportsInt) -> int:
-        try:
-            a = int(action)
-        except (TypeError, ValueError) as e:
-            raise ActionError(f"action must be an integer, got {action!r}") from e
         n = int(self.action_space.n)  # type: ignore[attr-defined]
-        if not 0 <= a < n or a != action:
+        if isinstance(action, int | np.integer) and not isinstance(action, bool):
+            a = int(action)
+        elif (
+            isinstance(action, np.ndarray)
+            and action.shape in ((), (1,))
+            and action.dtype.kind in "iu"
+        ):
+            a = int(action.reshape(()))  # SB3's predict() returns a 0-d or 1-element array
+        else:
+            raise ActionError(f"action must be an integer in [0, {n - 1}], got {action!r}")
+        if not 0 <= a < n:
             raise ActionError(f"action must be an integer in [0, {n - 1}], got {action!r}")
         return a
 

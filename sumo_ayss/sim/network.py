@@ -1,7 +1,8 @@
-"""The built-in SUMO networks and their rebuild with the pip-installed ``netconvert``.
+"""The built-in SUMO world: networks rebuilt with the pip-installed ``netconvert``.
 
 Run ``python -m sumo_ayss.sim.network`` (or ``make networks``) to rebuild every
-``networks/*.net.xml`` from its plain-XML sources (``.nod.xml``, ``.edg.xml``).
+``networks/*.net.xml`` from its plain-XML sources (``.nod.xml``, ``.edg.xml``) and to
+rewrite ``routes/vtypes.add.xml`` (the POV and the built-in VUTs) from the catalog.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ import os
 import subprocess
 from pathlib import Path
 
+from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE, vtypes_xml
 from sumo_ayss.config import PROJECT_ROOT, Case
 from sumo_ayss.errors import SimulationError
 
@@ -78,6 +80,14 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     for stem in sorted(set(NETWORK_OF_CASE.values())):
         print(build_network(stem, out_dir=args.out_dir))
+    print(write_vtypes_file((args.out_dir or PROJECT_ROOT / "routes") / "vtypes.add.xml"))
+
+
+def write_vtypes_file(path: Path) -> Path:
+    """The catalog's POV and built-in VUTs as a SUMO additional file (ids ``vut_<name>``)."""
+    types = {f"vut_{name}": vt for name, vt in BUILTIN_VUTS.items()} | {"pov": POV_TYPE}
+    path.write_text(vtypes_xml(types))
+    return path
 
 
 if __name__ == "__main__":

@@ -13,20 +13,25 @@ are always downstream of the insertion spot, so they cannot block the insertion.
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import libsumo
+from libsumo import _libsumo
 
 from sumo_ayss.errors import SimulationError
 from sumo_ayss.sim.session import SUMO_ERRORS, SumoSession
 
-# libsumo functions bound once: attribute lookups are a measurable part of a 30 µs step.
-_get_lane_pos = libsumo.vehicle.getLanePosition
-_get_speed = libsumo.vehicle.getSpeed
-_get_accel = libsumo.vehicle.getAcceleration
-_get_lane_index = libsumo.vehicle.getLaneIndex
-_get_position = libsumo.vehicle.getPosition
-_set_speed = libsumo.vehicle.setSpeed
+# Hot-path getters bound once to libsumo's compiled functions. The public ``libsumo.vehicle``
+# methods are Python wrappers around these; in a 30 µs step the wrapper calls and attribute
+# lookups cost as much as the getters themselves (measured: benchmarks/env_throughput.py).
+_get_lane_pos = _libsumo.vehicle_getLanePosition
+_get_speed = _libsumo.vehicle_getSpeed
+_get_accel = _libsumo.vehicle_getAcceleration
+_get_lane_index = _libsumo.vehicle_getLaneIndex
+_get_position = _libsumo.vehicle_getPosition
+_set_speed = _libsumo.vehicle_setSpeed
 
 #: Where new vehicles are inserted (front positions [m]) before being moved into place.
 _INSERT_VUT_POS_M = 10.0
@@ -129,10 +134,8 @@ class VehiclePair:
         for vid in (self.vut, self.pov):
             if not vid:
                 continue
-            try:
+            with contextlib.suppress(*SUMO_ERRORS):  # gone already (left, or never inserted)
                 libsumo.vehicle.remove(vid)
-            except SUMO_ERRORS:
-                pass  # already gone (left the network, or never inserted)
         self.vut = self.pov = ""
 
     # ------------------------------------------------------------------ per step
@@ -167,6 +170,6 @@ class VehiclePair:
         """Start a forced change of the POV to ``lane`` (continuous lateral motion)."""
         libsumo.vehicle.changeLane(self.pov, lane, duration_s)
 
-    def collided(self, colliding: tuple[str, ...] | list[str] | object) -> bool:
+    def collided(self, colliding: Sequence[str]) -> bool:
         """Whether either vehicle of the pair is in ``colliding`` (ids from the session)."""
-        return self.vut in colliding or self.pov in colliding  # type: ignore[operator]
+        return bool(colliding) and (self.vut in colliding or self.pov in colliding)

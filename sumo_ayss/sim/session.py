@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 import libsumo
+from libsumo import _libsumo
 
 from sumo_ayss.catalog import VehicleType, vtypes_xml
 from sumo_ayss.config import SimConfig
@@ -25,6 +26,11 @@ logger = logging.getLogger(__name__)
 
 #: libsumo's exception types; wrapped into SimulationError at this layer's boundary.
 SUMO_ERRORS: tuple[type[BaseException], ...] = (libsumo.TraCIException, libsumo.FatalTraCIError)
+
+
+_step = _libsumo.simulation_step
+_n_colliding = _libsumo.simulation_getCollidingVehiclesNumber
+_colliding_ids = _libsumo.simulation_getCollidingVehiclesIDList
 
 
 def sumo_version() -> str:
@@ -134,16 +140,18 @@ class SumoSession:
 
     def step(self) -> None:
         """Advance SUMO by one ``step_length_s``."""
-        libsumo.simulationStep()
+        # The compiled step, without libsumo's Python step-listener bookkeeping (we register
+        # no listeners); the public wrapper costs ~2 µs per call on a ~10 µs step.
+        _step(0.0)
 
     def time_s(self) -> float:
         return float(libsumo.simulation.getTime())
 
     def colliding_ids(self) -> Sequence[str]:
         """Ids of vehicles involved in a collision during the last step."""
-        if libsumo.simulation.getCollidingVehiclesNumber() == 0:
+        if _n_colliding() == 0:
             return ()
-        return tuple(libsumo.simulation.getCollidingVehiclesIDList())
+        return tuple(_colliding_ids())
 
     def add_route(self, route_id: str, edges: Sequence[str]) -> None:
         if route_id not in libsumo.route.getIDList():
@@ -154,4 +162,6 @@ class SumoSession:
         try:
             return fn(*args)
         except SUMO_ERRORS as e:
-            raise SimulationError(f"SUMO call {getattr(fn, '__name__', fn)}{args} failed: {e}") from e
+            raise SimulationError(
+                f"SUMO call {getattr(fn, '__name__', fn)}{args} failed: {e}"
+            ) from e

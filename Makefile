@@ -1,0 +1,54 @@
+# One Makefile for people and CI: `make demo` (the main job) and `make test`.
+# Each target creates or refreshes the local virtual environment (.venv) when it is
+# missing or older than pyproject.toml; nothing else is needed on a fresh machine with
+# Python 3.11.
+
+PYTHON ?= $(shell command -v python3.11 || command -v python3)
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+# torch first, pinned: that CPU build is on this machine's disk; an unpinned torch pulls a
+# multi-GB CUDA build from PyPI.
+TORCH  := torch==2.13.0
+
+.PHONY: all demo test test-slow lint format typecheck bench networks clean
+
+all: test
+
+$(STAMP): pyproject.toml
+	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet $(TORCH)
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	@touch $(STAMP)
+
+venv: $(STAMP)
+
+demo: $(STAMP)
+	$(BIN)/python -m sumo_ayss.demo
+
+test: $(STAMP)
+	$(BIN)/python -m pytest
+
+test-slow: $(STAMP)
+	$(BIN)/python -m pytest -m slow
+
+lint: $(STAMP)
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+
+format: $(STAMP)
+	$(BIN)/ruff format .
+	$(BIN)/ruff check --fix .
+
+typecheck: $(STAMP)
+	$(BIN)/mypy sumo_ayss
+
+bench: $(STAMP)
+	$(BIN)/python benchmarks/env_throughput.py
+
+networks: $(STAMP)
+	$(BIN)/python -m sumo_ayss.sim.network
+
+clean:
+	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache .mypy_cache

@@ -1,0 +1,105 @@
+"""Env throughput: CarFollowing-v0 (random policy, resets included) vs a raw libsumo loop.
+
+Both run in this one process, one after the other, on the same scene (one VUT-POV pair,
+5 s episodes of 25 steps, fresh vehicles each episode). The raw loop does the minimum of
+libsumo calls the scene needs, with no Python env around it: it is the ceiling.
+
+    python benchmarks/env_throughput.py [--steps 60000] [--repeats 3]
+
+Targets (issue 2): >= 30,000 env steps/s and >= 35 % of the raw loop.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+
+from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE
+from sumo_ayss.config import SimConfig
+from sumo_ayss.envs.car_following import CarFollowingEnv
+from sumo_ayss.sim.network import network_path
+from sumo_ayss.sim.session import SumoSession
+
+
+def bench_env(env_cls: type, steps: int) -> float:
+    env = env_cls()
+    rng = np.random.default_rng(0)
+    actions = rng.integers(0, env.action_space.n, size=steps)
+    env.reset(seed=0)
+    t0 = time.perf_counter()
+    for a in actions:
+        _, _, term, trunc, _ = env.step(int(a))
+        if term or trunc:
+            env.reset()
+    dt = time.perf_counter() - t0
+    env.close()
+    return steps / dt
+
+
+def bench_raw(steps: int) -> float:
+    import libsumo
+
+    types = {"vut_pi1": BUILTIN_VUTS["pi1"], "pov": POV_TYPE}
+    session = SumoSession(network_path("car_following"), types, SimConfig(), 0, "raw bench")
+    session.start()
+    libsumo.route.add("r", ["road"])
+    rng = np.random.default_rng(0)
+    v = rng.uniform(10, 30, size=steps)
+    ep = 0
+    vut = pov = ""
+    t0 = time.perf_counter()
+    for i in range(steps):
+        if i % 25 == 0:  # new episode: fresh vehicles, one insertion step, exact placement
+            if vut:
+                libsumo.vehicle.remove(vut)
+                libsumo.vehicle.remove(pov)
+            ep += 1
+            vut, pov = f"v{ep}", f"p{ep}"
+            libsumo.vehicle.add(pov, "r", "pov", "now", "0", "60", "0")
+            libsumo.vehicle.add(vut, "r", "vut_pi1", "now", "0", "10", "0")
+            libsumo.simulationStep()
+            libsumo.vehicle.setSpeedMode(pov, 0)
+            libsumo.vehicle.moveTo(pov, "road_0", 170.0)
+            libsumo.vehicle.moveTo(vut, "road_0", 150.0)
+            libsumo.vehicle.setPreviousSpeed(pov, 20.0)
+            libsumo.vehicle.setPreviousSpeed(vut, 20.0)
+        libsumo.vehicle.setSpeed(pov, v[i])
+        libsumo.simulationStep()
+        libsumo.vehicle.getLanePosition(pov)
+        libsumo.vehicle.getSpeed(pov)
+        libsumo.vehicle.getLanePosition(vut)
+        libsumo.vehicle.getSpeed(vut)
+        libsumo.simulation.getCollidingVehiclesNumber()
+    dt = time.perf_counter() - t0
+    session.close()
+    return steps / dt
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--steps", type=int, default=60_000)
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    cases: dict[str, object] = {"CarFollowing-v0": CarFollowingEnv}
+    try:
+        from sumo_ayss.envs.cut_in import CutInEnv
+
+        cases["CutIn-v0"] = CutInEnv
+    except ImportError:
+        pass
+    raw = [bench_raw(args.steps) for _ in range(args.repeats)]
+    raw_med = statistics.median(raw)
+    print(f"{'loop':<22}{'steps/s (median)':>18}{'min':>10}{'max':>10}{'vs raw':>9}")
+    print(f"{'raw libsumo':<22}{raw_med:>18,.0f}{min(raw):>10,.0f}{max(raw):>10,.0f}{1:>9.0%}")
+    for name, cls in cases.items():
+        runs = [bench_env(cls, args.steps) for _ in range(args.repeats)]  # type: ignore[arg-type]
+        med = statistics.median(runs)
+        print(f"{name:<22}{med:>18,.0f}{min(runs):>10,.0f}{max(runs):>10,.0f}{med / raw_med:>9.0%}")
+    print("targets: >= 30,000 env steps/s; >= 35 % of the raw loop")
+
+
+if __name__ == "__main__":
+    main()

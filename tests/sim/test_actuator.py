@@ -1,0 +1,39 @@
+"""The POV actuator: bounded, monotone, and the law the docs state."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given
+from hypothesis import strategies as st
+
+from sumo_ayss.config import ActuatorConfig
+from sumo_ayss.sim.actuator import next_speed, pov_acceleration, pov_acceleration_array
+
+CFG = ActuatorConfig()
+speeds = st.floats(0.0, 40.0)
+targets = st.floats(-10.0, 500.0)
+
+
+@given(speeds, targets)
+def test_bounded_and_signed(v: float, target: float) -> None:
+    a = pov_acceleration(v, target, CFG)
+    assert CFG.accel_min_mps2 <= a <= CFG.accel_max_mps2
+    clipped = min(max(target, 0.0), CFG.max_speed_mps)
+    assert (a > 0) == (clipped > v) or a == 0.0
+    v1 = next_speed(v, a, 0.2, CFG)
+    assert 0.0 <= v1 <= CFG.max_speed_mps
+
+
+@given(speeds, targets, targets)
+def test_monotone_in_target(v: float, t1: float, t2: float) -> None:
+    lo, hi = sorted((t1, t2))
+    assert pov_acceleration(v, lo, CFG) <= pov_acceleration(v, hi, CFG)
+
+
+def test_known_values_and_vectorised_twin() -> None:
+    assert pov_acceleration(25.0, 20.0, CFG) == -6.0  # unclipped law gives -8.3
+    assert pov_acceleration(20.0, 21.2, CFG) == (21.2 - 20.0) / 0.6
+    v = np.array([25.0, 20.0, 0.0])
+    t = np.array([20.0, 21.2, 100.0])
+    expected = [pov_acceleration(a, b, CFG) for a, b in zip(v, t, strict=True)]
+    np.testing.assert_allclose(pov_acceleration_array(v, t, CFG), expected)
