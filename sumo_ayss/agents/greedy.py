@@ -1,0 +1,34 @@
+"""Greedy (argmax-Q) policy of a trained model, batched, for evaluation and Monte Carlo."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+import torch as th
+
+from sumo_ayss.agents.dqn import AyssDQN
+
+
+class GreedyPolicy:
+    """``obs (N, d) float32 -> actions (N,) int64``: argmax of the online Q network.
+
+    One batched forward pass per call, without SB3's ``predict`` bookkeeping, so a Monte
+    Carlo stage can evaluate many thousands of observations at once.
+    """
+
+    def __init__(self, model: AyssDQN) -> None:
+        self.q_net = model.q_net
+        self.q_net.set_training_mode(False)
+
+    @classmethod
+    def load(cls, path: str | Path) -> GreedyPolicy:
+        return cls(AyssDQN.load(str(path), device="cpu"))
+
+    def q_values(self, obs: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
+        with th.no_grad():
+            return self.q_net(th.as_tensor(np.asarray(obs, dtype=np.float32))).numpy()
+
+    def __call__(self, obs: npt.NDArray[np.float32]) -> npt.NDArray[np.int64]:
+        return self.q_values(obs).argmax(axis=1).astype(np.int64)

@@ -1,0 +1,84 @@
+"""An experiment = environment + learner + training schedule, loaded from one YAML file.
+
+    env:   {case: car_following, vut: pi1, odd: {...}, reward: {...}, ...}   # EnvConfig
+    agent: {gamma: 0.8, learning_rate: 1.0e-5, ...}                         # DQNHyperParams
+    train: {total_timesteps: 200000, eval_every: 10000, ...}                # TrainConfig
+
+Every key is optional (defaults in code); unknown keys are rejected with a suggestion.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar
+
+from sumo_ayss.agents.hparams import DQNHyperParams
+from sumo_ayss.config import EnvConfig, _require, build, read_yaml, to_dict
+from sumo_ayss.selection import CRITERIA
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """Training schedule and candidate evaluation. Section ``train``."""
+
+    SECTION: ClassVar[str] = "train"
+
+    total_timesteps: int = 200_000
+    """Environment steps (transitions) per run."""
+    eval_every: int = 10_000
+    """Steps between SPCP candidates (paper: 10,000). Each is saved and evaluated."""
+    n_eval_scenarios: int = 100
+    """Fixed scenarios each candidate is evaluated on (paper: 100)."""
+    eval_seed: int = 2024
+    """Seed of the evaluation scenarios: the same for every VUT and training seed."""
+    selection: str = "mean_reward"
+    """SPCP criterion, one of :data:`sumo_ayss.selection.CRITERIA`."""
+    torch_threads: int = 1
+    """PyTorch intra-op threads; 1 lets parallel runs share cores without contention."""
+    progress_bar: bool = True
+
+    def __post_init__(self) -> None:
+        s = self.SECTION
+        for name in ("total_timesteps", "eval_every", "n_eval_scenarios", "torch_threads"):
+            value = getattr(self, name)
+            _require(value >= 1, f"{s}.{name} must be >= 1, got {value}")
+        _require(
+            self.eval_every <= self.total_timesteps,
+            f"{s}.eval_every ({self.eval_every}) must be <= total_timesteps "
+            f"({self.total_timesteps})",
+        )
+        _require(
+            self.selection in CRITERIA,
+            f"{s}.selection must be one of {sorted(CRITERIA)}, got {self.selection!r}",
+        )
+
+
+@dataclass(frozen=True)
+class ExperimentConfig:
+    """The whole resolved configuration of one training run (minus VUT name and seed)."""
+
+    env: EnvConfig = field(default_factory=EnvConfig)
+    agent: DQNHyperParams = field(default_factory=DQNHyperParams)
+    train: TrainConfig = field(default_factory=TrainConfig)
+
+    def with_vut(self, vut: str | None) -> ExperimentConfig:
+        if vut is None:
+            return self
+        return dataclasses.replace(self, env=dataclasses.replace(self.env, vut=vut))
+
+    def to_dict(self) -> dict[str, Any]:
+        return to_dict(self)  # type: ignore[no-any-return]
+
+
+def load_experiment(path: str | Path | None) -> ExperimentConfig:
+    """Defaults, overridden by the YAML file at ``path`` (``None``: defaults only)."""
+    if path is None:
+        return ExperimentConfig()
+    path = Path(path)
+    return build(ExperimentConfig, read_yaml(path), "", path.resolve().parent)
+
+
+def experiment_from_dict(data: dict[str, Any], base_dir: Path) -> ExperimentConfig:
+    return build(ExperimentConfig, data, "", base_dir)

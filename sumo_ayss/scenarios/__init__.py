@@ -1,0 +1,1 @@
+"""Running policies on scenario sets: candidate evaluation, outcome tables, Monte Carlo AYSS."""

@@ -1,0 +1,443 @@
+"""Train SPCP candidates for one (case, VUT, seed) and select the SPCP.
+
+    python -m sumo_ayss.train --config configs/car_following.yaml --vut pi1 --seed 0
+    python -m sumo_ayss.train --config configs/car_following.yaml --vut pi1 --seed 0 --resume
+
+Every ``train.eval_every`` steps the model is stored as an SPCP candidate and evaluated on
+``train.n_eval_scenarios`` fixed initial conditions (``train.eval_seed``: the same for every
+VUT and seed), in the process's one SUMO simulation: the training env itself is borrowed at
+an episode boundary and put back exactly where it was. At the end the SPCP is selected by
+``train.selection``.
+
+Run folder ``<out>/<case>/<vut>/seed_<k>/``:
+
+    config.yaml        the exact resolved configuration (with vut and seed)
+    command.txt        the command line
+    versions.json      Python, package, SUMO, torch, SB3, gymnasium, numpy versions
+    seeds.json         training seed, SUMO seed, evaluation-scenario seed
+    eval.csv           one row per candidate (step, mean_return, crash_rate, ...)
+    checkpoints/       step_XXXXXXXX/model.zip per candidate; the latest also holds the
+                       replay buffer and RNG state; latest.json points at it
+    spcp.json, spcp.zip  the selected candidate and why
+    tb/                TensorBoard logs
+
+Every file is written atomically (temporary file + rename), and ``latest.json`` is written
+last, so a kill at any moment leaves a resumable folder.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import dataclasses
+import io
+import json
+import logging
+import os
+import platform
+import random
+import shlex
+import shutil
+import sys
+import time
+from collections.abc import Sequence
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch as th
+from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.monitor import Monitor
+from stable_baselines3.common.vec_env import DummyVecEnv
+
+from sumo_ayss.agents.dqn import AyssDQN
+from sumo_ayss.agents.greedy import GreedyPolicy
+from sumo_ayss.config import to_dict, write_yaml
+from sumo_ayss.envs import make_env
+from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
+from sumo_ayss.envs.pair_env import PairEnv
+from sumo_ayss.errors import CheckpointError, ConfigError
+from sumo_ayss.experiment import ExperimentConfig, experiment_from_dict, load_experiment
+from sumo_ayss.scenarios.rollout import run_episodes, summarize
+from sumo_ayss.selection import select_spcp
+
+logger = logging.getLogger(__name__)
+
+EVAL_COLUMNS = [
+    "step",
+    "mean_return",
+    "std_return",
+    "crash_rate",
+    "lane_change_rate",
+    "mean_final_headway_m",
+    "n_episodes",
+    "wall_s",
+    "checkpoint",
+]
+
+
+# ---------------------------------------------------------------------- atomic file helpers
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def atomic_write_json(path: Path, data: Any) -> None:
+    atomic_write_text(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
+
+
+def write_eval_table(path: Path, rows: Sequence[dict[str, Any]]) -> None:
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=EVAL_COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    atomic_write_text(path, buf.getvalue())
+
+
+def read_eval_table(path: Path) -> list[dict[str, Any]]:
+    if not path.is_file():
+        return []
+    with path.open() as f:
+        rows = list(csv.DictReader(f))
+    for row in rows:
+        row["step"] = int(row["step"])
+        row["n_episodes"] = int(row["n_episodes"])
+        for key in EVAL_COLUMNS:
+            if key not in ("step", "n_episodes", "checkpoint"):
+                row[key] = float(row[key])
+    return rows
+
+
+def versions() -> dict[str, str]:
+    out = {"python": platform.python_version(), "platform": platform.platform()}
+    for dist in (
+        "sumo_ayss",
+        "eclipse-sumo",
+        "libsumo",
+        "sumolib",
+        "stable-baselines3",
+        "torch",
+        "gymnasium",
+        "numpy",
+    ):
+        try:
+            out[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            out[dist] = "not installed"
+    return out
+
+
+def run_dir_for(out: Path, cfg: ExperimentConfig, seed: int) -> Path:
+    return out / cfg.env.case / cfg.env.vut / f"seed_{seed}"
+
+
+# ---------------------------------------------------------------------- the trainer
+
+
+class Trainer:
+    """Owns one run: its folder, env, model, candidates and evaluation table."""
+
+    def __init__(self, cfg: ExperimentConfig, seed: int, run_dir: Path) -> None:
+        self.cfg = cfg
+        self.seed = seed
+        self.run_dir = run_dir
+        self.ckpt_dir = run_dir / "checkpoints"
+        self.eval_path = run_dir / "eval.csv"
+        self.scenarios = sample_initial_conditions(
+            cfg.env.odd, cfg.train.n_eval_scenarios, cfg.train.eval_seed
+        )
+        self.rows: list[dict[str, Any]] = []
+        self.next_eval = cfg.train.eval_every
+        self.env: PairEnv = make_env(cfg.env, sumo_seed=seed)
+        self.vec_env = DummyVecEnv([lambda: Monitor(self.env)])
+        self.model: AyssDQN | None = None
+
+    # -- folder ------------------------------------------------------------------------
+
+    def write_metadata(self, argv: Sequence[str]) -> None:
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        self.ckpt_dir.mkdir(exist_ok=True)
+        resolved = {"vut": self.cfg.env.vut, "seed": self.seed, **self.cfg.to_dict()}
+        write_yaml(self.run_dir / "config.yaml", resolved)
+        atomic_write_text(
+            self.run_dir / "command.txt", shlex.join([sys.executable, "-m", __spec__.name, *argv])
+            if __spec__
+            else shlex.join(argv)
+        )
+        atomic_write_json(self.run_dir / "versions.json", versions())
+        atomic_write_json(
+            self.run_dir / "seeds.json",
+            {"train_seed": self.seed, "sumo_seed": self.seed, "eval_seed": self.cfg.train.eval_seed},
+        )
+
+    # -- model ---------------------------------------------------------------------------
+
+    def new_model(self) -> AyssDQN:
+        th.set_num_threads(self.cfg.train.torch_threads)
+        self.model = AyssDQN(
+            self.vec_env,
+            self.cfg.agent,
+            seed=self.seed,
+            tensorboard_log=str(self.run_dir / "tb"),
+            device="cpu",
+        )
+        return self.model
+
+    def learn(self, progress_bar: bool) -> None:
+        model = self.model
+        assert model is not None
+        remaining = self.cfg.train.total_timesteps - model.num_timesteps
+        if remaining > 0:
+            model.learn(
+                total_timesteps=remaining,
+                callback=_CandidateCallback(self),
+                reset_num_timesteps=model.num_timesteps == 0,
+                tb_log_name="dqn",
+                progress_bar=progress_bar,
+            )
+        if model.num_timesteps >= self.next_eval:  # the last candidate, at the very end
+            self.candidate(at_episode_boundary=False)
+
+    # -- candidates ----------------------------------------------------------------------
+
+    def candidate(self, at_episode_boundary: bool = True) -> None:
+        """Store the model as a candidate, evaluate it, checkpoint, and move the schedule."""
+        model = self.model
+        assert model is not None
+        step = model.num_timesteps
+        step_dir = self.ckpt_dir / f"step_{step:09d}"
+        step_dir.mkdir(parents=True, exist_ok=True)
+        _atomic_model_save(model, step_dir / "model.zip")
+
+        # Borrow the training env: evaluation resets it to fixed initial conditions (this
+        # does not consume its RNG); afterwards the current episode's start is restored
+        # exactly, so the observation SB3 holds stays true.
+        current_ic = self.env.initial_condition
+        t0 = time.perf_counter()
+        summary = summarize(run_episodes(self.env, GreedyPolicy(model), self.scenarios))
+        wall = time.perf_counter() - t0
+        if at_episode_boundary and current_ic is not None:
+            self.env.reset(options={"initial_condition": current_ic})
+
+        row = {"step": step, **summary.as_dict(), "wall_s": round(wall, 3)}
+        row["checkpoint"] = str(step_dir.relative_to(self.run_dir) / "model.zip")
+        row = {k: row[k] for k in EVAL_COLUMNS}
+        self.rows.append(row)
+        model.logger.record("eval/mean_return", summary.mean_return)
+        model.logger.record("eval/crash_rate", summary.crash_rate)
+        model.logger.record("eval/mean_final_headway_m", summary.mean_final_headway_m)
+        logger.info("candidate %d: mean return %.3f", step, summary.mean_return)
+        while self.next_eval <= step:
+            self.next_eval += self.cfg.train.eval_every
+
+        self._save_resume_state(step_dir, current_ic)
+        write_eval_table(self.eval_path, self.rows)
+        previous = self._latest()
+        atomic_write_json(self.ckpt_dir / "latest.json", {"step": step, "dir": step_dir.name})
+        if previous is not None and previous != step_dir:  # keep one replay buffer only
+            (previous / "replay.pkl").unlink(missing_ok=True)
+
+    def _save_resume_state(self, step_dir: Path, ic: InitialCondition | None) -> None:
+        model = self.model
+        assert model is not None
+        tmp = step_dir / ".replay.pkl.tmp"
+        model.save_replay_buffer(tmp)
+        os.replace(tmp, step_dir / "replay.pkl")
+        state = {
+            "num_timesteps": model.num_timesteps,
+            "next_eval": self.next_eval,
+            "initial_condition": dataclasses.asdict(ic) if ic is not None else None,
+            "env_rng": self.env.np_random.bit_generator.state,
+            "numpy_rng": _jsonable(np.random.get_state()),
+            "python_rng": _jsonable(random.getstate()),
+        }
+        th.save(th.get_rng_state(), step_dir / ".torch_rng.pt.tmp")
+        os.replace(step_dir / ".torch_rng.pt.tmp", step_dir / "torch_rng.pt")
+        atomic_write_json(step_dir / "state.json", state)
+
+    def _latest(self) -> Path | None:
+        path = self.ckpt_dir / "latest.json"
+        if not path.is_file():
+            return None
+        return self.ckpt_dir / json.loads(path.read_text())["dir"]
+
+    # -- resume --------------------------------------------------------------------------
+
+    def resume(self) -> None:
+        """Continue from the latest complete checkpoint."""
+        latest = self._latest()
+        if latest is None:
+            raise CheckpointError(f"{self.run_dir}: no checkpoint to resume from")
+        state = json.loads((latest / "state.json").read_text())
+        th.set_num_threads(self.cfg.train.torch_threads)
+        model = AyssDQN.load(
+            str(latest / "model.zip"),
+            env=self.vec_env,
+            device="cpu",
+            tensorboard_log=str(self.run_dir / "tb"),
+        )
+        model.load_replay_buffer(latest / "replay.pkl")
+        self.model = model
+        self.next_eval = int(state["next_eval"])
+        self.rows = [r for r in read_eval_table(self.eval_path) if r["step"] <= model.num_timesteps]
+        # Put the env back at the checkpoint's episode start, with its RNG where it was
+        # (through the Monitor wrapper, which must see the reset too).
+        monitor = self.vec_env.envs[0]
+        monitor.reset(seed=self.seed)  # starts SUMO and creates the env RNG
+        self.env.np_random.bit_generator.state = state["env_rng"]
+        ic = state["initial_condition"]
+        obs, _ = monitor.reset(
+            options={"initial_condition": InitialCondition(**ic)} if ic else None
+        )
+        model._last_obs = obs[None, :]  # type: ignore[assignment]
+        model._last_episode_starts = np.ones((1,), dtype=bool)
+        np.random.set_state(_tuple_state(state["numpy_rng"]))
+        random.setstate(_tuple_state(state["python_rng"]))
+        th.set_rng_state(th.load(latest / "torch_rng.pt"))
+        logger.info("resumed %s at step %d", self.run_dir, model.num_timesteps)
+
+    # -- selection -----------------------------------------------------------------------
+
+    def select(self) -> dict[str, Any]:
+        choice = select_spcp(self.rows, self.cfg.train.selection)
+        row = self.rows[choice.index]
+        shutil.copyfile(self.run_dir / row["checkpoint"], self.run_dir / ".spcp.zip.tmp")
+        os.replace(self.run_dir / ".spcp.zip.tmp", self.run_dir / "spcp.zip")
+        record = {**dataclasses.asdict(choice), "checkpoint": row["checkpoint"], "row": row}
+        atomic_write_json(self.run_dir / "spcp.json", record)
+        return record
+
+    def close(self) -> None:
+        self.vec_env.close()
+        self.env.close()
+
+
+class _CandidateCallback(BaseCallback):
+    """Calls :meth:`Trainer.candidate` at the first episode end after each ``eval_every``."""
+
+    def __init__(self, trainer: Trainer) -> None:
+        super().__init__()
+        self.trainer = trainer
+
+    def _on_step(self) -> bool:
+        if self.num_timesteps >= self.trainer.next_eval and bool(self.locals["dones"][0]):
+            self.trainer.candidate()
+        return True
+
+
+def _atomic_model_save(model: AyssDQN, path: Path) -> None:
+    tmp = path.with_name(f".{path.stem}.tmp.zip")
+    model.save(tmp)
+    os.replace(tmp, path)
+
+
+def _jsonable(obj: Any) -> Any:
+    if isinstance(obj, np.ndarray):
+        return {"__ndarray__": obj.tolist(), "dtype": str(obj.dtype)}
+    if isinstance(obj, tuple | list):
+        return [_jsonable(x) for x in obj]
+    return obj
+
+
+def _tuple_state(obj: Any) -> Any:
+    if isinstance(obj, dict) and "__ndarray__" in obj:
+        return np.array(obj["__ndarray__"], dtype=obj["dtype"])
+    if isinstance(obj, list):
+        return tuple(_tuple_state(x) for x in obj)
+    return obj
+
+
+# ---------------------------------------------------------------------- entry point
+
+
+def train(
+    cfg: ExperimentConfig,
+    seed: int,
+    out: Path,
+    *,
+    resume: bool = False,
+    argv: Sequence[str] = (),
+) -> Path:
+    """Train one (case, VUT, seed) into its run folder; return the folder."""
+    run_dir = run_dir_for(out, cfg, seed)
+    config_file = run_dir / "config.yaml"
+    if resume:
+        if not config_file.is_file():
+            raise CheckpointError(f"--resume: no run folder at {run_dir}")
+        _check_same_config(run_dir, cfg, seed)
+    elif (run_dir / "checkpoints").exists():
+        raise CheckpointError(
+            f"{run_dir} already holds a run; pass --resume to continue it or choose another --out"
+        )
+    trainer = Trainer(cfg, seed, run_dir)
+    try:
+        if resume and trainer._latest() is not None:
+            trainer.resume()
+        else:
+            trainer.write_metadata(argv)
+            trainer.new_model()  # SB3 seeds the env: its first reset uses ``seed``
+        trainer.learn(progress_bar=cfg.train.progress_bar)
+        choice = trainer.select()
+        logger.info("SPCP: %s", choice["reason"])
+    finally:
+        trainer.close()
+    return run_dir
+
+
+def _check_same_config(run_dir: Path, cfg: ExperimentConfig, seed: int) -> None:
+    import yaml
+
+    stored = yaml.safe_load((run_dir / "config.yaml").read_text())
+    stored_seed = stored.pop("seed")
+    stored.pop("vut")
+    stored_cfg = experiment_from_dict(stored, run_dir)
+    if stored_seed != seed or to_dict(stored_cfg) != to_dict(cfg):
+        raise CheckpointError(
+            f"--resume: {run_dir}/config.yaml differs from the requested configuration; "
+            "resume with the same config file, --vut and --seed"
+        )
+
+
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(
+        prog="python -m sumo_ayss.train", description=__doc__.splitlines()[0]
+    )
+    parser.add_argument("--config", type=Path, default=None, help="experiment YAML")
+    parser.add_argument("--vut", default=None, help="VUT name (overrides env.vut)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path, default=Path("runs"), help="runs root folder")
+    parser.add_argument("--resume", action="store_true", help="continue a killed run")
+    parser.add_argument(
+        "--total-timesteps", type=int, default=None, help="override train.total_timesteps"
+    )
+    parser.add_argument("--eval-every", type=int, default=None, help="override train.eval_every")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    return parser.parse_args(argv)
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    args = parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    try:
+        cfg = load_experiment(args.config).with_vut(args.vut)
+        overrides: dict[str, Any] = {}
+        if args.total_timesteps is not None:
+            overrides["total_timesteps"] = args.total_timesteps
+        if args.eval_every is not None:
+            overrides["eval_every"] = args.eval_every
+        if args.no_progress:
+            overrides["progress_bar"] = False
+        cfg = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, **overrides))
+        run_dir = train(cfg, args.seed, args.out, resume=args.resume, argv=argv)
+    except (ConfigError, CheckpointError) as e:
+        sys.exit(f"error: {e}")
+    print(run_dir)
+
+
+if __name__ == "__main__":
+    main()
