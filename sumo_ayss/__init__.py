@@ -1,7 +1,7 @@
 """sumo_ayss: rank black-box driving functions by safety with adversarial-yet-safe opponents.
 
 Importing the package registers the Gymnasium env ids ``sumo_ayss/CarFollowing-v0`` (and
-the other cases as they land); SUMO itself starts only when an env is reset.
+``sumo_ayss/CutIn-v0``); SUMO itself starts only when an env is reset.
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ __version__ = "0.1.0"
 
 _ENVS = {
     "sumo_ayss/CarFollowing-v0": "sumo_ayss.envs.car_following:CarFollowingEnv",
+    "sumo_ayss/CutIn-v0": "sumo_ayss.envs.cut_in:CutInEnv",
 }
 
 for _env_id, _entry_point in _ENVS.items():

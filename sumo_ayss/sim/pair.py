@@ -167,9 +167,57 @@ class VehiclePair:
         return _get_position(self.pov), _get_position(self.vut)
 
     def change_pov_lane(self, lane: int, duration_s: float) -> None:
-        """Start a forced change of the POV to ``lane`` (continuous lateral motion)."""
+        """Start a forced change of the POV to ``lane`` (continuous lateral motion).
+
+        ``duration_s`` is how long TraCI keeps the *request* active, not the motion's length:
+        the lateral motion takes ``--lanechange.duration`` (``SimConfig.lanechange_duration_s``).
+        """
         libsumo.vehicle.changeLane(self.pov, lane, duration_s)
 
     def collided(self, colliding: Sequence[str]) -> bool:
         """Whether either vehicle of the pair is in ``colliding`` (ids from the session)."""
         return bool(colliding) and (self.vut in colliding or self.pov in colliding)
+
+    # ------------------------------------------------------------------ lateral (cut-in)
+
+    def lateral_speeds(self) -> tuple[float, float]:
+        """``(pov, vut)`` lateral speeds during the last step [m/s], positive to the left.
+
+        SUMO's ``getLateralSpeed``. With ``--lanechange.duration`` a lane change is a
+        continuous lateral motion, and this is the lateral displacement of the last step
+        divided by the step length: lane width / duration while a change is under way (e.g.
+        -3.2 m/s for a 3.2 m lane in 1.0 s, to the right), 0 otherwise. On the built-in roads
+        (along +x) it equals the change of world y per step over the step length.
+        """
+        return _get_lateral_speed(self.pov), _get_lateral_speed(self.vut)
+
+    def pov_lateral_offset_m(self) -> float:
+        """POV's offset from the centre line of the lane its front is on [m], positive left.
+
+        Non-zero while a lane change is under way; the lane (and so the offset's reference)
+        flips when the POV's centre crosses the lane boundary, half-way through the change.
+        """
+        return float(_get_lateral_lane_pos(self.pov))
+
+    def allow_vut_overtake_right(self) -> None:
+        """Let the VUT drive past a slower vehicle in the lane to its left.
+
+        SUMO's lane-change model (LC2013) forbids overtaking on the right unless congested:
+        it makes a vehicle hold back for a slower leader in the lane to its left, even with
+        lane-change mode 0 (checked: a free IDM VUT at 20 m/s, 10 m behind a 20 m/s POV in
+        the left lane, alternated +2.4 / -2.4 m/s² instead of accelerating; with the POV
+        200 m ahead it still lost 0.1 m/s² in the second step).
+        A VUT that reacts only through its car-following model must ignore vehicles in
+        other lanes, so this sets the VUT's ``lcOvertakeRight`` to 1 (always allowed);
+        SUMO's global ``--lanechange.overtake-right true`` has the same effect for all.
+        Call after :meth:`place`, before the episode's first step.
+        """
+        try:
+            libsumo.vehicle.setParameter(self.vut, "laneChangeModel.lcOvertakeRight", "1")
+        except SUMO_ERRORS as e:
+            raise SimulationError(f"setting lcOvertakeRight of {self.vut} failed: {e}") from e
+
+
+# Getters of the lateral (cut-in) methods, bound like the hot-path ones above.
+_get_lateral_speed = _libsumo.vehicle_getLateralSpeed
+_get_lateral_lane_pos = _libsumo.vehicle_getLateralLanePosition
