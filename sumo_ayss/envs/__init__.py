@@ -1,18 +1,44 @@
-"""Gymnasium envs of the testbed; importing :mod:`sumo_ayss` registers their ids."""
+"""Gymnasium envs of the testbed; importing :mod:`sumo_ayss` registers their ids.
+
+The env classes are imported lazily: the pure modules of this package (``rewards``,
+``odd``) must be importable without loading libsumo (the report stage uses them).
+"""
 
 from __future__ import annotations
 
-from sumo_ayss.config import EnvConfig
-from sumo_ayss.envs.car_following import CarFollowingEnv
-from sumo_ayss.envs.cut_in import CutInEnv
-from sumo_ayss.envs.odd import InitialCondition
-from sumo_ayss.envs.pair_env import PairEnv
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from sumo_ayss.config import EnvConfig
+    from sumo_ayss.envs.car_following import CarFollowingEnv
+    from sumo_ayss.envs.cut_in import CutInEnv
+    from sumo_ayss.envs.odd import InitialCondition
+    from sumo_ayss.envs.pair_env import PairEnv
+
+_LAZY = {
+    "CarFollowingEnv": "sumo_ayss.envs.car_following",
+    "CutInEnv": "sumo_ayss.envs.cut_in",
+    "InitialCondition": "sumo_ayss.envs.odd",
+    "PairEnv": "sumo_ayss.envs.pair_env",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def make_env(config: EnvConfig, sumo_seed: int | None = None) -> PairEnv:
     """The env of ``config.case`` (no wrappers), SUMO not started yet."""
     if config.case == "cut_in":
+        from sumo_ayss.envs.cut_in import CutInEnv
+
         return CutInEnv(config, sumo_seed=sumo_seed)
+    from sumo_ayss.envs.car_following import CarFollowingEnv
+
     return CarFollowingEnv(config, sumo_seed=sumo_seed)
 
 

@@ -1,0 +1,522 @@
+"""Report figures: reward shapes, learning curves, indicator vs headway, safety index.
+
+Drawn on bare matplotlib ``Figure`` objects rendered by Agg, so the report never touches
+pyplot's global state or backend.
+
+Every function draws one PNG file and returns its path. Colours are per VUT and the same in
+every figure of a report (:func:`vut_colors`); seeds are told apart by line style and
+marker. The statistics come from :mod:`sumo_ayss.analysis`; nothing here computes a verdict.
+This module imports neither SUMO nor torch (:func:`reward_shapes_figure` imports
+:mod:`sumo_ayss.plots` lazily, see there).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import matplotlib as mpl
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.ticker import FuncFormatter
+from numpy.typing import NDArray
+
+from sumo_ayss.analysis import DELTA_V_BAR, POV_ACCELERATION, Indicator, binned_mean_ci
+from sumo_ayss.analysis.ranking import SafetyIndex
+from sumo_ayss.config import RewardConfig
+from sumo_ayss.report.load import Run
+
+__all__ = [
+    "CASES",
+    "DPI",
+    "CaseInfo",
+    "indicator_figure",
+    "learning_curves_figure",
+    "reward_shapes_figure",
+    "safety_index_figure",
+    "seed_style",
+    "vut_colors",
+]
+
+logger = logging.getLogger(__name__)
+
+DPI = 100
+"""Resolution of every PNG: 100 dpi makes a 11-inch-wide figure 1100 px, i.e. 100 % zoom."""
+
+#: VUT colours in order of first use: the paper draws π1 green and π2 orange.
+_PALETTE = (
+    "#2ca02c",
+    "#ff7f0e",
+    "#1f77b4",
+    "#d62728",
+    "#9467bd",
+    "#8c564b",
+    "#e377c2",
+    "#17becf",
+    "#bcbd22",
+    "#7f7f7f",
+)
+_LINESTYLES = ("-", "--", ":", "-.")
+_MARKERS = ("o", "s", "^", "D", "v", "P", "X")
+
+
+@dataclass(frozen=True)
+class CaseInfo:
+    """How a case is named and drawn.
+
+    Attributes:
+        title: Section title, e.g. ``"One-lane car-following"``.
+        indicator: Naming of its aggressiveness indicator for verdict sentences.
+        axis_label: Matplotlib axis label of the indicator, with unit.
+        symbol: The indicator's symbol in text (HTML / Markdown).
+        paper_figure: The paper figure the indicator plot reproduces.
+        paper_table: The paper table the outcome table reproduces.
+    """
+
+    title: str
+    indicator: Indicator
+    axis_label: str
+    symbol: str
+    paper_figure: str
+    paper_table: str
+
+
+CASES: Mapping[str, CaseInfo] = {
+    "car_following": CaseInfo(
+        title="One-lane car-following",
+        indicator=POV_ACCELERATION,
+        axis_label="POV acceleration implied by the SPCP's action [m/s²]",
+        symbol="POV acceleration",
+        paper_figure="Fig. 4",
+        paper_table="Table II",
+    ),
+    "cut_in": CaseInfo(
+        title="Two-lane cut-in",
+        indicator=DELTA_V_BAR,
+        axis_label=r"$\Delta\bar{v}$ [m/s]",
+        symbol="Δv̄",
+        paper_figure="Fig. 6",
+        paper_table="Table III",
+    ),
+}
+
+
+def case_info(case: str) -> CaseInfo:
+    """The :class:`CaseInfo` of ``case``; a generic one for an unknown case name."""
+    if case in CASES:
+        return CASES[case]
+    return CaseInfo(
+        title=case,
+        indicator=Indicator(),
+        axis_label="aggressiveness indicator",
+        symbol="indicator",
+        paper_figure="—",
+        paper_table="—",
+    )
+
+
+def vut_colors(vuts: Sequence[str]) -> dict[str, str]:
+    """One colour per VUT, in the order given (the report passes all VUTs sorted).
+
+    Args:
+        vuts: VUT names; duplicates keep their first colour.
+
+    Returns:
+        ``{vut: hex colour}``; the palette repeats after ten VUTs.
+    """
+    colors: dict[str, str] = {}
+    for vut in vuts:
+        if vut not in colors:
+            colors[vut] = _PALETTE[len(colors) % len(_PALETTE)]
+    return colors
+
+
+def seed_style(position: int) -> tuple[str, str]:
+    """``(linestyle, marker)`` of the ``position``-th seed of a VUT (0-based)."""
+    return _LINESTYLES[position % len(_LINESTYLES)], _MARKERS[position % len(_MARKERS)]
+
+
+@contextmanager
+def _style() -> Iterator[None]:
+    """Readable defaults for every report figure."""
+    with mpl.rc_context(
+        {
+            "font.size": 10,
+            "axes.titlesize": 11,
+            "axes.titleweight": "bold",
+            "axes.labelsize": 10,
+            "legend.fontsize": 8.5,
+            "axes.grid": True,
+            "grid.alpha": 0.3,
+            "axes.spines.top": False,
+            "axes.spines.right": False,
+            "figure.facecolor": "white",
+            "savefig.facecolor": "white",
+        }
+    ):
+        yield
+
+
+def _save(fig: Figure, path: Path) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=DPI)  # a bare Figure renders PNG with Agg; no pyplot state
+    return path
+
+
+def _no_data(ax: Axes, text: str) -> None:
+    ax.text(0.5, 0.5, text, ha="center", va="center", transform=ax.transAxes, color="0.4")
+
+
+# --------------------------------------------------------------------------- reward shapes
+
+
+def reward_shapes_figure(reward: RewardConfig, path: Path) -> Path | None:
+    """Draws the reward shapes with :func:`sumo_ayss.plots.plot_reward_shapes`.
+
+    ``sumo_ayss.plots`` is imported here, not at module level: through
+    ``sumo_ayss.envs`` it loads libsumo, which the rest of the report does not need.
+
+    Args:
+        reward: The runs' reward configuration.
+        path: PNG file to write.
+
+    Returns:
+        ``path``, or None if the plotting module cannot be imported on this machine.
+    """
+    try:
+        from sumo_ayss.plots import plot_reward_shapes
+    except ImportError as exc:  # e.g. libsumo not installed where the report is made
+        logger.warning("reward-shape figure skipped: %s", exc)
+        return None
+    with _style():
+        return plot_reward_shapes(reward, path)
+
+
+# --------------------------------------------------------------------------- learning curves
+
+
+def _thousands(x: float, _pos: int) -> str:
+    return f"{x / 1000:g}k" if x else "0"
+
+
+def learning_curves_figure(
+    runs_by_vut: Mapping[str, Sequence[Run]],
+    colors: Mapping[str, str],
+    path: Path,
+    *,
+    title: str,
+) -> Path:
+    """Mean evaluation reward (and crash / lane-change rate) vs training steps, per run.
+
+    One colour per VUT, one line style per seed; the selected SPCP is a large star on each
+    curve. Panels: mean evaluation episode reward; crash rate in %; and, when any run has
+    it, the lane-change rate in %.
+
+    Args:
+        runs_by_vut: ``{vut: runs}`` of one case.
+        colors: ``{vut: colour}``.
+        path: PNG file to write.
+        title: Figure title.
+
+    Returns:
+        ``path``.
+    """
+    runs = [r for rs in runs_by_vut.values() for r in rs]
+    has_lc = any(
+        r.eval_curve is not None and np.isfinite(r.eval_curve.lane_change_rate).any()
+        for r in runs
+        if r.case == "cut_in"
+    )
+    panels: list[tuple[str, str, float]] = [
+        ("mean_return", "mean evaluation episode reward", 1.0),
+        ("crash_rate", "crash rate [%]", 100.0),
+    ]
+    if has_lc:
+        panels.append(("lane_change_rate", "lane-change rate [%]", 100.0))
+    widths = {2: 11.0, 3: 13.0}
+    with _style():
+        fig = Figure(figsize=(widths[len(panels)], 4.4), layout="constrained")
+        axes = fig.subplots(
+            1,
+            len(panels),
+            gridspec_kw={"width_ratios": [1.6] + [1.0] * (len(panels) - 1)},
+        )
+        drawn = False
+        for ax, (column, label, scale) in zip(axes, panels, strict=True):
+            for vut, members in runs_by_vut.items():
+                for pos, run in enumerate(members):
+                    drawn |= _draw_curve(ax, run, column, scale, colors[vut], pos)
+            ax.set_xlabel("training steps (transitions)")
+            ax.set_ylabel(label)
+            ax.xaxis.set_major_formatter(FuncFormatter(_thousands))
+            if column == "lane_change_rate":
+                ax.set_ylim(-2.0, 102.0)
+            elif scale == 100.0:
+                ax.set_ylim(bottom=-2.0)
+        axes[0].set_title("Evaluation reward of every SPCP candidate")
+        axes[1].set_title("Crash rate on the evaluation scenarios")
+        if has_lc:
+            axes[2].set_title("Lane-change rate")
+        if not drawn:
+            _no_data(axes[0], "no eval.csv in these runs yet")
+        axes[0].legend(handles=_run_legend(runs_by_vut, colors), loc="best", ncol=2)
+        fig.suptitle(title, fontsize=12, fontweight="bold")
+        return _save(fig, path)
+
+
+def _draw_curve(ax: Axes, run: Run, column: str, scale: float, color: str, pos: int) -> bool:
+    curve = run.eval_curve
+    if curve is None or len(curve) == 0:
+        return False
+    y = getattr(curve, column) * scale
+    if not np.isfinite(y).any():
+        return False
+    ls, marker = seed_style(pos)
+    ax.plot(curve.step, y, color=color, ls=ls, lw=1.6, marker=marker, ms=3.5, alpha=0.9)
+    if run.spcp is not None:
+        hit = np.flatnonzero(curve.step == run.spcp.step)
+        if hit.size:
+            ax.plot(
+                curve.step[hit[0]],
+                y[hit[0]],
+                marker="*",
+                ms=17,
+                color=color,
+                mec="black",
+                mew=1.0,
+                ls="none",
+                zorder=5,
+            )
+    return True
+
+
+def _run_legend(runs_by_vut: Mapping[str, Sequence[Run]], colors: Mapping[str, str]) -> list[Any]:
+    handles: list[Any] = []
+    for vut, members in runs_by_vut.items():
+        for pos, run in enumerate(members):
+            ls, marker = seed_style(pos)
+            handles.append(
+                Line2D([], [], color=colors[vut], ls=ls, marker=marker, ms=4, label=run.label)
+            )
+    handles.append(
+        Line2D(
+            [], [], marker="*", ms=13, color="0.6", mec="black", ls="none", label="selected SPCP"
+        )
+    )
+    return handles
+
+
+# --------------------------------------------------------------------------- indicator vs headway
+
+
+def _seed_arrays(run: Run) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    if run.ayss is None or len(run.ayss) == 0:
+        return None
+    return run.ayss.h, run.ayss.indicator
+
+
+def _band(ax: Axes, centers: NDArray[np.float64], stats: Any, color: str, label: str) -> None:
+    ax.plot(centers, stats.means, color=color, lw=2.2, marker="o", ms=4, label=label)
+    ok = np.isfinite(stats.lo) & np.isfinite(stats.hi)
+    ax.fill_between(
+        centers, stats.lo, stats.hi, where=ok, color=color, alpha=0.22, lw=0, interpolate=False
+    )
+
+
+def indicator_figure(
+    runs_by_vut: Mapping[str, Sequence[Run]],
+    colors: Mapping[str, str],
+    path: Path,
+    *,
+    edges: NDArray[np.float64],
+    axis_label: str,
+    title: str,
+    level: float = 0.95,
+) -> Path:
+    """Mean indicator vs headway with confidence bands (the paper's Fig. 4 / Fig. 6).
+
+    Left: one line and band per VUT, all seeds pooled (per-bin Student t interval at
+    ``level``). Right: one thin line per seed, same colours. Below each: samples per bin.
+    Bins with fewer than two samples are left out.
+
+    Args:
+        runs_by_vut: ``{vut: runs}`` of one case.
+        colors: ``{vut: colour}``.
+        path: PNG file to write.
+        edges: Headway bin edges in m, shape ``(k + 1,)``.
+        axis_label: Label of the indicator axis, with unit.
+        title: Figure title.
+        level: Confidence level of the bands.
+
+    Returns:
+        ``path``.
+    """
+    centers = 0.5 * (edges[:-1] + edges[1:])
+    width = float(np.min(np.diff(edges)))
+    pct = f"{100 * level:g} %"
+    in_range: list[tuple[str, str, int]] = []  # (vut, run label, samples in the bin range)
+    with _style():
+        fig = Figure(figsize=(12.0, 6.8), layout="constrained")
+        grid = fig.add_gridspec(2, 2, height_ratios=[3.0, 1.0])
+        ax_pool = fig.add_subplot(grid[0, 0])
+        ax_npool = fig.add_subplot(grid[1, 0], sharex=ax_pool)
+        ax_seed = fig.add_subplot(grid[0, 1], sharex=ax_pool, sharey=ax_pool)
+        ax_nseed = fig.add_subplot(grid[1, 1])
+        n_vut = max(1, len(runs_by_vut))
+        for v, (vut, members) in enumerate(runs_by_vut.items()):
+            color = colors[vut]
+            arrays = [a for a in (_seed_arrays(r) for r in members) if a is not None]
+            if not arrays:
+                in_range += [(vut, f"{r.label}\n(none)", 0) for r in members]
+                continue
+            h = np.concatenate([a[0] for a in arrays])
+            y = np.concatenate([a[1] for a in arrays])
+            pooled = binned_mean_ci(h, y, edges, level=level, min_count=2)
+            n_in = int(pooled.counts.sum())
+            _band(ax_pool, centers, pooled, color, f"{vut} ({len(arrays)} seeds, n = {n_in})")
+            offset = (v - (n_vut - 1) / 2) * width / (n_vut + 1)
+            ax_npool.bar(
+                centers + offset, pooled.counts, width=width / (n_vut + 1), color=color, alpha=0.8
+            )
+            for pos, run in enumerate(members):
+                arr = _seed_arrays(run)
+                if arr is None:
+                    in_range.append((vut, f"{run.label}\n(none)", 0))
+                    continue
+                stats = binned_mean_ci(arr[0], arr[1], edges, level=level, min_count=2)
+                ls, marker = seed_style(pos)
+                ax_seed.plot(
+                    centers,
+                    stats.means,
+                    color=color,
+                    ls=ls,
+                    lw=1.1,
+                    marker=marker,
+                    ms=3,
+                    label=run.label,
+                )
+                in_range.append((vut, run.label, int(stats.counts.sum())))
+        ax_pool.set_title(f"All seeds pooled: mean and {pct} CI per {width:g} m bin")
+        ax_seed.set_title("Each SPCP (seed) separately: mean per bin")
+        ax_pool.set_ylabel(f"{axis_label}\n(lower = more aggressive SPCP = safer VUT)")
+        ax_npool.set_ylabel("samples / bin")
+        ax_npool.set_xlabel("distance headway h [m]")
+        ax_seed.set_xlabel("distance headway h [m]")
+        ax_pool.set_xlim(edges[0], edges[-1])
+        if any(n for _, _, n in in_range):
+            ax_pool.legend(loc="best")
+            ax_seed.legend(loc="best", ncol=2)
+            xs = np.arange(len(in_range))
+            ax_nseed.bar(xs, [n for _, _, n in in_range], color=[colors[v] for v, _, _ in in_range])
+            ax_nseed.set_xticks(xs, [lab.replace(" seed ", "\ns") for _, lab, _ in in_range])
+            ax_nseed.tick_params(axis="x", labelsize=8)
+            ax_nseed.set_ylabel("samples")
+            ax_nseed.set_title(
+                f"AYSS samples per SPCP with {edges[0]:g} ≤ h ≤ {edges[-1]:g} m", fontsize=9.5
+            )
+            ax_nseed.grid(axis="x", visible=False)
+        else:
+            _no_data(ax_pool, "no AYSS samples (ayss.csv) in these runs yet")
+            ax_nseed.set_axis_off()
+        fig.suptitle(title, fontsize=12, fontweight="bold")
+        return _save(fig, path)
+
+
+# --------------------------------------------------------------------------- safety index
+
+
+def safety_index_figure(
+    indices: Mapping[str, SafetyIndex],
+    colors: Mapping[str, str],
+    path: Path,
+    *,
+    unit: str,
+    what: str,
+    title: str,
+) -> Path:
+    """Safety index per VUT with its interval, safest on top, per-seed indices as dots.
+
+    Args:
+        indices: ``{vut: index}``, any order (drawn sorted by point estimate).
+        colors: ``{vut: colour}``.
+        path: PNG file to write.
+        unit: Unit of the index, e.g. ``"m/s²"``.
+        what: What the index is minus the mean of, e.g. ``"POV acceleration"``.
+        title: Figure title.
+
+    Returns:
+        ``path``.
+    """
+    order = sorted(indices, key=lambda v: (indices[v].point, v))  # bottom to top
+    with _style():
+        fig = Figure(figsize=(10.0, 1.6 + 0.75 * max(1, len(order))), layout="constrained")
+        ax = fig.subplots()
+        rng = np.random.default_rng(0)
+        for y, vut in enumerate(order):
+            idx = indices[vut]
+            color = colors[vut]
+            err = [[idx.point - idx.lo], [idx.hi - idx.point]]
+            ax.errorbar(
+                idx.point,
+                y,
+                xerr=err,
+                fmt="o",
+                ms=9,
+                color=color,
+                capsize=6,
+                lw=2.2,
+                label=f"{vut}: {idx.point:.2f} [{idx.lo:.2f}, {idx.hi:.2f}] {unit}",
+            )
+            if idx.seed_points:
+                jitter = rng.uniform(-0.12, 0.12, len(idx.seed_points))
+                ax.scatter(
+                    idx.seed_points,
+                    y + 0.25 + jitter * 0.5,
+                    s=28,
+                    facecolors="none",
+                    edgecolors=color,
+                    lw=1.2,
+                    zorder=3,
+                )
+            rank = len(order) - y
+            ax.annotate(
+                f"#{rank}",
+                xy=(idx.hi, y),
+                xytext=(8, 0),
+                textcoords="offset points",
+                va="center",
+                fontsize=9,
+                color="0.25",
+            )
+        ax.set_yticks(range(len(order)), order)
+        ax.set_ylim(-0.6, len(order) - 0.3)
+        level = next(iter(indices.values())).level if indices else 0.95
+        lo_h, hi_h = next(iter(indices.values())).h_range if indices else (0.0, 5.0)
+        ax.set_xlabel(
+            f"safety index = −mean {what} over AYSS with {lo_h:g} ≤ h ≤ {hi_h:g} m [{unit}]"
+            "   (larger = safer VUT)"
+        )
+        ax.set_title(
+            f"dot and bar: index with {100 * level:g} % hierarchical-bootstrap CI; "
+            "circles: each seed's own index",
+            fontsize=9.5,
+            fontweight="normal",
+            color="0.3",
+        )
+        fig.suptitle(title, fontsize=12, fontweight="bold")
+        if not order:
+            _no_data(ax, "no safety index: no AYSS samples yet")
+        else:
+            ax.legend(loc="lower right", fontsize=8.5)
+            xmin, xmax = ax.get_xlim()
+            pad = 0.08 * (xmax - xmin) if math.isfinite(xmax - xmin) else 0.0
+            ax.set_xlim(xmin - pad, xmax + pad)
+        ax.grid(axis="y", visible=False)
+        return _save(fig, path)

@@ -1,0 +1,333 @@
+"""Report stage on synthetic run folders (no SUMO, no training, no torch)."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import re
+import subprocess
+import sys
+import zlib
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from sumo_ayss.analysis.ranking import POV_ACCELERATION, SafetyIndex
+from sumo_ayss.catalog import BUILTIN_VUTS
+from sumo_ayss.config import RewardConfig, to_dict
+from sumo_ayss.report import (
+    AYSS_COLUMNS,
+    OUTCOME_KEYS,
+    RUN_FILES,
+    ReportOptions,
+    find_run_dirs,
+    load_run,
+    pair_verdict,
+    vut_safety_index,
+    write_report,
+)
+from sumo_ayss.report.__main__ import main
+
+EVAL_HEADER = (
+    "step,mean_return,std_return,crash_rate,lane_change_rate,mean_final_headway_m,"
+    "n_episodes,wall_s,checkpoint"
+)
+
+#: Mean indicator offset per VUT: pi2's SPCPs are clearly more aggressive (more negative).
+OFFSET = {"pi1": 0.0, "pi2": -1.5, "pi1_again": 0.0}
+
+FAST = ReportOptions(n_boot=400)
+
+
+def _estimate(value: float, half: float) -> dict[str, float]:
+    return {"value": value, "lo": max(0.0, value - half), "hi": value + half}
+
+
+def make_run(
+    root: Path,
+    case: str,
+    vut: str,
+    seed: int,
+    *,
+    files: Sequence[str] = ("config", "eval", "spcp", "outcome", "ayss", "versions"),
+    n_samples: int = 300,
+) -> Path:
+    """Writes a plausible run folder ``root/case/vut/seed_<seed>`` with synthetic data."""
+    run_dir = root / case / vut / f"seed_{seed}"
+    run_dir.mkdir(parents=True)
+    rng = np.random.default_rng([seed, zlib.crc32(vut.encode()), int(case == "cut_in")])
+    if "config" in files:
+        env = {
+            "case": case,
+            "vut": vut,
+            "vuts": {k: to_dict(v) for k, v in BUILTIN_VUTS.items()},
+            "reward": to_dict(RewardConfig()),
+        }
+        data = {"vut": vut, "seed": seed, "env": env, "agent": {"gamma": 0.8}, "train": {}}
+        (run_dir / RUN_FILES.config).write_text(yaml.safe_dump(data, sort_keys=False))
+    steps = np.arange(10_000, 200_001, 10_000)
+    returns = 19.0 * (1 - np.exp(-steps / 40_000)) + rng.normal(0, 0.3, steps.size)
+    if "eval" in files:
+        lines = [EVAL_HEADER]
+        for s, r in zip(steps, returns, strict=True):
+            crash = max(0.0, 0.3 * math.exp(-s / 50_000) + rng.normal(0, 0.01))
+            lc = 0.9 if case == "cut_in" else 0.0
+            lines.append(f"{s},{r:.4f},2.0,{crash:.3f},{lc},2.1,100,12.5,ckpt/step_{s}/model.zip")
+        (run_dir / RUN_FILES.eval_table).write_text("\n".join(lines) + "\n")
+    if "spcp" in files:
+        best = int(np.argmax(returns))
+        spcp = {
+            "step": int(steps[best]),
+            "score": float(returns[best]),
+            "criterion": "mean_reward",
+            "reason": "best",
+            "checkpoint": f"ckpt/step_{steps[best]}/model.zip",
+            "row": {},
+        }
+        (run_dir / RUN_FILES.spcp).write_text(json.dumps(spcp))
+    if "outcome" in files:
+        outcome = {
+            OUTCOME_KEYS.n: 200,
+            OUTCOME_KEYS.crash_rate: _estimate(0.01 * (seed % 3), 0.01),
+            OUTCOME_KEYS.mean_return: _estimate(19.4 - 0.05 * seed, 0.2),
+            OUTCOME_KEYS.mean_final_headway_m: _estimate(1.7 + 0.8 * (vut == "pi2"), 0.3),
+        }
+        if case == "cut_in":
+            outcome[OUTCOME_KEYS.lane_change_rate] = _estimate(0.99, 0.01)
+            outcome[OUTCOME_KEYS.lane_change_no_collision] = {
+                "n": 196,
+                OUTCOME_KEYS.mean_return: _estimate(20.8, 0.2),
+                OUTCOME_KEYS.mean_final_headway_m: _estimate(0.36, 0.05),
+            }
+        (run_dir / RUN_FILES.outcome).write_text(json.dumps(outcome))
+    if "ayss" in files:
+        _write_ayss(run_dir / RUN_FILES.ayss, case, vut, rng, n_samples)
+    if "versions" in files:
+        versions = {"python": "3.11.2", "eclipse-sumo": "1.28.0", "numpy": np.__version__}
+        (run_dir / RUN_FILES.versions).write_text(json.dumps(versions))
+    return run_dir
+
+
+def _write_ayss(path: Path, case: str, vut: str, rng: np.random.Generator, n: int) -> None:
+    cols = AYSS_COLUMNS
+    h = rng.uniform(0.0, 5.0, n)
+    seed_shift = rng.normal(0.0, 0.1)
+    if case == "car_following":
+        y = np.clip(-2.5 + 0.35 * h + OFFSET[vut] + seed_shift + rng.normal(0, 0.8, n), -6, 6)
+        name = "pov_accel_mps2"
+    else:
+        y = -1.0 - 0.2 * h + OFFSET[vut] + seed_shift + rng.normal(0, 0.6, n)
+        name = "delta_v_bar_mps"
+    header = [
+        cols.v_pov,
+        cols.v_vut,
+        cols.h,
+        cols.same_lane,
+        cols.action,
+        cols.target_speed_mps,
+        cols.ttc_s,
+        cols.indicator,
+        cols.indicator_name,
+    ]
+    with path.open("w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(header)
+        for hi, yi in zip(h, y, strict=True):
+            writer.writerow([20.0, 22.0, f"{hi:.4f}", 0, 3, 15.0, 2.5, f"{yi:.4f}", name])
+
+
+@pytest.fixture(scope="module")
+def full_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Both cases, pi1 and pi2, three seeds each; returns report.html."""
+    root = tmp_path_factory.mktemp("runs")
+    for case in ("car_following", "cut_in"):
+        for vut in ("pi1", "pi2"):
+            for seed in range(3):
+                make_run(root, case, vut, seed)
+    return write_report([root], options=FAST)
+
+
+def test_html_is_self_contained(full_report: Path) -> None:
+    assert full_report == full_report.parent.parent / "report" / "report.html"
+    text = full_report.read_text(encoding="utf-8")
+    assert 'src="http' not in text and "href='http" not in text
+    assert not re.search(r'href="(?!#)', text), "only in-page links are allowed"
+    assert "<script" not in text.lower() and "<link" not in text.lower()
+    srcs = re.findall(r'<img[^>]*\ssrc="([^"]*)"', text)
+    assert srcs and all(s.startswith("data:image/png;base64,") for s in srcs)
+    assert text.count("<img") == len(srcs)
+
+
+def test_html_holds_every_figure_and_table(full_report: Path) -> None:
+    text = full_report.read_text(encoding="utf-8")
+    # Per case: reward shapes, learning curves, indicator vs headway, safety index.
+    assert text.count("<img") == 8
+    assert "Table II equivalent" in text and "Table III equivalent" in text
+    assert "19.48" in text and "20.99" in text  # the paper's reference numbers
+    assert "Significance rule" in text and "Welch" in text
+    pngs = sorted(p.name for p in full_report.parent.glob("*.png"))
+    assert len(pngs) == 8 and "car_following_indicator_vs_headway.png" in pngs
+
+
+def test_verdict_names_the_safer_vut(full_report: Path) -> None:
+    text = full_report.read_text(encoding="utf-8")
+    assert "pi2 is safer than pi1: its SPCPs brake" in text
+    assert "pi2 is safer than pi1: its SPCPs close in" in text
+    verdicts = text.split('id="inputs"')[0]  # the summary at the top names it too
+    assert verdicts.count("pi2 is safer than pi1") == 2
+
+
+def test_summary_md_links_resolve(full_report: Path) -> None:
+    md = full_report.parent / "summary.md"
+    text = md.read_text(encoding="utf-8")
+    links = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", text)
+    assert len(links) == 8
+    for link in links:
+        assert not link.startswith(("/", "http"))
+        assert (md.parent / link).is_file(), link
+    assert "pi2 is safer than pi1" in text
+    assert "Table II equivalent" in text and "Table III equivalent" in text
+
+
+def test_missing_ayss_is_reported_not_fatal(tmp_path: Path) -> None:
+    for vut in ("pi1", "pi2"):
+        for seed in range(3):
+            files: tuple[str, ...] = ("config", "eval", "spcp", "outcome", "versions")
+            if (vut, seed) != ("pi2", 2):
+                files += ("ayss",)
+            make_run(tmp_path, "car_following", vut, seed, files=files)
+    make_run(tmp_path, "car_following", "pi2", 9, files=("config", "eval"))
+    out = write_report([tmp_path], tmp_path / "out", options=FAST)
+    text = out.read_text(encoding="utf-8")
+    assert "car_following/pi2/seed_2: ayss.csv missing" in text
+    assert "car_following/pi2/seed_9: outcome.json missing" in text
+    assert "outcome.json missing" in (tmp_path / "out" / "summary.md").read_text()
+    assert "pi2 is safer than pi1" in text  # the remaining seeds still decide
+
+
+def test_no_ayss_at_all_gives_no_verdict(tmp_path: Path) -> None:
+    make_run(tmp_path, "cut_in", "pi1", 0, files=("config", "eval", "spcp"))
+    out = write_report([tmp_path / "cut_in" / "pi1" / "seed_0"], tmp_path / "out", options=FAST)
+    text = out.read_text(encoding="utf-8")
+    assert "No verdict yet" in text and "ayss.csv missing" in text
+    assert text.count("<img") == 3  # reward shapes, learning curves, (empty) indicator plot
+
+
+def test_same_vut_under_two_seed_sets_is_no_difference(tmp_path: Path) -> None:
+    first = [load_run(make_run(tmp_path, "car_following", "pi1", s)) for s in range(3)]
+    second = [load_run(make_run(tmp_path, "car_following", "pi1_again", s)) for s in (3, 4, 5)]
+    a = vut_safety_index(first, FAST, rng=1)
+    b = vut_safety_index(second, FAST, rng=2)
+    assert a is not None and b is not None
+    pair = pair_verdict(
+        a, b, name_a="pi1 (seeds 0-2)", name_b="pi1 (seeds 3-5)", indicator=POV_ACCELERATION
+    )
+    assert not pair.significant and pair.safer is None
+    assert pair.sentence.startswith("No significant difference")
+    text = write_report([tmp_path], tmp_path / "out", options=FAST).read_text(encoding="utf-8")
+    assert re.search(
+        r"No significant difference in safety between (pi1 and pi1_again|pi1_again and pi1)", text
+    )
+    assert "is safer than" not in text
+
+
+def _index(point: float, seed_points: Sequence[float], replicates: np.ndarray) -> SafetyIndex:
+    return SafetyIndex(
+        point=point,
+        lo=float(np.quantile(replicates, 0.025)),
+        hi=float(np.quantile(replicates, 0.975)),
+        n_seeds=len(seed_points),
+        n_samples=300,
+        bins_used=(True,) * 10,
+        replicates=replicates,
+        indicator_samples=-np.asarray(seed_points, dtype=float),
+        seed_points=tuple(seed_points),
+    )
+
+
+def test_bootstrap_alone_is_not_significant() -> None:
+    rng = np.random.default_rng(0)
+    # Narrow bootstraps 0.5 apart, but the seeds spread widely: Welch p is large.
+    a = _index(2.5, (1.0, 2.5, 4.0), 2.5 + rng.normal(0, 0.05, 400))
+    b = _index(2.0, (0.5, 2.0, 3.5), 2.0 + rng.normal(0, 0.05, 400))
+    pair = pair_verdict(a, b, name_a="A", name_b="B", indicator=POV_ACCELERATION)
+    assert pair.verdict.significant and pair.verdict.p_seed_welch > 0.05
+    assert not pair.significant and pair.safer is None
+    assert pair.sentence.startswith("No significant difference")
+    assert "bootstrap interval alone excludes 0" in pair.sentence
+    # With tight seeds both tests agree and A is called safer.
+    c = _index(2.5, (2.45, 2.5, 2.55), 2.5 + rng.normal(0, 0.05, 400))
+    d = _index(2.0, (1.95, 2.0, 2.05), 2.0 + rng.normal(0, 0.05, 400))
+    pair = pair_verdict(c, d, name_a="A", name_b="B", indicator=POV_ACCELERATION)
+    assert pair.significant and pair.safer == "A"
+    assert pair.sentence.startswith("A is safer than B") and "Welch test: p" in pair.sentence
+
+
+def test_outcome_reader_accepts_variants(tmp_path: Path) -> None:
+    run_dir = make_run(tmp_path, "cut_in", "pi1", 0, files=("config",))
+    outcome = {
+        "n_episodes": 200,
+        "crash_rate": {"mean": 0.02, "ci": [0.005, 0.05]},
+        "lane_change_rate": 0.98,
+        "mean_return": {"value": 20.1, "lo": 19.9, "hi": 20.3},
+    }
+    (run_dir / RUN_FILES.outcome).write_text(json.dumps(outcome))
+    run = load_run(run_dir)
+    o = run.outcome
+    assert o is not None and o.n == 200
+    assert (o.crash_rate.value, o.crash_rate.lo, o.crash_rate.hi) == (0.02, 0.005, 0.05)
+    assert o.lane_change_rate is not None and o.lane_change_rate.value == 0.98
+    assert math.isnan(o.lane_change_rate.lo)
+    assert not o.mean_final_headway_m.known and o.lane_change_no_collision is None
+    assert run.reward == RewardConfig() and run.seed == 0 and run.case == "cut_in"
+    assert "ayss.csv missing" in run.problems and "eval.csv missing" in run.problems
+
+
+def test_tolerant_readers_on_bad_files(tmp_path: Path) -> None:
+    run_dir = make_run(tmp_path, "car_following", "pi1", 0, files=())
+    (run_dir / RUN_FILES.outcome).write_text("{not json")
+    (run_dir / RUN_FILES.ayss).write_text("h,indicator,indicator_name\n1.0,-2.0,x\nnan,1,x\n")
+    (run_dir / RUN_FILES.eval_table).write_text("step,other\n1,2\n")
+    run = load_run(run_dir)
+    assert run.case == "car_following" and run.vut == "pi1" and run.seed == 0
+    assert run.outcome is None and run.eval_curve is None
+    assert run.ayss is not None and len(run.ayss) == 1 and run.ayss.n_dropped == 1
+    text = " | ".join(run.problems)
+    assert "outcome.json unreadable" in text and "eval.csv unreadable" in text
+    assert "config.yaml missing" in text and "unknown indicator_name 'x'" in text
+
+
+def test_find_run_dirs_skips_the_report_folder(tmp_path: Path) -> None:
+    make_run(tmp_path, "car_following", "pi1", 0)
+    make_run(tmp_path, "car_following", "pi2", 0)
+    (tmp_path / "report").mkdir()
+    (tmp_path / "report" / "summary.md").write_text("# old report\n")
+    found = find_run_dirs([tmp_path, tmp_path / "car_following" / "pi1" / "seed_0"])
+    assert [p.relative_to(tmp_path.resolve()).as_posix() for p in found] == [
+        "car_following/pi1/seed_0",
+        "car_following/pi2/seed_0",
+    ]
+
+
+def test_cli_writes_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    make_run(tmp_path, "car_following", "pi1", 0)
+    make_run(tmp_path, "car_following", "pi2", 0)
+    main([str(tmp_path), "--out", str(tmp_path / "r"), "--title", "My title", "--n-boot", "200"])
+    printed = capsys.readouterr().out.strip()
+    assert printed == str(tmp_path / "r" / "report.html")
+    assert "<title>My title</title>" in Path(printed).read_text(encoding="utf-8")
+    with pytest.raises(SystemExit, match="not a folder"):
+        main([str(tmp_path / "nope")])
+
+
+def test_report_imports_neither_torch_nor_libsumo() -> None:
+    code = (
+        "import sys, sumo_ayss.report; "
+        "bad = [m for m in ('torch', 'libsumo', 'matplotlib.pyplot') if m in sys.modules]; "
+        "sys.exit(str(bad) if bad else 0)"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)
