@@ -26,3 +26,7 @@ class CheckpointError(AyssError, RuntimeError):
 
 class ActionError(AyssError, ValueError):
     """An action outside the env's action space, or a step before reset."""
+
+
+class TableError(AyssError, ValueError):
+    """A table or summary file is missing, malformed, or does not match its schema."""

@@ -236,10 +236,18 @@ class Trainer:
 
         self._save_resume_state(step_dir, current_ic)
         write_eval_table(self.eval_path, self.rows)
-        previous = self._latest()
         atomic_write_json(self.ckpt_dir / "latest.json", {"step": step, "dir": step_dir.name})
-        if previous is not None and previous != step_dir:  # keep one replay buffer only
-            (previous / "replay.pkl").unlink(missing_ok=True)
+        self._prune_replays(step_dir)
+
+    def _prune_replays(self, keep: Path) -> None:
+        """Keep the replay buffer of the latest checkpoint only (each is ~6 MB per 100k).
+
+        Run after ``latest.json`` moves on and again at resume, so a kill between the two
+        leaves no orphan behind for good.
+        """
+        for path in self.ckpt_dir.glob("step_*/replay.pkl"):
+            if path.parent != keep:
+                path.unlink(missing_ok=True)
 
     def _save_resume_state(self, step_dir: Path, ic: InitialCondition | None) -> None:
         model = self.model
@@ -281,6 +289,7 @@ class Trainer:
             tensorboard_log=str(self.run_dir / "tb"),
         )
         model.load_replay_buffer(latest / "replay.pkl")
+        self._prune_replays(latest)
         self.model = model
         self.next_eval = int(state["next_eval"])
         self.rows = [r for r in read_eval_table(self.eval_path) if r["step"] <= model.num_timesteps]

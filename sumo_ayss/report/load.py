@@ -102,6 +102,9 @@ class OutcomeKeys:
     mean_return: str = "mean_return"
     mean_final_headway_m: str = "mean_final_headway_m"
     lane_change_no_collision: str = "lane_change_no_collision"
+    summary: str = "summary"
+    lc_no_collision_return: str = "lc_no_collision_return"
+    lc_no_collision_final_headway_m: str = "lc_no_collision_final_headway_m"
     value: tuple[str, ...] = ("value", "mean", "point", "estimate")
     lo: tuple[str, ...] = ("lo", "ci_lo", "lower")
     hi: tuple[str, ...] = ("hi", "ci_hi", "upper")
@@ -121,9 +124,9 @@ class AyssColumns:
     indicator the file holds (:data:`INDICATOR_NAMES`).
     """
 
-    v_pov: str = "v_pov"
-    v_vut: str = "v_vut"
-    h: str = "h"
+    v_pov: str = "v_pov_mps"
+    v_vut: str = "v_vut_mps"
+    h: str = "h_m"
     same_lane: str = "same_lane"
     action: str = "action"
     target_speed_mps: str = "target_speed_mps"
@@ -445,6 +448,9 @@ def read_outcome(path: Path) -> Outcome:
     if not isinstance(data, Mapping):
         raise ValueError("top level is not a JSON object")
     keys = OUTCOME_KEYS
+    # The evaluate stage nests the estimates under "summary" (sumo_ayss.scenarios.outcome).
+    if isinstance(data.get(keys.summary), Mapping):
+        data = data[keys.summary]
     subset = data.get(keys.lane_change_no_collision)
     lc_subset = None
     if isinstance(subset, Mapping):
@@ -452,6 +458,14 @@ def read_outcome(path: Path) -> Outcome:
             n=_count(subset),
             mean_return=_estimate(subset.get(keys.mean_return)) or Estimate(),
             mean_final_headway_m=_estimate(subset.get(keys.mean_final_headway_m)) or Estimate(),
+        )
+    elif isinstance(data.get(keys.lc_no_collision_return), Mapping):
+        lc_return = _estimate(data.get(keys.lc_no_collision_return)) or Estimate()
+        lc_subset = OutcomeSubset(
+            n=_count(data[keys.lc_no_collision_return]),
+            mean_return=lc_return,
+            mean_final_headway_m=_estimate(data.get(keys.lc_no_collision_final_headway_m))
+            or Estimate(),
         )
     return Outcome(
         n=_count(data),

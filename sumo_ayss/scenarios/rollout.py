@@ -46,33 +46,36 @@ class ScenarioSummary:
         return dict(self.__dict__)
 
 
-def run_episodes(
-    env: PairEnv, policy: Policy, scenarios: Sequence[InitialCondition]
-) -> list[EpisodeResult]:
-    """Roll ``policy`` greedily from each initial condition until the episode ends.
+def run_episode(env: PairEnv, policy: Policy, ic: InitialCondition) -> EpisodeResult:
+    """Roll ``policy`` greedily from one initial condition until the episode ends.
 
-    Uses ``env.unwrapped`` directly and passes each start state through
-    ``reset(options={"initial_condition": ...})``, so the env's RNG is not consumed: a
-    training env evaluated between training phases continues its own random stream.
+    Uses ``env.unwrapped`` and ``reset(options={"initial_condition": ic})``, so the env's RNG
+    is not consumed. ``policy`` is called on a batch of one observation, shape ``(1, d)``.
     """
     base = env.unwrapped
     assert isinstance(base, PairEnv)
-    results = []
-    for ic in scenarios:
-        obs, _ = base.reset(options={"initial_condition": ic})
-        total, steps, changed = 0.0, 0, False
-        while True:
-            action = int(np.asarray(policy(obs[None, :])).reshape(-1)[0])
-            obs, reward, terminated, truncated, info = base.step(action)
-            total += float(reward)
-            steps += 1
-            changed = changed or bool(info.get("lane_change_started", False))
-            if terminated or truncated:
-                break
-        results.append(
-            EpisodeResult(total, bool(info["collision"]), float(info["headway_m"]), steps, changed)
-        )
-    return results
+    obs, _ = base.reset(options={"initial_condition": ic})
+    total, steps, changed = 0.0, 0, False
+    while True:
+        action = int(np.asarray(policy(obs[None, :])).reshape(-1)[0])
+        obs, reward, terminated, truncated, info = base.step(action)
+        total += float(reward)
+        steps += 1
+        changed = changed or bool(info.get("lane_change_started", False))
+        if terminated or truncated:
+            break
+    return EpisodeResult(total, bool(info["collision"]), float(info["headway_m"]), steps, changed)
+
+
+def run_episodes(
+    env: PairEnv, policy: Policy, scenarios: Sequence[InitialCondition]
+) -> list[EpisodeResult]:
+    """:func:`run_episode` on each initial condition in turn.
+
+    A training env evaluated between training phases continues its own random stream, as
+    no reset here consumes the env's RNG.
+    """
+    return [run_episode(env, policy, ic) for ic in scenarios]
 
 
 def summarize(results: Sequence[EpisodeResult]) -> ScenarioSummary:

@@ -290,7 +290,7 @@ def test_outcome_reader_accepts_variants(tmp_path: Path) -> None:
 def test_tolerant_readers_on_bad_files(tmp_path: Path) -> None:
     run_dir = make_run(tmp_path, "car_following", "pi1", 0, files=())
     (run_dir / RUN_FILES.outcome).write_text("{not json")
-    (run_dir / RUN_FILES.ayss).write_text("h,indicator,indicator_name\n1.0,-2.0,x\nnan,1,x\n")
+    (run_dir / RUN_FILES.ayss).write_text("h_m,indicator,indicator_name\n1.0,-2.0,x\nnan,1,x\n")
     (run_dir / RUN_FILES.eval_table).write_text("step,other\n1,2\n")
     run = load_run(run_dir)
     assert run.case == "car_following" and run.vut == "pi1" and run.seed == 0

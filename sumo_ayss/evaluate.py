@@ -1,0 +1,307 @@
+"""Evaluate a trained run's SPCP: overall safety outcome, then Monte Carlo AYSS.
+
+    python -m sumo_ayss.evaluate runs/car_following/pi1/seed_0
+    python -m sumo_ayss.evaluate <run_dir> --n-outcome 200 --n-ayss 100000 --seed 4242 --force
+
+Reads ``<run>/config.yaml`` (the resolved configuration, with ``vut`` and ``seed``) and the
+selected policy ``<run>/spcp.zip``, and writes into the run folder:
+
+    outcome.csv   one row per outcome episode   (sumo_ayss.scenarios.tables.OUTCOME_SCHEMA)
+    outcome.json  crash / lane-change rates, mean reward and final headway with 95 % CIs
+    ayss.csv      one row per kept AYSS sample  (sumo_ayss.scenarios.tables.AYSS_SCHEMA)
+    ayss.json     filter counts, throughput, the Monte Carlo settings, mean indicator
+
+Both stages run in one env, so in one SUMO simulation (libsumo allows one per process). A
+stage whose CSV and JSON both exist is skipped unless ``--force``; a skipped stage whose
+stored settings differ from the requested ones is reported in the log. ``--seed`` fixes the
+outcome scenario set and the AYSS draws; keep it the same for every run that is compared.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import logging
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from sumo_ayss.agents.greedy import GreedyPolicy
+from sumo_ayss.config import to_dict
+from sumo_ayss.envs import make_env
+from sumo_ayss.envs.pair_env import PairEnv
+from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
+from sumo_ayss.experiment import ExperimentConfig, experiment_from_dict
+from sumo_ayss.scenarios.ayss import DEFAULT_AYSS_SEED, AyssConfig, run_ayss
+from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_N, DEFAULT_OUTCOME_SEED, run_outcome
+from sumo_ayss.scenarios.rollout import Policy
+from sumo_ayss.scenarios.tables import read_json, write_json, write_table
+
+__all__ = ["EvaluationResult", "evaluate_run", "load_run", "main"]
+
+logger = logging.getLogger(__name__)
+
+OUTCOME_CSV, OUTCOME_JSON = "outcome.csv", "outcome.json"
+AYSS_CSV, AYSS_JSON = "ayss.csv", "ayss.json"
+
+
+@dataclass(frozen=True)
+class RunInfo:
+    """What a run folder says about itself.
+
+    Attributes:
+        run_dir: The folder.
+        config: The resolved experiment configuration (``env.vut`` is the run's VUT).
+        seed: The training seed (also the run's SUMO seed).
+        spcp_step: Training step of the selected candidate (``spcp.json``), if recorded.
+    """
+
+    run_dir: Path
+    config: ExperimentConfig
+    seed: int
+    spcp_step: int | None
+
+
+@dataclass(frozen=True)
+class EvaluationResult:
+    """Files of an evaluated run and which stages ran now (False: skipped, outputs existed)."""
+
+    run_dir: Path
+    outcome_csv: Path
+    outcome_json: Path
+    ayss_csv: Path
+    ayss_json: Path
+    ran_outcome: bool
+    ran_ayss: bool
+
+
+def load_run(run_dir: str | Path) -> RunInfo:
+    """Read ``config.yaml`` (and ``spcp.json`` if present) of a run folder.
+
+    Raises:
+        CheckpointError: If the folder or its config is missing or unreadable.
+    """
+    run_dir = Path(run_dir)
+    path = run_dir / "config.yaml"
+    if not path.is_file():
+        raise CheckpointError(f"{run_dir}: not a run folder (no config.yaml)")
+    try:
+        data = yaml.safe_load(path.read_text())
+        data = dict(data)
+        seed, vut = int(data.pop("seed")), data.pop("vut")
+    except (yaml.YAMLError, TypeError, ValueError, KeyError) as exc:
+        raise CheckpointError(f"{path}: unreadable run configuration ({exc})") from exc
+    try:
+        cfg = experiment_from_dict(data, run_dir).with_vut(vut)
+    except ConfigError as exc:
+        raise CheckpointError(f"{path}: invalid run configuration: {exc}") from exc
+    spcp_step = None
+    if (run_dir / "spcp.json").is_file():
+        spcp_step = read_json(run_dir / "spcp.json").get("step")
+    return RunInfo(run_dir, cfg, seed, spcp_step)
+
+
+def _load_policy(run_dir: Path) -> Policy:
+    path = run_dir / "spcp.zip"
+    if not path.is_file():
+        raise CheckpointError(f"{run_dir}: no spcp.zip (was the SPCP selected?)")
+    return GreedyPolicy.load(path)
+
+
+def _base_record(run: RunInfo, stage: str) -> dict[str, Any]:
+    env = run.config.env
+    return {
+        "stage": stage,
+        "run_dir": str(run.run_dir.resolve()),
+        "case": env.case,
+        "vut": env.vut,
+        "train_seed": run.seed,
+        "spcp_step": run.spcp_step,
+    }
+
+
+def _should_run(csv_path: Path, json_path: Path, requested: dict[str, Any], force: bool) -> bool:
+    """Whether a stage runs; logs a skip, and a warning if its stored settings differ."""
+    if force or not (csv_path.is_file() and json_path.is_file()):
+        return True
+    stored = read_json(json_path).get("settings")
+    logger.info("skipping %s: outputs exist (pass --force to recompute)", csv_path.name)
+    requested = json.loads(json.dumps(requested))  # tuples -> lists, as stored
+    if stored != requested:
+        logger.warning(
+            "%s was computed with %s, not the requested %s; pass --force to recompute",
+            json_path.name,
+            stored,
+            requested,
+        )
+    return False
+
+
+def _outcome_stage(
+    env: PairEnv, policy: Policy, run: RunInfo, n: int, seed: int, progress: bool
+) -> None:
+    if seed == run.config.train.eval_seed:
+        logger.warning(
+            "outcome seed %d equals train.eval_seed: the SPCP is scored on the scenarios it "
+            "was selected on",
+            seed,
+        )
+    result = run_outcome(env, policy, n=n, seed=seed, progress=progress)
+    write_table(run.run_dir / OUTCOME_CSV, result.table)
+    record = {
+        **_base_record(run, "outcome"),
+        "settings": {"n": n, "seed": seed},
+        "odd": to_dict(run.config.env.odd),
+        "summary": result.summary.as_dict(),
+        "wall_s": round(result.wall_s, 3),
+    }
+    write_json(run.run_dir / OUTCOME_JSON, record)
+    s = result.summary
+    logger.info(
+        "outcome: crash rate %.3f [%.3f, %.3f], mean return %.3f",
+        s.crash_rate.value,
+        s.crash_rate.lo,
+        s.crash_rate.hi,
+        s.mean_return.mean,
+    )
+
+
+def _ayss_stage(
+    env: PairEnv, policy: Policy, run: RunInfo, cfg: AyssConfig, progress: bool
+) -> None:
+    result = run_ayss(env, policy, cfg, progress=progress)
+    write_table(run.run_dir / AYSS_CSV, result.table)
+    summary = result.summary()
+    settings = summary.pop("config")  # the AyssConfig used, compared on a later skip
+    record = {**_base_record(run, "ayss"), **summary, "settings": settings}
+    write_json(run.run_dir / AYSS_JSON, record)
+    logger.info(
+        "ayss: kept %d of %d samples in %.1f s", len(result.table), cfg.n_samples, result.wall_s
+    )
+
+
+def evaluate_run(
+    run_dir: str | Path,
+    *,
+    n_outcome: int = DEFAULT_OUTCOME_N,
+    outcome_seed: int = DEFAULT_OUTCOME_SEED,
+    ayss: AyssConfig | None = None,
+    force: bool = False,
+    progress: bool = True,
+    policy: Policy | None = None,
+) -> EvaluationResult:
+    """Run the outcome and AYSS stages on a run folder (see the module docstring).
+
+    Args:
+        run_dir: Folder written by :func:`sumo_ayss.train.train`.
+        n_outcome: Outcome episodes (paper: 200).
+        outcome_seed: Seed of the outcome scenario set (same for every compared run).
+        ayss: Monte Carlo settings; default :class:`AyssConfig()` (its seed included).
+        force: Recompute stages whose outputs exist.
+        progress: tqdm progress bars.
+        policy: Use this policy instead of ``<run>/spcp.zip`` (e.g. a scripted one).
+
+    Returns:
+        The output paths and which stages ran.
+
+    Raises:
+        CheckpointError: If the run folder, its config or its SPCP cannot be read.
+    """
+    run = load_run(run_dir)
+    ayss_cfg = ayss if ayss is not None else AyssConfig()
+    d = run.run_dir
+    paths = {n: d / n for n in (OUTCOME_CSV, OUTCOME_JSON, AYSS_CSV, AYSS_JSON)}
+    do_outcome = _should_run(
+        paths[OUTCOME_CSV], paths[OUTCOME_JSON], {"n": n_outcome, "seed": outcome_seed}, force
+    )
+    do_ayss = _should_run(paths[AYSS_CSV], paths[AYSS_JSON], ayss_cfg.to_dict(), force)
+    if do_outcome or do_ayss:
+        pol = policy if policy is not None else _load_policy(d)
+        env = make_env(run.config.env, sumo_seed=run.seed)
+        try:
+            if do_outcome:
+                _outcome_stage(env, pol, run, n_outcome, outcome_seed, progress)
+            if do_ayss:
+                _ayss_stage(env, pol, run, ayss_cfg, progress)
+        finally:
+            env.close()
+    return EvaluationResult(
+        d,
+        paths[OUTCOME_CSV],
+        paths[OUTCOME_JSON],
+        paths[AYSS_CSV],
+        paths[AYSS_JSON],
+        do_outcome,
+        do_ayss,
+    )
+
+
+# --------------------------------------------------------------------------- CLI
+
+
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(
+        prog="python -m sumo_ayss.evaluate", description=(__doc__ or "").splitlines()[0]
+    )
+    parser.add_argument("run_dir", type=Path, help="run folder (holds config.yaml, spcp.zip)")
+    parser.add_argument(
+        "--n-outcome", type=int, default=DEFAULT_OUTCOME_N, help="outcome episodes (default 200)"
+    )
+    parser.add_argument(
+        "--n-ayss",
+        type=int,
+        default=AyssConfig.n_samples,
+        help=f"AYSS Monte Carlo draws before filtering (default {AyssConfig.n_samples})",
+    )
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=None,
+        help=f"seed of the outcome scenarios and the AYSS draws (default: outcome "
+        f"{DEFAULT_OUTCOME_SEED}, AYSS {DEFAULT_AYSS_SEED}); the same for compared runs",
+    )
+    parser.add_argument(
+        "--ayss-speeds-from-odd",
+        action="store_true",
+        help="sample AYSS speeds in the run's ODD instead of [0, 30] m/s",
+    )
+    parser.add_argument("--force", action="store_true", help="recompute existing outputs")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    return parser.parse_args(argv)
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    args = parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    t0 = time.perf_counter()
+    try:
+        overrides: dict[str, Any] = {"n_samples": args.n_ayss}
+        if args.seed is not None:
+            overrides["seed"] = args.seed
+        if args.ayss_speeds_from_odd:
+            ayss = AyssConfig.from_odd(load_run(args.run_dir).config.env.odd, **overrides)
+        else:
+            ayss = dataclasses.replace(AyssConfig(), **overrides)
+        result = evaluate_run(
+            args.run_dir,
+            n_outcome=args.n_outcome,
+            outcome_seed=args.seed if args.seed is not None else DEFAULT_OUTCOME_SEED,
+            ayss=ayss,
+            force=args.force,
+            progress=not args.no_progress,
+        )
+    except AyssError as e:
+        sys.exit(f"error: {e}")
+    logger.info("done in %.1f s", time.perf_counter() - t0)
+    for path in (result.outcome_csv, result.outcome_json, result.ayss_csv, result.ayss_json):
+        print(path)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,390 @@
+"""One command from config to verdict: the grid cases × VUTs × seeds, resumable.
+
+    python -m sumo_ayss.pipeline configs/paper.yaml [--workers N] [--backend local|ray]
+
+Each job (case, VUT, seed) trains (or resumes) its SPCP candidates, selects the SPCP, runs
+the outcome episodes and the Monte Carlo AYSS; then one report covers the whole grid. Jobs
+run in parallel processes (one SUMO per process: libsumo holds one simulation each), or as
+Ray tasks. Every stage writes atomically and is skipped when its output exists and was made
+from the same inputs, so rerunning after a crash or Ctrl-C continues where it stopped. A
+failing job is retried once, then reported with its log; it never costs the other jobs.
+
+Pipeline YAML (every key optional)::
+
+    grid: {cases: [car_following, cut_in], vuts: [pi1, pi2], seeds: [0, 1, 2]}
+    experiments: {car_following: car_following.yaml, cut_in: cut_in.yaml}  # per case
+    out: ../runs/paper          # relative to the YAML file
+    total_timesteps: null       # override every experiment's train.total_timesteps
+    eval_every: null            # override every experiment's train.eval_every
+    evaluate: {n_outcome: 200, n_ayss: 100000}
+    workers: 0                  # 0 = as many as cores
+    retries: 1
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import hashlib
+import json
+import logging
+import multiprocessing
+import os
+import sys
+import time
+import traceback
+from collections.abc import Mapping, Sequence
+from concurrent.futures import Future, ProcessPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar, Literal
+
+from sumo_ayss.config import PROJECT_ROOT, Case, _require, build, read_yaml, to_dict
+from sumo_ayss.errors import ConfigError
+
+logger = logging.getLogger(__name__)
+
+Backend = Literal["local", "ray"]
+
+
+@dataclass(frozen=True)
+class GridConfig:
+    """The grid of jobs. Section ``grid``."""
+
+    SECTION: ClassVar[str] = "grid"
+
+    cases: tuple[Case, ...] = ("car_following", "cut_in")
+    vuts: tuple[str, ...] = ("pi1", "pi2")
+    seeds: tuple[int, ...] = (0, 1, 2)
+
+    def __post_init__(self) -> None:
+        for name in ("cases", "vuts", "seeds"):
+            values = getattr(self, name)
+            _require(len(values) > 0, f"grid.{name} must not be empty")
+            _require(
+                len(set(values)) == len(values), f"grid.{name} has duplicates: {list(values)}"
+            )
+
+
+@dataclass(frozen=True)
+class EvaluateConfig:
+    """Outcome and AYSS sizes. Section ``evaluate``."""
+
+    n_outcome: int = 200
+    n_ayss: int = 100_000
+
+    def __post_init__(self) -> None:
+        _require(self.n_outcome >= 1, f"evaluate.n_outcome must be >= 1, got {self.n_outcome}")
+        _require(self.n_ayss >= 1, f"evaluate.n_ayss must be >= 1, got {self.n_ayss}")
+
+
+@dataclass(frozen=True)
+class PipelineConfig:
+    """A whole batch: grid, experiment file per case, output folder, parallelism."""
+
+    grid: GridConfig = field(default_factory=GridConfig)
+    experiments: Mapping[str, Path] = field(
+        default_factory=lambda: {
+            "car_following": PROJECT_ROOT / "configs" / "car_following.yaml",
+            "cut_in": PROJECT_ROOT / "configs" / "cut_in.yaml",
+        }
+    )
+    out: Path = Path("runs") / "paper"
+    total_timesteps: int | None = None
+    eval_every: int | None = None
+    evaluate: EvaluateConfig = field(default_factory=EvaluateConfig)
+    workers: int = 0
+    retries: int = 1
+
+    def __post_init__(self) -> None:
+        _require(self.workers >= 0, f"workers must be >= 0, got {self.workers}")
+        _require(self.retries >= 0, f"retries must be >= 0, got {self.retries}")
+        for case in self.grid.cases:
+            _require(
+                case in self.experiments,
+                f"experiments has no file for case {case!r}; given: {sorted(self.experiments)}",
+            )
+
+    @property
+    def n_workers(self) -> int:
+        return self.workers or os.cpu_count() or 1
+
+
+@dataclass(frozen=True)
+class JobSpec:
+    """One (case, VUT, seed): everything a worker process needs, picklable."""
+
+    case: str
+    vut: str
+    seed: int
+    experiment: dict[str, Any]
+    """The resolved experiment (``ExperimentConfig.to_dict()``, VUT set)."""
+    out: str
+    n_outcome: int
+    n_ayss: int
+
+    @property
+    def name(self) -> str:
+        return f"{self.case}/{self.vut}/seed_{self.seed}"
+
+    @property
+    def run_dir(self) -> Path:
+        return Path(self.out) / self.case / self.vut / f"seed_{self.seed}"
+
+
+@dataclass
+class JobStatus:
+    spec: JobSpec
+    state: str = "queued"
+    attempts: int = 0
+    error: str = ""
+    wall_s: float = 0.0
+
+
+# ---------------------------------------------------------------------- loading
+
+
+def load_pipeline(path: str | Path | None, **overrides: Any) -> PipelineConfig:
+    """Pipeline YAML over defaults, then ``overrides`` (None values are ignored)."""
+    if path is None:
+        cfg = PipelineConfig()
+    else:
+        path = Path(path)
+        cfg = build(PipelineConfig, read_yaml(path), "", path.resolve().parent)
+    clean = {k: v for k, v in overrides.items() if v is not None}
+    return dataclasses.replace(cfg, **clean) if clean else cfg
+
+
+def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
+    """Resolve every job's experiment; bad grids are refused here, before any job runs."""
+    from sumo_ayss.experiment import load_experiment
+
+    jobs = []
+    for case in cfg.grid.cases:
+        exp = load_experiment(cfg.experiments[case])
+        if exp.env.case != case:
+            raise ConfigError(
+                f"experiments.{case}: {cfg.experiments[case]} is a {exp.env.case!r} experiment"
+            )
+        train = exp.train
+        if cfg.total_timesteps is not None:
+            train = dataclasses.replace(train, total_timesteps=cfg.total_timesteps)
+        if cfg.eval_every is not None:
+            train = dataclasses.replace(train, eval_every=cfg.eval_every)
+        exp = dataclasses.replace(exp, train=dataclasses.replace(train, progress_bar=False))
+        for vut in cfg.grid.vuts:
+            if vut not in exp.env.vuts:
+                raise ConfigError(
+                    f"grid.vuts: {vut!r} is not a VUT of the {case} experiment; "
+                    f"allowed: {sorted(exp.env.vuts)}"
+                )
+            for seed in cfg.grid.seeds:
+                jobs.append(
+                    JobSpec(
+                        case=case,
+                        vut=vut,
+                        seed=int(seed),
+                        experiment=exp.with_vut(vut).to_dict(),
+                        out=str(cfg.out),
+                        n_outcome=cfg.evaluate.n_outcome,
+                        n_ayss=cfg.evaluate.n_ayss,
+                    )
+                )
+    return jobs
+
+
+# ---------------------------------------------------------------------- one job
+
+
+def _fingerprint(*parts: Any) -> str:
+    h = hashlib.sha256()
+    for part in parts:
+        if isinstance(part, Path):
+            h.update(part.read_bytes())
+        else:
+            h.update(json.dumps(part, sort_keys=True, default=str).encode())
+    return h.hexdigest()[:16]
+
+
+def run_job(spec: JobSpec) -> dict[str, Any]:
+    """Train (or resume, or skip) and evaluate one job. Runs in a worker process."""
+    from sumo_ayss.evaluate import evaluate_run
+    from sumo_ayss.experiment import experiment_from_dict
+    from sumo_ayss.train import atomic_write_json, train
+
+    run_dir = spec.run_dir
+    run_dir.mkdir(parents=True, exist_ok=True)
+    handler = logging.FileHandler(run_dir / "job.log")
+    handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s: %(message)s"))
+    root = logging.getLogger()
+    root.addHandler(handler)
+    root.setLevel(logging.INFO)
+    t0 = time.perf_counter()
+    stages: dict[str, str] = {}
+    try:
+        cfg = experiment_from_dict(spec.experiment, run_dir)
+        if (run_dir / "spcp.json").is_file() and (run_dir / "config.yaml").is_file():
+            from sumo_ayss.train import _check_same_config
+
+            _check_same_config(run_dir, cfg, spec.seed)  # raises if the inputs changed
+            stages["train"] = "skipped"
+        else:
+            resume = (run_dir / "config.yaml").is_file()
+            train(cfg, spec.seed, Path(spec.out), resume=resume, argv=["--pipeline", spec.name])
+            stages["train"] = "resumed" if resume else "done"
+
+        marker = run_dir / "evaluate.done.json"
+        key = _fingerprint(run_dir / "spcp.zip", spec.n_outcome, spec.n_ayss)
+        done = json.loads(marker.read_text()) if marker.is_file() else {}
+        if done.get("inputs") == key:
+            stages["evaluate"] = "skipped"
+        else:
+            evaluate_run(run_dir, n_outcome=spec.n_outcome, n_ayss=spec.n_ayss, force=True)
+            atomic_write_json(marker, {"inputs": key})
+            stages["evaluate"] = "done"
+    except BaseException:
+        logger.exception("job %s failed", spec.name)
+        raise
+    finally:
+        root.removeHandler(handler)
+        handler.close()
+    return {"job": spec.name, "stages": stages, "wall_s": time.perf_counter() - t0}
+
+
+# ---------------------------------------------------------------------- the grid
+
+
+def _progress(status: JobStatus) -> str:
+    latest = status.spec.run_dir / "checkpoints" / "latest.json"
+    total = status.spec.experiment["train"]["total_timesteps"]
+    if (status.spec.run_dir / "evaluate.done.json").is_file():
+        return "evaluated"
+    if (status.spec.run_dir / "spcp.json").is_file():
+        return "trained; evaluating" if status.state == "running" else "trained"
+    if latest.is_file():
+        step = json.loads(latest.read_text())["step"]
+        return f"train {step:,}/{total:,}"
+    return "train 0" if status.state == "running" else ""
+
+
+def _table(statuses: Sequence[JobStatus]) -> Any:
+    from rich.table import Table
+
+    table = Table(title="sumo_ayss pipeline", expand=False)
+    for col in ("job", "state", "progress", "tries", "wall [s]"):
+        table.add_column(col)
+    colours = {"done": "green", "failed": "red", "running": "yellow", "retrying": "magenta"}
+    for s in statuses:
+        colour = colours.get(s.state, "white")
+        table.add_row(
+            s.spec.name,
+            f"[{colour}]{s.state}[/{colour}]",
+            _progress(s),
+            str(s.attempts),
+            f"{s.wall_s:.0f}" if s.wall_s else "",
+        )
+    return table
+
+
+def run_grid_local(jobs: Sequence[JobSpec], workers: int, retries: int, live: bool) -> list[JobStatus]:
+    """Run ``jobs`` on a local process pool with retries and a live table."""
+    statuses = [JobStatus(j) for j in jobs]
+    ctx = multiprocessing.get_context("spawn")  # fresh interpreters: no inherited libsumo
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        pending: dict[Future[dict[str, Any]], JobStatus] = {}
+
+        def submit(s: JobStatus) -> None:
+            s.attempts += 1
+            s.state = "running" if s.attempts == 1 else "retrying"
+            pending[pool.submit(run_job, s.spec)] = s
+
+        for s in statuses:
+            submit(s)
+        display = _live(statuses) if live else None
+        try:
+            while pending:
+                done = [f for f in list(pending) if f.done()]
+                for fut in done:
+                    s = pending.pop(fut)
+                    try:
+                        result = fut.result()
+                        s.state, s.wall_s = "done", result["wall_s"]
+                    except Exception as e:  # noqa: BLE001 - a job's failure is data here
+                        s.error = "".join(traceback.format_exception_only(e)).strip()
+                        if s.attempts <= retries:
+                            logger.warning("job %s failed (%s); retrying", s.spec.name, s.error)
+                            submit(s)
+                        else:
+                            s.state = "failed"
+                if display is not None:
+                    display.update(_table(statuses))
+                time.sleep(0.5)
+        finally:
+            if display is not None:
+                display.update(_table(statuses))
+                display.stop()
+    return statuses
+
+
+def _live(statuses: Sequence[JobStatus]) -> Any:
+    from rich.live import Live
+
+    live = Live(_table(statuses), refresh_per_second=2, transient=False)
+    live.start()
+    return live
+
+
+def run_pipeline(
+    cfg: PipelineConfig, *, backend: Backend = "local", address: str | None = None,
+    live: bool = True,
+) -> tuple[list[JobStatus], Path | None]:
+    """Run the grid, then the report over every finished job; return statuses and report."""
+    jobs = plan_jobs(cfg)
+    cfg.out.mkdir(parents=True, exist_ok=True)
+    from sumo_ayss.train import atomic_write_json
+
+    atomic_write_json(cfg.out / "pipeline.json", to_dict(cfg))
+    if backend == "ray":
+        from sumo_ayss.ray_backend import run_grid_ray
+
+        statuses = run_grid_ray(jobs, cfg.retries, address)
+    else:
+        statuses = run_grid_local(jobs, min(cfg.n_workers, len(jobs)), cfg.retries, live)
+    finished = [s.spec.run_dir for s in statuses if s.state == "done"]
+    report = None
+    if finished:
+        from sumo_ayss.report import write_report
+
+        report = write_report(finished, cfg.out / "report")
+    return statuses, report
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(
+        prog="python -m sumo_ayss.pipeline", description=__doc__.splitlines()[0]
+    )
+    parser.add_argument("config", type=Path, nargs="?", default=None, help="pipeline YAML")
+    parser.add_argument("--out", type=Path, default=None)
+    parser.add_argument("--workers", type=int, default=None)
+    parser.add_argument("--backend", choices=["local", "ray"], default="local")
+    parser.add_argument("--address", default=None, help="Ray cluster address (ray backend)")
+    parser.add_argument("--no-live", action="store_true", help="no live table (logs only)")
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    try:
+        cfg = load_pipeline(args.config, out=args.out, workers=args.workers)
+        statuses, report = run_pipeline(
+            cfg, backend=args.backend, address=args.address, live=not args.no_live
+        )
+    except ConfigError as e:
+        sys.exit(f"error: {e}")
+    failed = [s for s in statuses if s.state == "failed"]
+    for s in failed:
+        print(f"FAILED {s.spec.name}: {s.error}  (log: {s.spec.run_dir / 'job.log'})")
+    if report is not None:
+        print(f"report: {report}")
+    sys.exit(1 if failed else 0)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,280 @@
+"""Overall safety outcome of an SPCP (paper Tables II and III), with confidence intervals.
+
+:func:`run_outcome` rolls a policy greedily over ``n`` initial conditions drawn from the
+env's ODD by :func:`~sumo_ayss.envs.odd.sample_initial_conditions` with a fixed seed, so
+every SPCP (every VUT, every training seed) meets the *same* scenarios (paper: 200). The
+default seed :data:`DEFAULT_OUTCOME_SEED` differs from the training's candidate-evaluation
+seed (``train.eval_seed``, 2024), so an SPCP is not scored on the scenarios it was selected
+on.
+
+One row per episode goes to the outcome table (:data:`~sumo_ayss.scenarios.tables.
+OUTCOME_SCHEMA`); :func:`summarize_outcome` reduces it to
+
+* crash rate and lane-change rate: proportions with a Wilson score interval
+  (:func:`wilson_interval`), which stays inside [0, 1] and is informative at 0 crashes;
+* mean episode reward and mean final headway: Student t intervals
+  (:func:`sumo_ayss.analysis.stats.mean_ci`);
+* for cut-in, also the paper's Table III reading: mean reward and headway over the episodes
+  with a lane change and no collision (``lane_change_no_collision``). Both are reported.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from statistics import NormalDist
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+from tqdm import tqdm
+
+from sumo_ayss.analysis.stats import check_level, mean_ci
+from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
+from sumo_ayss.envs.pair_env import PairEnv
+from sumo_ayss.errors import ConfigError
+from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, run_episode
+from sumo_ayss.scenarios.tables import OUTCOME_SCHEMA, Table
+
+__all__ = [
+    "DEFAULT_OUTCOME_N",
+    "DEFAULT_OUTCOME_SEED",
+    "MeanInterval",
+    "OutcomeResult",
+    "OutcomeSummary",
+    "Proportion",
+    "outcome_table",
+    "run_outcome",
+    "summarize_outcome",
+    "wilson_interval",
+]
+
+#: Episodes per SPCP (paper: 200).
+DEFAULT_OUTCOME_N = 200
+#: Seed of the outcome scenario set, shared by every SPCP; not ``train.eval_seed`` (2024).
+DEFAULT_OUTCOME_SEED = 4242
+
+
+# --------------------------------------------------------------------------- statistics
+
+
+def wilson_interval(count: int, n: int, level: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval of a binomial proportion ``count / n``.
+
+    ``(p + z²/2n ± z·sqrt(p(1-p)/n + z²/4n²)) / (1 + z²/n)`` with ``p = count / n`` and
+    ``z`` the standard normal ``(1 + level) / 2`` quantile. Unlike the Wald interval it
+    does not collapse to a point at 0 or n successes: at ``count = 0`` it is
+    ``[0, z² / (n + z²)]``.
+
+    Args:
+        count: Successes, ``0 <= count <= n``.
+        n: Trials, >= 1.
+        level: Confidence level in (0, 1).
+
+    Returns:
+        ``(lo, hi)`` as fractions in [0, 1].
+
+    Raises:
+        ConfigError: If ``n < 1``, ``count`` is outside ``[0, n]`` or ``level`` is invalid.
+    """
+    level = check_level(level)
+    if isinstance(n, bool) or int(n) != n or n < 1:
+        raise ConfigError(f"n: expected an integer >= 1, got {n!r}")
+    if isinstance(count, bool) or int(count) != count or not 0 <= count <= n:
+        raise ConfigError(f"count: expected an integer in [0, {n}], got {count!r}")
+    z = NormalDist().inv_cdf(0.5 * (1.0 + level))
+    p = count / n
+    z2n = z * z / n
+    denom = 1.0 + z2n
+    centre = (p + 0.5 * z2n) / denom
+    half = z / denom * math.sqrt(p * (1.0 - p) / n + z * z / (4.0 * n * n))
+    lo = 0.0 if count == 0 else max(0.0, centre - half)
+    hi = 1.0 if count == n else min(1.0, centre + half)
+    return lo, hi
+
+
+@dataclass(frozen=True)
+class Proportion:
+    """A rate with its Wilson interval. ``value``, ``lo``, ``hi`` are fractions in [0, 1]."""
+
+    count: int
+    n: int
+    value: float
+    lo: float
+    hi: float
+    level: float
+
+    @classmethod
+    def of(cls, flags: npt.ArrayLike, level: float = 0.95) -> Proportion:
+        """The proportion of True in ``flags`` (NaN value and bounds when empty)."""
+        arr = np.asarray(flags, dtype=bool)
+        n, count = int(arr.size), int(arr.sum())
+        if n == 0:
+            return cls(0, 0, math.nan, math.nan, math.nan, level)
+        lo, hi = wilson_interval(count, n, level)
+        return cls(count, n, count / n, lo, hi, level)
+
+
+@dataclass(frozen=True)
+class MeanInterval:
+    """A mean with its Student t interval, in the unit of the averaged quantity.
+
+    ``n = 0`` gives NaN everywhere, ``n = 1`` NaN bounds (see :func:`mean_ci`).
+    """
+
+    n: int
+    mean: float
+    lo: float
+    hi: float
+    level: float
+
+    @classmethod
+    def of(cls, values: npt.ArrayLike, level: float = 0.95) -> MeanInterval:
+        arr = np.asarray(values, dtype=float)
+        mean, lo, hi = mean_ci(arr, level)
+        return cls(int(arr.size), mean, lo, hi, level)
+
+
+@dataclass(frozen=True)
+class OutcomeSummary:
+    """Paper Tables II / III for one SPCP.
+
+    Attributes:
+        case: ``"car_following"`` or ``"cut_in"``.
+        n_episodes: Episodes summarised.
+        crash_rate: Share of episodes that ended in a collision.
+        lane_change_rate: Share of episodes with a started lane change (cut-in); ``None``
+            in car-following.
+        mean_return: Mean undiscounted episode reward, all episodes.
+        mean_final_headway_m: Mean headway after the last step [m], all episodes.
+        lc_no_collision_return: Cut-in only (else ``None``): mean episode reward over the
+            episodes with a lane change and no collision (paper Table III's r̄_epi).
+        lc_no_collision_final_headway_m: Cut-in only: mean final headway [m] over the same
+            episodes (paper Table III's h̄).
+    """
+
+    case: str
+    n_episodes: int
+    crash_rate: Proportion
+    lane_change_rate: Proportion | None
+    mean_return: MeanInterval
+    mean_final_headway_m: MeanInterval
+    lc_no_collision_return: MeanInterval | None
+    lc_no_collision_final_headway_m: MeanInterval | None
+
+    def as_dict(self) -> dict[str, Any]:
+        """Nested plain dict (NaN stays NaN; :func:`tables.write_json` writes it as null)."""
+        return asdict(self)
+
+
+def summarize_outcome(table: Table, case: str, level: float = 0.95) -> OutcomeSummary:
+    """Reduce an outcome table (e.g. read back from ``outcome.csv``) to its summary.
+
+    Args:
+        table: Rows of :data:`OUTCOME_SCHEMA`.
+        case: ``"car_following"`` or ``"cut_in"``; cut-in adds the lane-change figures.
+        level: Confidence level of every interval.
+
+    Returns:
+        The :class:`OutcomeSummary`.
+    """
+    if table.schema != OUTCOME_SCHEMA:
+        raise ConfigError(f"summarize_outcome: expected an outcome table, got {table.schema.name}")
+    collided, changed = table["collided"], table["lane_changed"]
+    returns, headway = table["episode_return"], table["final_headway_m"]
+    cut_in = case == "cut_in"
+    subset = changed & ~collided
+    return OutcomeSummary(
+        case=case,
+        n_episodes=len(table),
+        crash_rate=Proportion.of(collided, level),
+        lane_change_rate=Proportion.of(changed, level) if cut_in else None,
+        mean_return=MeanInterval.of(returns, level),
+        mean_final_headway_m=MeanInterval.of(headway, level),
+        lc_no_collision_return=MeanInterval.of(returns[subset], level) if cut_in else None,
+        lc_no_collision_final_headway_m=(
+            MeanInterval.of(headway[subset], level) if cut_in else None
+        ),
+    )
+
+
+# --------------------------------------------------------------------------- running
+
+
+def outcome_table(
+    scenarios: Sequence[InitialCondition], episodes: Sequence[EpisodeResult]
+) -> Table:
+    """The outcome table of episodes run from ``scenarios`` (same order, same length)."""
+    if len(scenarios) != len(episodes):
+        raise ConfigError(f"{len(scenarios)} scenarios but {len(episodes)} episodes")
+    return Table(
+        OUTCOME_SCHEMA,
+        {
+            "scenario": np.arange(len(scenarios), dtype=np.int64),
+            "v_pov0_mps": [ic.pov_speed_mps for ic in scenarios],
+            "v_vut0_mps": [ic.vut_speed_mps for ic in scenarios],
+            "gap0_m": [ic.gap_m for ic in scenarios],
+            "episode_return": [e.episode_return for e in episodes],
+            "collided": np.array([e.collided for e in episodes], dtype=bool),
+            "lane_changed": np.array([e.lane_changed for e in episodes], dtype=bool),
+            "final_headway_m": [e.final_headway_m for e in episodes],
+            "n_steps": np.array([e.n_steps for e in episodes], dtype=np.int64),
+        },
+    )
+
+
+@dataclass(frozen=True)
+class OutcomeResult:
+    """What :func:`run_outcome` returns.
+
+    Attributes:
+        table: One row per episode (:data:`OUTCOME_SCHEMA`).
+        summary: Rates and means with intervals.
+        seed: Seed of the scenario set.
+        n: Number of scenarios.
+        wall_s: Wall-clock time of the rollouts [s].
+    """
+
+    table: Table
+    summary: OutcomeSummary
+    seed: int
+    n: int
+    wall_s: float
+
+
+def run_outcome(
+    env: PairEnv,
+    policy: Policy,
+    n: int = DEFAULT_OUTCOME_N,
+    seed: int = DEFAULT_OUTCOME_SEED,
+    *,
+    level: float = 0.95,
+    progress: bool = False,
+) -> OutcomeResult:
+    """Roll ``policy`` over ``n`` ODD scenarios of ``seed`` and summarise the outcome.
+
+    Args:
+        env: The case's env (its ODD gives the scenarios); SUMO starts at the first reset.
+            Its RNG is not consumed.
+        policy: ``obs (N, d) float32 -> actions (N,)``; called with ``N = 1`` per step.
+        n: Number of scenarios (episodes), >= 1.
+        seed: Seed of :func:`sample_initial_conditions`; keep it fixed across SPCPs.
+        level: Confidence level of the summary's intervals.
+        progress: Show a tqdm progress bar over the episodes.
+
+    Returns:
+        The :class:`OutcomeResult`.
+    """
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise ConfigError(f"n: expected an integer >= 1, got {n!r}")
+    base = env.unwrapped
+    assert isinstance(base, PairEnv)
+    scenarios = sample_initial_conditions(base.config.odd, n, seed)
+    t0 = time.perf_counter()
+    bar = tqdm(scenarios, desc="outcome", unit="ep", disable=not progress, leave=False)
+    episodes = [run_episode(base, policy, ic) for ic in bar]
+    wall = time.perf_counter() - t0
+    table = outcome_table(scenarios, episodes)
+    return OutcomeResult(table, summarize_outcome(table, base.config.case, level), seed, n, wall)

@@ -1,0 +1,533 @@
+"""Schemas, writers and validating readers of the evaluation tables (CSV) and summaries (JSON).
+
+Two tables leave the evaluation stages, one row per item, as plain CSV that a person can open
+in any spreadsheet (stdlib :mod:`csv`, no pandas):
+
+* :data:`OUTCOME_SCHEMA` — ``<run>/outcome.csv``, one row per outcome episode (paper
+  Tables II and III): the initial condition, the return, whether it crashed or changed lanes,
+  the headway at the last step.
+* :data:`AYSS_SCHEMA` — ``<run>/ayss.csv``, one row per kept adversarial-yet-safe sample of
+  the Monte Carlo stage (paper Fig. 4 and 6): the sampled observation, the SPCP's action,
+  TTC and the aggressiveness indicator.
+
+Every column has a name, a dtype, a unit and a meaning (:class:`Column`);
+:func:`schema_markdown` prints them as a Markdown table for the docs. Encoding on disk:
+
+* ``float``: Python's ``repr`` of the float64 value (shortest text that reads back to the
+  same number), ``inf`` / ``-inf`` / ``nan`` for non-finite values. A column accepts NaN only
+  when ``nullable`` (an empty cell then also reads as NaN) and ±inf only when ``allow_inf``.
+* ``int``: decimal integer. ``bool``: ``0`` / ``1`` (``true`` / ``false`` accepted on read).
+* ``str``: the text; ``choices`` restricts it to a fixed set.
+
+Files are written atomically (temporary file in the same folder, then :func:`os.replace`), so
+a reader never sees half a table. :func:`read_table` checks the header (missing and extra
+columns), every cell's dtype, NaN / inf where they are not allowed, and the choices, and
+raises :data:`TableError` naming the file, column and row.
+
+:data:`TableError` is ``sumo_ayss.errors.TableError`` when that module defines it, otherwise a
+local subclass of both :class:`~sumo_ayss.errors.CheckpointError` and :class:`ValueError`
+(catch it by this module's name, or as ``CheckpointError`` / ``ValueError``).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import numpy.typing as npt
+
+import sumo_ayss.errors as _errors
+from sumo_ayss.errors import AyssError, CheckpointError
+
+__all__ = [
+    "AYSS_SCHEMA",
+    "INDICATOR_ACCEL",
+    "INDICATOR_DELTA_V_BAR",
+    "INDICATOR_NAMES",
+    "OUTCOME_SCHEMA",
+    "Column",
+    "Table",
+    "TableError",
+    "TableSchema",
+    "atomic_write_text",
+    "read_json",
+    "read_table",
+    "schema_markdown",
+    "table_from_rows",
+    "write_json",
+    "write_table",
+]
+
+Dtype = Literal["int", "float", "bool", "str"]
+
+
+class _FallbackTableError(CheckpointError, ValueError):
+    """A table or summary file is missing, malformed, or does not match its schema."""
+
+
+#: Raised when a table does not match its schema (see the module docstring).
+TableError: type[AyssError] = getattr(_errors, "TableError", _FallbackTableError)
+
+_NUMPY_DTYPE: dict[str, type] = {"int": np.int64, "float": np.float64, "bool": np.bool_}
+_TRUE = frozenset({"1", "true", "True", "TRUE"})
+_FALSE = frozenset({"0", "false", "False", "FALSE"})
+
+
+# --------------------------------------------------------------------------- schemas
+
+
+@dataclass(frozen=True)
+class Column:
+    """One column of a table.
+
+    Attributes:
+        name: Header text, unique in its table.
+        dtype: ``"int"``, ``"float"``, ``"bool"`` or ``"str"``.
+        unit: Physical unit (``"m"``, ``"m/s"``, ``"m/s²"``, ``"s"``) or ``"-"``.
+        meaning: What the value is, with its sign convention.
+        nullable: NaN allowed (float columns only).
+        allow_inf: ±inf allowed (float columns only).
+        choices: Allowed values of a ``str`` column; ``None`` = any text.
+    """
+
+    name: str
+    dtype: Dtype
+    unit: str
+    meaning: str
+    nullable: bool = False
+    allow_inf: bool = False
+    choices: tuple[str, ...] | None = None
+
+
+@dataclass(frozen=True)
+class TableSchema:
+    """An ordered set of columns with a name (used in error messages and docs)."""
+
+    name: str
+    columns: tuple[Column, ...]
+    by_name: Mapping[str, Column] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        names = [c.name for c in self.columns]
+        if len(set(names)) != len(names):
+            raise ValueError(f"schema {self.name}: duplicate column names in {names}")
+        object.__setattr__(self, "by_name", {c.name: c for c in self.columns})
+
+    @property
+    def names(self) -> list[str]:
+        """Column names in file order."""
+        return [c.name for c in self.columns]
+
+
+def schema_markdown(schema: TableSchema) -> str:
+    """The schema as a Markdown table: column, dtype, unit, meaning."""
+    lines = ["| column | dtype | unit | meaning |", "|---|---|---|---|"]
+    for c in schema.columns:
+        extra = []
+        if c.nullable:
+            extra.append("NaN allowed")
+        if c.allow_inf:
+            extra.append("inf allowed")
+        if c.choices:
+            extra.append("one of " + ", ".join(f"`{v}`" for v in c.choices))
+        note = f" ({'; '.join(extra)})" if extra else ""
+        lines.append(f"| `{c.name}` | {c.dtype} | {c.unit} | {c.meaning}{note} |")
+    return "\n".join(lines) + "\n"
+
+
+#: ``<run>/outcome.csv``: one row per episode of the outcome stage (paper Tables II, III).
+OUTCOME_SCHEMA = TableSchema(
+    "outcome",
+    (
+        Column("scenario", "int", "-", "index of the initial condition in the scenario set"),
+        Column("v_pov0_mps", "float", "m/s", "POV speed at the start of the episode"),
+        Column("v_vut0_mps", "float", "m/s", "VUT speed at the start of the episode"),
+        Column(
+            "gap0_m",
+            "float",
+            "m",
+            "initial longitudinal gap, POV rear bumper minus VUT front bumper",
+        ),
+        Column("episode_return", "float", "-", "undiscounted sum of the rewards R of the episode"),
+        Column("collided", "bool", "-", "the episode ended in a collision"),
+        Column(
+            "lane_changed",
+            "bool",
+            "-",
+            "the POV started a lane change (cut-in); always 0 in car-following",
+        ),
+        Column(
+            "final_headway_m",
+            "float",
+            "m",
+            "headway h after the last step (POV rear minus VUT front; < 0 = overlap)",
+        ),
+        Column("n_steps", "int", "-", "decisions taken (25 for a full 5 s episode)"),
+    ),
+)
+
+#: Aggressiveness indicator of car-following: POV acceleration [m/s²], < 0 brakes.
+INDICATOR_ACCEL = "pov_accel_mps2"
+#: Aggressiveness indicator of cut-in: Δv̄ [m/s], < 0 closes in.
+INDICATOR_DELTA_V_BAR = "delta_v_bar_mps"
+#: Allowed values of ``ayss.csv``'s ``indicator_name``.
+INDICATOR_NAMES = (INDICATOR_ACCEL, INDICATOR_DELTA_V_BAR)
+
+#: ``<run>/ayss.csv``: one row per kept adversarial-yet-safe sample (paper Fig. 4 and 6).
+AYSS_SCHEMA = TableSchema(
+    "ayss",
+    (
+        Column("sample", "int", "-", "index of the draw in the seed's Monte Carlo sample"),
+        Column("v_pov_mps", "float", "m/s", "sampled POV speed (observation)"),
+        Column("v_vut_mps", "float", "m/s", "sampled VUT speed (observation)"),
+        Column(
+            "h_m",
+            "float",
+            "m",
+            "sampled headway, POV rear bumper minus VUT front bumper (observation)",
+        ),
+        Column(
+            "same_lane",
+            "int",
+            "-",
+            "same-lane flag of the observation: 1 in car-following, 0 in cut-in",
+        ),
+        Column("action", "int", "-", "the SPCP's (greedy) action index"),
+        Column(
+            "target_speed_mps",
+            "float",
+            "m/s",
+            "target speed the action asks for (cut-in lane change: the POV keeps v_pov)",
+        ),
+        Column(
+            "ttc_s",
+            "float",
+            "s",
+            "time to collision h / (v_vut - v_pov) when closing, +inf otherwise",
+            allow_inf=True,
+        ),
+        Column(
+            "indicator_name",
+            "str",
+            "-",
+            "pov_accel_mps2 (car-following) or delta_v_bar_mps (cut-in)",
+            choices=INDICATOR_NAMES,
+        ),
+        Column(
+            "indicator",
+            "float",
+            "m/s² or m/s",
+            "aggressiveness: POV acceleration (< 0 brakes) or Δv̄ (< 0 closes in); "
+            "smaller = more aggressive",
+        ),
+        Column(
+            "h_after_m",
+            "float",
+            "m",
+            "cut-in: headway after the 1-step scenario in SUMO; NaN in car-following",
+            nullable=True,
+        ),
+        Column(
+            "delta_v_bar_before_mps",
+            "float",
+            "m/s",
+            "cut-in: Δv̄ at the sampled state, before the action acts (no lateral speed); "
+            "NaN in car-following",
+            nullable=True,
+        ),
+    ),
+)
+
+
+# --------------------------------------------------------------------------- table object
+
+
+@dataclass(frozen=True)
+class Table:
+    """A validated, column-oriented table: one 1-D numpy array per schema column.
+
+    Attributes:
+        schema: The schema the columns follow.
+        columns: ``name -> array``, all the same length. Any array-like is accepted and
+            stored as a numpy array of the column's dtype (int64, float64, bool or str).
+    """
+
+    schema: TableSchema
+    columns: Mapping[str, Any]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "columns", _coerce_columns(self.schema, self.columns))
+
+    def __len__(self) -> int:
+        return len(next(iter(self.columns.values()))) if self.columns else 0
+
+    def __getitem__(self, name: str) -> npt.NDArray[Any]:
+        return self.columns[name]
+
+    def rows(self) -> Iterator[dict[str, Any]]:
+        """Rows as dicts of Python scalars, in order."""
+        lists = {name: arr.tolist() for name, arr in self.columns.items()}
+        for i in range(len(self)):
+            yield {name: lists[name][i] for name in self.schema.names}
+
+    def equals(self, other: Table) -> bool:
+        """Same schema and identical values (NaN equal to NaN)."""
+        if self.schema != other.schema or len(self) != len(other):
+            return False
+        for name in self.schema.names:
+            a, b = self.columns[name], other.columns[name]
+            if a.dtype.kind == "f":
+                if not np.array_equal(a, b, equal_nan=True):
+                    return False
+            elif not np.array_equal(a, b):
+                return False
+        return True
+
+
+def table_from_rows(schema: TableSchema, rows: Sequence[Mapping[str, Any]]) -> Table:
+    """Build a :class:`Table` from row dicts holding exactly the schema's columns."""
+    for i, row in enumerate(rows):
+        _check_names(schema, list(row), f"{schema.name} row {i}")
+    return Table(schema, {c.name: [row[c.name] for row in rows] for c in schema.columns})
+
+
+def _check_names(schema: TableSchema, names: Sequence[str], where: str) -> None:
+    missing = [n for n in schema.names if n not in names]
+    extra = [n for n in names if n not in schema.by_name]
+    if missing or extra:
+        parts = []
+        if missing:
+            parts.append(f"missing column(s) {missing}")
+        if extra:
+            parts.append(f"unexpected column(s) {extra}")
+        raise TableError(f"{where}: {'; '.join(parts)} (schema {schema.name}: {schema.names})")
+
+
+def _coerce_columns(schema: TableSchema, columns: Mapping[str, Any]) -> dict[str, npt.NDArray[Any]]:
+    """Arrays of the schema's dtypes, checked for length, NaN, inf and choices."""
+    _check_names(schema, list(columns), f"table {schema.name}")
+    out: dict[str, npt.NDArray[Any]] = {}
+    for col in schema.columns:
+        arr = _coerce_column(col, columns[col.name], schema.name)
+        _check_values(col, arr, f"table {schema.name}")
+        out[col.name] = arr
+    lengths = {name: len(arr) for name, arr in out.items()}
+    if len(set(lengths.values())) > 1:
+        raise TableError(f"table {schema.name}: columns differ in length: {lengths}")
+    return out
+
+
+def _coerce_column(col: Column, values: Any, table: str) -> npt.NDArray[Any]:
+    where = f"table {table}, column {col.name!r}"
+    arr = np.asarray(values)
+    if arr.ndim != 1:
+        raise TableError(f"{where}: expected a 1-D sequence, got shape {arr.shape}")
+    if col.dtype == "str":
+        if arr.size and arr.dtype.kind not in "UO":
+            raise TableError(f"{where}: expected text, got dtype {arr.dtype}")
+        return arr.astype(str)
+    kinds = {"int": "iub", "bool": "biu", "float": "fiu"}[col.dtype]
+    if arr.size and arr.dtype.kind not in kinds:
+        raise TableError(f"{where}: expected {col.dtype} values, got dtype {arr.dtype}")
+    if (
+        col.dtype == "bool"
+        and arr.size
+        and arr.dtype.kind in "iu"
+        and not np.isin(arr, (0, 1)).all()
+    ):
+        raise TableError(f"{where}: expected 0/1 booleans")
+    if col.dtype == "int" and arr.dtype.kind == "b":
+        arr = arr.astype(np.int64)
+    return arr.astype(_NUMPY_DTYPE[col.dtype])
+
+
+def _check_values(col: Column, arr: npt.NDArray[Any], where: str) -> None:
+    """NaN / inf / choices rules of ``col`` on the already typed ``arr``."""
+    if col.dtype == "float":
+        bad_nan = np.flatnonzero(np.isnan(arr)) if not col.nullable else np.array([], int)
+        if bad_nan.size:
+            raise TableError(f"{where}, column {col.name!r}, row {bad_nan[0]}: NaN not allowed")
+        bad_inf = np.flatnonzero(np.isinf(arr)) if not col.allow_inf else np.array([], int)
+        if bad_inf.size:
+            raise TableError(f"{where}, column {col.name!r}, row {bad_inf[0]}: inf not allowed")
+    if col.choices is not None:
+        bad = np.flatnonzero(~np.isin(arr, col.choices))
+        if bad.size:
+            raise TableError(
+                f"{where}, column {col.name!r}, row {bad[0]}: {str(arr[bad[0]])!r} is not one of "
+                f"{list(col.choices)}"
+            )
+
+
+# --------------------------------------------------------------------------- writing
+
+
+def atomic_write_text(path: str | Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file in the same folder + rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _format_column(col: Column, values: npt.NDArray[Any]) -> list[str]:
+    """Cells of one column as text (see the module docstring for the encoding)."""
+    items = values.tolist()
+    if col.dtype == "float":
+        return [repr(float(v)) for v in items]
+    if col.dtype == "bool":
+        return ["1" if v else "0" for v in items]
+    if col.dtype == "int":
+        return [str(int(v)) for v in items]
+    return [str(v) for v in items]
+
+
+def write_table(path: str | Path, table: Table) -> None:
+    """Write ``table`` as CSV (header = schema column order), atomically.
+
+    Args:
+        path: Destination file; its folder is created if needed.
+        table: A :class:`Table` (validated when it was built).
+    """
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    cols = table.schema.columns
+    writer.writerow([c.name for c in cols])
+    writer.writerows(zip(*(_format_column(c, table.columns[c.name]) for c in cols), strict=True))
+    atomic_write_text(path, buf.getvalue())
+
+
+# --------------------------------------------------------------------------- reading
+
+
+def read_table(path: str | Path, schema: TableSchema) -> Table:
+    """Read a CSV written by :func:`write_table` and validate it against ``schema``.
+
+    Args:
+        path: The CSV file.
+        schema: The schema it must follow (column order may differ; the set may not).
+
+    Returns:
+        The validated :class:`Table` (columns in schema order).
+
+    Raises:
+        TableError: If the file is missing or empty, a column is missing or unexpected, a
+            row has the wrong number of cells, a cell does not parse as its column's dtype,
+            or a value breaks the column's NaN / inf / choices rules. The message names the
+            file, the column and the (0-based data) row.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise TableError(f"{path}: table file not found")
+    with path.open(newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        raise TableError(f"{path}: empty file, expected a header with {schema.names}")
+    header, body = rows[0], rows[1:]
+    _check_names(schema, header, str(path))
+    if len(set(header)) != len(header):
+        raise TableError(f"{path}: duplicate column names in header {header}")
+    for i, row in enumerate(body):
+        if len(row) != len(header):
+            raise TableError(f"{path}: row {i} has {len(row)} cells, header has {len(header)}")
+    cells = list(zip(*body, strict=True)) if body else [() for _ in header]
+    columns = {}
+    for j, name in enumerate(header):
+        col = schema.by_name[name]
+        arr = _parse_column(col, cells[j], path)
+        _check_values(col, arr, str(path))
+        columns[name] = arr
+    return Table(schema, {name: columns[name] for name in schema.names})
+
+
+def _parse_column(col: Column, texts: Sequence[str], path: Path) -> npt.NDArray[Any]:
+    """Parse one column's cells, naming the first bad cell on failure."""
+    if col.dtype == "str":
+        return np.array(texts, dtype=str)
+    if col.dtype == "bool":
+        out = np.empty(len(texts), dtype=np.bool_)
+        for i, t in enumerate(texts):
+            if t in _TRUE:
+                out[i] = True
+            elif t in _FALSE:
+                out[i] = False
+            else:
+                raise _cell_error(path, col, i, t)
+        return out
+    if col.dtype == "float" and col.nullable:
+        texts = ["nan" if t.strip() == "" else t for t in texts]
+    try:
+        return np.array(texts, dtype=_NUMPY_DTYPE[col.dtype]).reshape(len(texts))
+    except (TypeError, ValueError, OverflowError):
+        pass
+    parse = int if col.dtype == "int" else float
+    for i, t in enumerate(texts):
+        try:
+            parse(t)
+        except (TypeError, ValueError, OverflowError):
+            raise _cell_error(path, col, i, t) from None
+    raise TableError(f"{path}: column {col.name!r}: values do not parse as {col.dtype}")
+
+
+def _cell_error(path: Path, col: Column, row: int, text: str) -> AyssError:
+    return TableError(f"{path}: column {col.name!r}, row {row}: expected {col.dtype}, got {text!r}")
+
+
+# --------------------------------------------------------------------------- JSON summaries
+
+
+def _jsonable(obj: Any) -> Any:
+    """Plain JSON types: numpy scalars/arrays to Python, tuples to lists, NaN/inf to None."""
+    if isinstance(obj, Mapping):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, np.generic):
+        return _jsonable(obj.item())
+    if isinstance(obj, Path):
+        return str(obj)
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def write_json(path: str | Path, data: Mapping[str, Any]) -> None:
+    """Write a summary as indented, key-sorted JSON, atomically.
+
+    Non-finite floats (NaN, ±inf) are written as ``null`` (strict JSON has no NaN); numpy
+    scalars and arrays become Python numbers and lists; paths become strings.
+    """
+    text = json.dumps(_jsonable(data), indent=2, sort_keys=True, allow_nan=False)
+    atomic_write_text(path, text + "\n")
+
+
+def read_json(path: str | Path) -> dict[str, Any]:
+    """Read a summary written by :func:`write_json`.
+
+    Raises:
+        TableError: If the file is missing, not JSON, or not a JSON object.
+    """
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise TableError(f"{path}: summary file not found") from None
+    except json.JSONDecodeError as exc:
+        raise TableError(f"{path}: not valid JSON ({exc})") from None
+    if not isinstance(data, dict):
+        raise TableError(f"{path}: expected a JSON object, got {type(data).__name__}")
+    return data
