@@ -166,12 +166,12 @@ def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
             raise ConfigError(
                 f"experiments.{case}: {cfg.experiments[case]} is a {exp.env.case!r} experiment"
             )
-        train = exp.train
+        overrides: dict[str, Any] = {"progress_bar": False}
         if cfg.total_timesteps is not None:
-            train = dataclasses.replace(train, total_timesteps=cfg.total_timesteps)
+            overrides["total_timesteps"] = cfg.total_timesteps
         if cfg.eval_every is not None:
-            train = dataclasses.replace(train, eval_every=cfg.eval_every)
-        exp = dataclasses.replace(exp, train=dataclasses.replace(train, progress_bar=False))
+            overrides["eval_every"] = cfg.eval_every
+        exp = dataclasses.replace(exp, train=dataclasses.replace(exp.train, **overrides))
         for vut in cfg.grid.vuts:
             if vut not in exp.env.vuts:
                 raise ConfigError(
@@ -210,6 +210,7 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
     """Train (or resume, or skip) and evaluate one job. Runs in a worker process."""
     from sumo_ayss.evaluate import evaluate_run
     from sumo_ayss.experiment import experiment_from_dict
+    from sumo_ayss.scenarios.ayss import AyssConfig
     from sumo_ayss.train import atomic_write_json, train
 
     run_dir = spec.run_dir
@@ -239,7 +240,13 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
         if done.get("inputs") == key:
             stages["evaluate"] = "skipped"
         else:
-            evaluate_run(run_dir, n_outcome=spec.n_outcome, n_ayss=spec.n_ayss, force=True)
+            evaluate_run(
+                run_dir,
+                n_outcome=spec.n_outcome,
+                ayss=AyssConfig(n_samples=spec.n_ayss),
+                force=True,
+                progress=False,
+            )
             atomic_write_json(marker, {"inputs": key})
             stages["evaluate"] = "done"
     except BaseException:
