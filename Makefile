@@ -1,4 +1,5 @@
-# One Makefile for people and CI: `make demo` (the main job) and `make test`.
+# One Makefile for people and CI: `make demo` (the main job: the whole pipeline at a small
+# budget, ending with the path of its HTML report) and `make test`.
 # Each target creates or refreshes the local virtual environment (.venv) when it is
 # missing or older than pyproject.toml; nothing else is needed on a fresh machine with
 # Python 3.11.
@@ -25,7 +26,7 @@ $(STAMP): pyproject.toml
 venv: $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/python -m sumo_ayss.demo
+	$(BIN)/python -m sumo_ayss.pipeline configs/demo.yaml
 
 test: $(STAMP)
 	$(BIN)/python -m pytest

@@ -293,11 +293,30 @@ def _table(statuses: Sequence[JobStatus]) -> Any:
     return table
 
 
-def run_grid_local(jobs: Sequence[JobSpec], workers: int, retries: int, live: bool) -> list[JobStatus]:
+def _die_with_parent() -> None:
+    """Worker initializer: on Linux, get SIGKILLed when the pipeline process dies.
+
+    Without it a killed pipeline leaves its workers running, and a rerun would race them
+    for the same run folders.
+    """
+    if sys.platform.startswith("linux"):
+        import ctypes
+        import signal
+
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        pr_set_pdeathsig = 1
+        libc.prctl(pr_set_pdeathsig, signal.SIGKILL)
+
+
+def run_grid_local(
+    jobs: Sequence[JobSpec], workers: int, retries: int, live: bool
+) -> list[JobStatus]:
     """Run ``jobs`` on a local process pool with retries and a live table."""
     statuses = [JobStatus(j) for j in jobs]
     ctx = multiprocessing.get_context("spawn")  # fresh interpreters: no inherited libsumo
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+    with ProcessPoolExecutor(
+        max_workers=workers, mp_context=ctx, initializer=_die_with_parent
+    ) as pool:
         pending: dict[Future[dict[str, Any]], JobStatus] = {}
 
         def submit(s: JobStatus) -> None:

@@ -1,0 +1,114 @@
+"""The pipeline: bad grids refused up front, failing jobs retried then reported, kill + rerun."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from sumo_ayss.config import PROJECT_ROOT
+from sumo_ayss.errors import ConfigError
+from sumo_ayss.pipeline import load_pipeline, plan_jobs, run_pipeline
+
+TINY_AGENT = {
+    "feature_net_arch": [32],
+    "value_net_arch": [32],
+    "advantage_net_arch": [32],
+    "learning_starts": 100,
+    "buffer_size": 5000,
+    "learning_rate": 1e-3,
+}
+
+
+def write_configs(tmp_path: Path, seeds: list[int], **extra) -> Path:
+    exp = yaml.safe_load((PROJECT_ROOT / "configs" / "car_following.yaml").read_text())
+    exp["agent"] = TINY_AGENT
+    exp["train"].update(n_eval_scenarios=5)
+    (tmp_path / "cf.yaml").write_text(yaml.safe_dump(exp))
+    pipe = {
+        "grid": {"cases": ["car_following"], "vuts": ["pi1", "pi2"], "seeds": seeds},
+        "experiments": {"car_following": "cf.yaml"},
+        "out": "runs",
+        "total_timesteps": 600,
+        "eval_every": 300,
+        "evaluate": {"n_outcome": 10, "n_ayss": 2000},
+        "workers": 1,
+        **extra,
+    }
+    path = tmp_path / "pipe.yaml"
+    path.write_text(yaml.safe_dump(pipe))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("grid", "match"),
+    [
+        ({"vuts": ["pi1", "pi9"]}, r"grid\.vuts: 'pi9' is not a VUT of the car_following"),
+        ({"seeds": []}, r"grid\.seeds must not be empty"),
+        ({"cases": ["merge"]}, r"grid\.cases\[0\] must be one of"),
+    ],
+)
+def test_bad_grid_is_refused_before_any_job(tmp_path: Path, grid: dict, match: str) -> None:
+    path = write_configs(tmp_path, [0])
+    data = yaml.safe_load(path.read_text())
+    data["grid"].update(grid)
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(ConfigError, match=match):
+        plan_jobs(load_pipeline(path))
+    assert not (tmp_path / "runs").exists()
+
+
+@pytest.mark.sumo
+def test_failing_job_is_retried_then_reported_others_complete(tmp_path: Path) -> None:
+    cfg = load_pipeline(write_configs(tmp_path, [0]))
+    broken = cfg.out / "car_following" / "pi2" / "seed_0"
+    broken.mkdir(parents=True)
+    (broken / "config.yaml").write_text("not: [a, valid, run\n")  # a corrupt run folder
+    statuses, report = run_pipeline(cfg, live=False)
+    by_name = {s.spec.name: s for s in statuses}
+    bad = by_name["car_following/pi2/seed_0"]
+    assert bad.state == "failed" and bad.attempts == 2  # tried, retried once, reported
+    assert bad.error and (broken / "job.log").is_file()
+    good = by_name["car_following/pi1/seed_0"]
+    assert good.state == "done"
+    assert (good.spec.run_dir / "ayss.csv").is_file()
+    assert report is not None and report.is_file()
+
+
+@pytest.mark.sumo
+def test_sigkill_then_rerun_finishes_without_redoing_finished_stages(tmp_path: Path) -> None:
+    path = write_configs(tmp_path, [0, 1])
+    cmd = [sys.executable, "-m", "sumo_ayss.pipeline", str(path), "--no-live"]
+    out = tmp_path / "runs" / "car_following"
+    first = out / "pi1" / "seed_0"
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 240
+        while time.monotonic() < deadline:  # kill once job 1 is done and job 2 has started
+            if (first / "evaluate.done.json").is_file() and (out / "pi1" / "seed_1").exists():
+                break
+            assert proc.poll() is None, "pipeline ended before it could be killed"
+            time.sleep(0.05)
+        os.kill(proc.pid, signal.SIGKILL)
+    finally:
+        proc.wait()
+    finished = {p: p.read_bytes() for p in first.glob("*.csv")}
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    assert "report:" in done.stdout
+    for p, data in finished.items():  # completed stages were not redone
+        assert p.read_bytes() == data, p
+    log = (first / "job.log").read_text()
+    assert log.count("SPCP:") == 1  # trained once, skipped on the rerun
+    for vut in ("pi1", "pi2"):
+        for seed in (0, 1):
+            run = out / vut / f"seed_{seed}"
+            assert (run / "spcp.json").is_file() and (run / "ayss.csv").is_file()
+            assert json.loads((run / "evaluate.done.json").read_text())["inputs"]
