@@ -61,9 +61,7 @@ class GridConfig:
         for name in ("cases", "vuts", "seeds"):
             values = getattr(self, name)
             _require(len(values) > 0, f"grid.{name} must not be empty")
-            _require(
-                len(set(values)) == len(values), f"grid.{name} has duplicates: {list(values)}"
-            )
+            _require(len(set(values)) == len(values), f"grid.{name} has duplicates: {list(values)}")
 
 
 @dataclass(frozen=True)
@@ -361,7 +359,10 @@ def _live(statuses: Sequence[JobStatus]) -> Any:
 
 
 def run_pipeline(
-    cfg: PipelineConfig, *, backend: Backend = "local", address: str | None = None,
+    cfg: PipelineConfig,
+    *,
+    backend: Backend = "local",
+    address: str | None = None,
     live: bool = True,
 ) -> tuple[list[JobStatus], Path | None]:
     """Run the grid, then the report over every finished job; return statuses and report."""

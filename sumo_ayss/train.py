@@ -9,6 +9,13 @@ VUT and seed), in the process's one SUMO simulation: the training env itself is 
 an episode boundary and put back exactly where it was. At the end the SPCP is selected by
 ``train.selection``.
 
+With ``train.n_envs > 1`` the transitions come from that many VUT-POV pairs in one SUMO
+simulation (:class:`~sumo_ayss.envs.vec_env.PairVecEnv`). Their episodes never end together,
+so a candidate is evaluated as soon as ``eval_every`` is reached, on the pairs themselves
+(``n_envs`` scenarios at a time; the same episodes as the single env would run), and the
+pairs' unfinished training episodes are then cut: their last transitions are stored as
+time-limit truncations (bootstrapped, not terminal) and every pair starts a fresh episode.
+
 Run folder ``<out>/<case>/<vut>/seed_<k>/``:
 
     config.yaml        the exact resolved configuration (with vut and seed)
@@ -33,6 +40,7 @@ import dataclasses
 import io
 import json
 import logging
+import math
 import os
 import platform
 import random
@@ -49,17 +57,19 @@ import numpy as np
 import torch as th
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.monitor import Monitor
-from stable_baselines3.common.vec_env import DummyVecEnv
+from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor
 
 from sumo_ayss.agents.dqn import AyssDQN
 from sumo_ayss.agents.greedy import GreedyPolicy
+from sumo_ayss.agents.hparams import DQNHyperParams
 from sumo_ayss.config import to_dict, write_yaml
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
+from sumo_ayss.envs.vec_env import EpisodeTrace, PairVecEnv
 from sumo_ayss.errors import CheckpointError, ConfigError
 from sumo_ayss.experiment import ExperimentConfig, experiment_from_dict, load_experiment
-from sumo_ayss.scenarios.rollout import run_episodes, summarize
+from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, run_episodes, summarize
 from sumo_ayss.selection import select_spcp
 
 logger = logging.getLogger(__name__)
@@ -152,8 +162,17 @@ class Trainer:
         )
         self.rows: list[dict[str, Any]] = []
         self.next_eval = cfg.train.eval_every
-        self.env: PairEnv = make_env(cfg.env, sumo_seed=seed)
-        self.vec_env = DummyVecEnv([lambda: Monitor(self.env)])
+        self.n_envs = cfg.train.n_envs
+        #: The single env (``n_envs == 1``) or the pairs' vec env (``n_envs > 1``).
+        self.env: PairEnv | None = None
+        self.pair_vec: PairVecEnv | None = None
+        self.vec_env: VecEnv
+        if self.n_envs == 1:
+            env = self.env = make_env(cfg.env, sumo_seed=seed)
+            self.vec_env = DummyVecEnv([lambda: Monitor(env)])
+        else:
+            self.pair_vec = PairVecEnv(cfg.env, self.n_envs, sumo_seed=seed)
+            self.vec_env = VecMonitor(self.pair_vec)
         self.model: AyssDQN | None = None
 
     # -- folder ------------------------------------------------------------------------
@@ -164,14 +183,19 @@ class Trainer:
         resolved = {"vut": self.cfg.env.vut, "seed": self.seed, **self.cfg.to_dict()}
         write_yaml(self.run_dir / "config.yaml", resolved)
         atomic_write_text(
-            self.run_dir / "command.txt", shlex.join([sys.executable, "-m", __spec__.name, *argv])
+            self.run_dir / "command.txt",
+            shlex.join([sys.executable, "-m", __spec__.name, *argv])
             if __spec__
-            else shlex.join(argv)
+            else shlex.join(argv),
         )
         atomic_write_json(self.run_dir / "versions.json", versions())
         atomic_write_json(
             self.run_dir / "seeds.json",
-            {"train_seed": self.seed, "sumo_seed": self.seed, "eval_seed": self.cfg.train.eval_seed},
+            {
+                "train_seed": self.seed,
+                "sumo_seed": self.seed,
+                "eval_seed": self.cfg.train.eval_seed,
+            },
         )
 
     # -- model ---------------------------------------------------------------------------
@@ -180,7 +204,7 @@ class Trainer:
         th.set_num_threads(self.cfg.train.torch_threads)
         self.model = AyssDQN(
             self.vec_env,
-            self.cfg.agent,
+            hparams_for_n_envs(self.cfg.agent, self.n_envs),
             seed=self.seed,
             tensorboard_log=str(self.run_dir / "tb"),
             device="cpu",
@@ -204,8 +228,17 @@ class Trainer:
 
     # -- candidates ----------------------------------------------------------------------
 
-    def candidate(self, at_episode_boundary: bool = True) -> None:
-        """Store the model as a candidate, evaluate it, checkpoint, and move the schedule."""
+    def candidate(
+        self, at_episode_boundary: bool = True, rollout: dict[str, Any] | None = None
+    ) -> None:
+        """Store the model as a candidate, evaluate it, checkpoint, and move the schedule.
+
+        Args:
+            at_episode_boundary: (one env) the env has just started an episode, whose start
+                is restored after the evaluation.
+            rollout: (``n_envs > 1``) SB3's rollout locals when called from the callback:
+                the step's transitions, not stored yet, are cut into truncations there.
+        """
         model = self.model
         assert model is not None
         step = model.num_timesteps
@@ -213,17 +246,28 @@ class Trainer:
         step_dir.mkdir(parents=True, exist_ok=True)
         _atomic_model_save(model, step_dir / "model.zip")
 
-        # Borrow the training env: evaluation resets it to fixed initial conditions (this
-        # does not consume its RNG); afterwards the current episode's start is restored
-        # exactly, so the observation SB3 holds stays true.
-        current_ic = self.env.initial_condition
         t0 = time.perf_counter()
-        summary = summarize(run_episodes(self.env, GreedyPolicy(model), self.scenarios))
-        wall = time.perf_counter() - t0
-        if at_episode_boundary and current_ic is not None:
-            self.env.reset(options={"initial_condition": current_ic})
+        if self.pair_vec is not None:
+            results = evaluate_on_vec(self.pair_vec, GreedyPolicy(model), self.scenarios)
+            wall = time.perf_counter() - t0
+            self._restart_pairs(rollout)
+            env_state = self._pairs_state()
+        else:
+            # Borrow the training env: evaluation resets it to fixed initial conditions (this
+            # does not consume its RNG); afterwards the current episode's start is restored
+            # exactly, so the observation SB3 holds stays true.
+            env = self.env
+            assert env is not None
+            current_ic = env.initial_condition
+            results = run_episodes(env, GreedyPolicy(model), self.scenarios)
+            wall = time.perf_counter() - t0
+            if at_episode_boundary and current_ic is not None:
+                env.reset(options={"initial_condition": current_ic})
+            ic_dict = dataclasses.asdict(current_ic) if current_ic is not None else None
+            env_state = {"initial_condition": ic_dict, "env_rng": env.np_random.bit_generator.state}
+        summary = summarize(results)
 
-        row = {"step": step, **summary.as_dict(), "wall_s": round(wall, 3)}
+        row: dict[str, Any] = {"step": step, **summary.as_dict(), "wall_s": round(wall, 3)}
         row["checkpoint"] = str(step_dir.relative_to(self.run_dir) / "model.zip")
         row = {k: row[k] for k in EVAL_COLUMNS}
         self.rows.append(row)
@@ -234,7 +278,7 @@ class Trainer:
         while self.next_eval <= step:
             self.next_eval += self.cfg.train.eval_every
 
-        self._save_resume_state(step_dir, current_ic)
+        self._save_resume_state(step_dir, env_state)
         write_eval_table(self.eval_path, self.rows)
         atomic_write_json(self.ckpt_dir / "latest.json", {"step": step, "dir": step_dir.name})
         self._prune_replays(step_dir)
@@ -249,7 +293,43 @@ class Trainer:
             if path.parent != keep:
                 path.unlink(missing_ok=True)
 
-    def _save_resume_state(self, step_dir: Path, ic: InitialCondition | None) -> None:
+    def _restart_pairs(self, rollout: dict[str, Any] | None) -> None:
+        """After an evaluation on the pairs: a fresh training episode on every pair.
+
+        Each pair's unfinished episode is cut. Called from the callback (``rollout``: SB3's
+        rollout locals), the step's transitions are not stored yet: a pair whose episode was
+        still running gets ``done`` with its observation as ``terminal_observation`` and
+        ``TimeLimit.truncated`` (so the replay buffer bootstraps it, as at a time limit), and
+        the observation SB3 continues from becomes the fresh episode's first.
+        """
+        model = self.model
+        assert model is not None and self.pair_vec is not None
+        obs = self.vec_env.reset()  # VecMonitor too: its running episode sums restart
+        assert isinstance(obs, np.ndarray)
+        if rollout is None:
+            model._last_obs = obs
+            model._last_episode_starts = np.ones((self.n_envs,), dtype=bool)
+            return
+        new_obs, dones, infos = rollout["new_obs"], rollout["dones"], rollout["infos"]
+        for i in range(self.n_envs):
+            if not dones[i]:
+                infos[i]["terminal_observation"] = new_obs[i].copy()
+                infos[i]["TimeLimit.truncated"] = True
+                dones[i] = True
+        new_obs[:] = obs  # in place: SB3 stores and continues from these very arrays
+
+    def _pairs_state(self) -> dict[str, Any]:
+        """Resume state of the pairs: their current episode starts and RNGs."""
+        assert self.pair_vec is not None
+        return {
+            "initial_conditions": [
+                dataclasses.asdict(ic) if ic is not None else None
+                for ic in self.pair_vec.initial_conditions
+            ],
+            "env_rngs": [env.np_random.bit_generator.state for env in self.pair_vec.envs],
+        }
+
+    def _save_resume_state(self, step_dir: Path, env_state: dict[str, Any]) -> None:
         model = self.model
         assert model is not None
         tmp = step_dir / ".replay.pkl.tmp"
@@ -258,9 +338,8 @@ class Trainer:
         state = {
             "num_timesteps": model.num_timesteps,
             "next_eval": self.next_eval,
-            "initial_condition": dataclasses.asdict(ic) if ic is not None else None,
-            "env_rng": self.env.np_random.bit_generator.state,
-            "numpy_rng": _jsonable(np.random.get_state()),
+            **env_state,
+            "numpy_rng": _jsonable(np.random.get_state()),  # noqa: NPY002 (SB3 uses it)
             "python_rng": _jsonable(random.getstate()),
         }
         th.save(th.get_rng_state(), step_dir / ".torch_rng.pt.tmp")
@@ -293,21 +372,39 @@ class Trainer:
         self.model = model
         self.next_eval = int(state["next_eval"])
         self.rows = [r for r in read_eval_table(self.eval_path) if r["step"] <= model.num_timesteps]
-        # Put the env back at the checkpoint's episode start, with its RNG where it was
-        # (through the Monitor wrapper, which must see the reset too).
-        monitor = self.vec_env.envs[0]
-        monitor.reset(seed=self.seed)  # starts SUMO and creates the env RNG
-        self.env.np_random.bit_generator.state = state["env_rng"]
-        ic = state["initial_condition"]
-        obs, _ = monitor.reset(
-            options={"initial_condition": InitialCondition(**ic)} if ic else None
-        )
-        model._last_obs = obs[None, :]  # type: ignore[assignment]
-        model._last_episode_starts = np.ones((1,), dtype=bool)
-        np.random.set_state(_tuple_state(state["numpy_rng"]))
+        if self.pair_vec is not None:
+            self._resume_pairs(state)
+        else:
+            # Put the env back at the checkpoint's episode start, with its RNG where it was
+            # (through the Monitor wrapper, which must see the reset too).
+            assert isinstance(self.vec_env, DummyVecEnv) and self.env is not None
+            monitor = self.vec_env.envs[0]
+            monitor.reset(seed=self.seed)  # starts SUMO and creates the env RNG
+            self.env.np_random.bit_generator.state = state["env_rng"]
+            ic = state["initial_condition"]
+            obs, _ = monitor.reset(
+                options={"initial_condition": InitialCondition(**ic)} if ic else None
+            )
+            model._last_obs = obs[None, :]  # type: ignore[assignment]
+            model._last_episode_starts = np.ones((1,), dtype=bool)
+        np.random.set_state(_tuple_state(state["numpy_rng"]))  # noqa: NPY002 (SB3 uses it)
         random.setstate(_tuple_state(state["python_rng"]))
         th.set_rng_state(th.load(latest / "torch_rng.pt"))
         logger.info("resumed %s at step %d", self.run_dir, model.num_timesteps)
+
+    def _resume_pairs(self, state: dict[str, Any]) -> None:
+        """Restart every pair at its checkpointed episode start, RNGs where they were."""
+        model = self.model
+        assert model is not None and self.pair_vec is not None
+        ics = state["initial_conditions"]
+        self.vec_env.set_options(
+            [{"initial_condition": InitialCondition(**ic)} if ic else {} for ic in ics]
+        )
+        obs = self.vec_env.reset()  # starts SUMO; given starts do not use the pairs' RNGs
+        for env, rng_state in zip(self.pair_vec.envs, state["env_rngs"], strict=True):
+            env.np_random.bit_generator.state = rng_state
+        model._last_obs = obs  # type: ignore[assignment]
+        model._last_episode_starts = np.ones((self.n_envs,), dtype=bool)
 
     # -- selection -----------------------------------------------------------------------
 
@@ -322,20 +419,76 @@ class Trainer:
 
     def close(self) -> None:
         self.vec_env.close()
-        self.env.close()
+        if self.env is not None:
+            self.env.close()
 
 
 class _CandidateCallback(BaseCallback):
-    """Calls :meth:`Trainer.candidate` at the first episode end after each ``eval_every``."""
+    """Calls :meth:`Trainer.candidate` once ``eval_every`` is reached.
+
+    One env: at the first episode end after it (the env is borrowed and restored there).
+    Several pairs: at once (their episodes never end together; they are cut and restarted).
+    """
 
     def __init__(self, trainer: Trainer) -> None:
         super().__init__()
         self.trainer = trainer
 
     def _on_step(self) -> bool:
-        if self.num_timesteps >= self.trainer.next_eval and bool(self.locals["dones"][0]):
-            self.trainer.candidate()
+        trainer = self.trainer
+        if self.num_timesteps < trainer.next_eval:
+            return True
+        if trainer.pair_vec is not None:
+            trainer.candidate(at_episode_boundary=False, rollout=self.locals)
+        elif bool(self.locals["dones"][0]):
+            trainer.candidate()
         return True
+
+
+def hparams_for_n_envs(hparams: DQNHyperParams, n_envs: int) -> DQNHyperParams:
+    """Learner settings that keep ``hparams.update_to_data_ratio`` with ``n_envs`` envs.
+
+    SB3 counts ``train_freq`` in vec-env steps, each adding ``n_envs`` transitions, so the
+    same settings would do ``n_envs`` times fewer gradient steps per transition. This returns
+    the smallest ``(train_freq, gradient_steps)`` with ``gradient_steps / (train_freq ·
+    n_envs) = hparams.gradient_steps / hparams.train_freq`` (e.g. 4 and 1 become 1 and 2 for
+    8 envs); ``n_envs == 1`` returns ``hparams`` unchanged. Everything else SB3 already counts
+    in transitions (``learning_starts``, ``buffer_size``, ``target_update_interval``).
+    """
+    if n_envs == 1:
+        return hparams
+    per_step = n_envs * hparams.gradient_steps
+    g = math.gcd(hparams.train_freq, per_step)
+    return dataclasses.replace(
+        hparams, train_freq=hparams.train_freq // g, gradient_steps=per_step // g
+    )
+
+
+def evaluate_on_vec(
+    vec: PairVecEnv, policy: Policy, scenarios: Sequence[InitialCondition]
+) -> list[EpisodeResult]:
+    """:func:`~sumo_ayss.scenarios.rollout.run_episodes` on the pairs of ``vec``, N at a time.
+
+    Each episode equals the single env's from the same initial condition under the same
+    actions (:meth:`PairVecEnv.run_scenarios`); a greedy network policy called on a batch of
+    N observations may differ from one called on one observation in the last float bits,
+    which can only matter at exact ties of two actions' Q-values. ``vec`` needs a
+    :meth:`~PairVecEnv.reset` afterwards.
+    """
+    return [_episode_result(trace) for trace in vec.run_scenarios(policy, scenarios)]
+
+
+def _episode_result(trace: EpisodeTrace) -> EpisodeResult:
+    """The :class:`EpisodeResult` of a trace, as ``run_episode`` tabulates an episode."""
+    total = 0.0
+    changed = False
+    for reward, info in zip(trace.rewards, trace.infos, strict=True):
+        total += float(reward)
+        changed = changed or bool(info.get("lane_change_started", False))
+    last = trace.infos[-1]
+    return EpisodeResult(
+        total, bool(last["collision"]), float(last["headway_m"]), len(trace.rewards), changed
+    )
 
 
 def _atomic_model_save(model: AyssDQN, path: Path) -> None:
