@@ -38,10 +38,24 @@ class TrainConfig:
     torch_threads: int = 1
     """PyTorch intra-op threads; 1 lets parallel runs share cores without contention."""
     progress_bar: bool = True
+    n_envs: int = 1
+    """VUT-POV pairs collecting transitions side by side. 1: one env (SB3 ``DummyVecEnv``);
+    > 1: that many pairs in the process's one SUMO simulation
+    (:class:`~sumo_ayss.envs.vec_env.PairVecEnv`), each step adding ``n_envs`` transitions.
+    SB3 counts ``agent.train_freq`` in such steps, so the trainer rescales ``train_freq`` and
+    ``gradient_steps`` to keep ``agent.update_to_data_ratio`` gradient steps per transition.
+    Candidates are then evaluated on all pairs at once, right at ``eval_every``; the pairs'
+    running episodes are cut there (stored as time-limit truncations) and restarted."""
 
     def __post_init__(self) -> None:
         s = self.SECTION
-        for name in ("total_timesteps", "eval_every", "n_eval_scenarios", "torch_threads"):
+        for name in (
+            "total_timesteps",
+            "eval_every",
+            "n_eval_scenarios",
+            "torch_threads",
+            "n_envs",
+        ):
             value = getattr(self, name)
             _require(value >= 1, f"{s}.{name} must be >= 1, got {value}")
         _require(

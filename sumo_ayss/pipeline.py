@@ -333,7 +333,7 @@ def run_grid_local(
                     try:
                         result = fut.result()
                         s.state, s.wall_s = "done", result["wall_s"]
-                    except Exception as e:  # noqa: BLE001 - a job's failure is data here
+                    except Exception as e:  # a job's failure is data here
                         s.error = "".join(traceback.format_exception_only(e)).strip()
                         if s.attempts <= retries:
                             logger.warning("job %s failed (%s); retrying", s.spec.name, s.error)

@@ -100,7 +100,7 @@ def run_grid_ray(jobs: Sequence[JobSpec], retries: int, address: str | None) -> 
                 unpack(folder, s.spec.run_dir)
                 s.state, s.wall_s = "done", result["wall_s"]
                 logger.info("ray job %s done", s.spec.name)
-            except Exception as e:  # noqa: BLE001 - a job's failure is data here
+            except Exception as e:  # a job's failure is data here
                 s.error = "".join(traceback.format_exception_only(e)).strip()[-2000:]
                 if s.attempts <= retries:
                     logger.warning("ray job %s failed (%s); retrying", s.spec.name, s.error)

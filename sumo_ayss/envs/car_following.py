@@ -13,7 +13,6 @@ from __future__ import annotations
 from typing import Any, ClassVar
 
 import numpy as np
-import numpy.typing as npt
 from gymnasium import spaces
 
 from sumo_ayss.config import EnvConfig
@@ -63,15 +62,12 @@ class CarFollowingEnv(PairEnv):
         pov_front = VUT_START_POS_M + ic.gap_m + self._pov_length_m
         return PairPlacement(VUT_START_POS_M, ic.vut_speed_mps, 0, pov_front, ic.pov_speed_mps, 0)
 
-    def _observation(self, k: PairKinematics) -> npt.NDArray[np.float32]:
+    def _observation_values(self, k: PairKinematics) -> tuple[float, ...]:
         # Clipped with Python floats: np.clip costs more than the rest of this method.
-        return np.array(
-            (
-                min(k.pov_speed_mps, SPEED_HIGH_MPS),
-                min(k.vut_speed_mps, SPEED_HIGH_MPS),
-                min(max(k.headway_m, HEADWAY_LOW_M), HEADWAY_HIGH_M),
-            ),
-            dtype=np.float32,
+        return (
+            min(k.pov_speed_mps, SPEED_HIGH_MPS),
+            min(k.vut_speed_mps, SPEED_HIGH_MPS),
+            min(max(k.headway_m, HEADWAY_LOW_M), HEADWAY_HIGH_M),
         )
 
     def _apply_action(self, action: int, k: PairKinematics) -> float:

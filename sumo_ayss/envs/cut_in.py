@@ -80,7 +80,6 @@ import math
 from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 from gymnasium import spaces
 
 from sumo_ayss.config import EnvConfig
@@ -190,20 +189,17 @@ class CutInEnv(PairEnv):
         self._lc_started = False
         self._lc_ignored = False
 
-    # ------------------------------------------------------------------ gym API
+    # ------------------------------------------------------------------ episode phases
 
-    def reset(
-        self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[npt.NDArray[np.float32], dict[str, Any]]:
-        """Start an episode; see :meth:`PairEnv.reset`. Adds the lateral state to ``info``."""
-        obs, info = super().reset(seed=seed, options=options)
-        assert self._pair is not None and self.initial_condition is not None
-        assert self._k is not None
+    def _start_episode(self, ic: InitialCondition) -> tuple[tuple[float, ...], dict[str, Any]]:
+        """See :meth:`PairEnv._start_episode`; adds the lateral state to ``info``."""
+        values, info = super()._start_episode(ic)
+        assert self._pair is not None and self._k is not None
         self._pair.allow_vut_overtake_right()  # before the first step: the VUT drives freely
-        self._target_mps = self.initial_condition.pov_speed_mps
+        self._target_mps = ic.pov_speed_mps
         self._lc_started = self._lc_ignored = False
         info.update(self._lane_info(self._k))
-        return obs, info
+        return values, info
 
     # ------------------------------------------------------------------ case hooks
 
@@ -213,16 +209,13 @@ class CutInEnv(PairEnv):
             VUT_START_POS_M, ic.vut_speed_mps, VUT_LANE, pov_front, ic.pov_speed_mps, POV_LANE
         )
 
-    def _observation(self, k: PairKinematics) -> npt.NDArray[np.float32]:
+    def _observation_values(self, k: PairKinematics) -> tuple[float, ...]:
         assert self._lane is not None
-        return np.array(
-            (
-                min(k.pov_speed_mps, SPEED_HIGH_MPS),
-                min(k.vut_speed_mps, SPEED_HIGH_MPS),
-                min(max(k.headway_m, HEADWAY_LOW_M), HEADWAY_HIGH_M),
-                1.0 if self._lane.same_lane else 0.0,
-            ),
-            dtype=np.float32,
+        return (
+            min(k.pov_speed_mps, SPEED_HIGH_MPS),
+            min(k.vut_speed_mps, SPEED_HIGH_MPS),
+            min(max(k.headway_m, HEADWAY_LOW_M), HEADWAY_HIGH_M),
+            1.0 if self._lane.same_lane else 0.0,
         )
 
     def _apply_action(self, action: int, k: PairKinematics) -> float:

@@ -17,6 +17,7 @@ import gymnasium as gym
 import numpy as np
 import numpy.typing as npt
 
+from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_condition
 from sumo_ayss.envs.rewards import total_reward
@@ -40,6 +41,13 @@ def time_to_collision_s(gap_m: float, v_follower_mps: float, v_leader_mps: float
     if gap_m <= 0.0:
         return 0.0
     return gap_m / closing if closing > 0.0 else math.inf
+
+
+def session_vtypes(cfg: EnvConfig) -> dict[str, VehicleType]:
+    """The vehicle types a simulation of ``cfg`` loads: ``vut_<name>`` per catalog VUT, ``pov``."""
+    vtypes = {f"vut_{name}": vt for name, vt in cfg.vuts.items()}
+    vtypes["pov"] = cfg.pov
+    return vtypes
 
 
 class PairKinematics(NamedTuple):
@@ -95,6 +103,9 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         self._reward_cfg = config.reward
         self._decisions = 0
         self._v_pov = 0.0
+        self._target = 0.0  # the POV's target speed of the current decision [m/s]
+        self._accel = 0.0  # the POV's acceleration in the last SUMO step [m/s²]
+        self._shared = False  # a member of a PairVecEnv (see _join_shared)
         self._k: PairKinematics | None = None
         self.initial_condition: InitialCondition | None = None
 
@@ -104,7 +115,12 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
     def _placement(self, ic: InitialCondition) -> PairPlacement: ...
 
     @abstractmethod
-    def _observation(self, k: PairKinematics) -> npt.NDArray[np.float32]: ...
+    def _observation_values(self, k: PairKinematics) -> tuple[float, ...]:
+        """The observation's entries, clipped to the observation space (plain floats)."""
+
+    def _observation(self, k: PairKinematics) -> npt.NDArray[np.float32]:
+        """The observation (float32) of the state ``k``."""
+        return np.array(self._observation_values(k), dtype=np.float32)
 
     @abstractmethod
     def _apply_action(self, action: int, k: PairKinematics) -> float:
@@ -126,6 +142,50 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             options: ``{"initial_condition": InitialCondition}`` to start from a given state
                 instead of sampling the ODD (scenario sets, Monte Carlo, replays).
         """
+        if self._shared:
+            raise self._step_error()
+        ic = self._begin_reset(seed, options)
+        pair = self._ensure_sim()
+        pair.add()
+        pair.session.step()  # inserts the fresh vehicles (they do not move in this step)
+        values, info = self._start_episode(ic)
+        return np.array(values, dtype=np.float32), info
+
+    def step(
+        self, action: SupportsInt
+    ) -> tuple[npt.NDArray[np.float32], SupportsFloat, bool, bool, dict[str, Any]]:
+        pair = self._pair
+        if pair is None or self._k is None or self._shared:
+            raise self._step_error()
+        self._begin_decision(action)
+        session = pair.session
+        collided = False
+        for _ in range(self._substeps):
+            self._command_pov()
+            session.step()
+            if pair.collided(session.colliding_ids()):
+                collided = True
+                break
+        values, reward, terminated, truncated, info = self._end_decision(collided)
+        return np.array(values, dtype=np.float32), reward, terminated, truncated, info
+
+    def close(self) -> None:
+        """Close SUMO; safe to call twice. A vec-env member leaves the shared SUMO running."""
+        if self._session is not None:
+            self._session.close()
+        self._session = None
+        self._pair = None
+        super().close()
+
+    # ------------------------------------------------------------------ episode phases
+    #
+    # ``reset`` and ``step`` are built from the phases below, around their SUMO steps. A
+    # :class:`~sumo_ayss.envs.vec_env.PairVecEnv` runs many envs in one simulation by calling
+    # the same phases of each member around one shared SUMO step, so that observation,
+    # reward, termination and the POV's actuator are this code in both.
+
+    def _begin_reset(self, seed: int | None, options: dict[str, Any] | None) -> InitialCondition:
+        """Seed the RNG (``seed``) and choose the episode's initial condition (no SUMO call)."""
         super().reset(seed=seed)
         ic = (options or {}).get("initial_condition")
         if ic is None:
@@ -134,9 +194,15 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             raise ConfigError(
                 f"reset options['initial_condition'] must be an InitialCondition, got {ic!r}"
             )
-        pair = self._ensure_sim()
-        pair.add()
-        pair.session.step()  # inserts the fresh vehicles (they do not move in this step)
+        return ic
+
+    def _start_episode(self, ic: InitialCondition) -> tuple[tuple[float, ...], dict[str, Any]]:
+        """Place the pair's fresh vehicles at ``ic``: the reset's observation values and info.
+
+        The vehicles must have been added (and, for the single env, inserted by a step).
+        """
+        pair = self._pair
+        assert pair is not None
         pair.place(self._placement(ic))
         self.initial_condition = ic
         self._decisions = 0
@@ -148,30 +214,37 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             "sumo_seed": self.sumo_seed,
             "initial_condition": ic,
         }
-        return self._observation(k), info
+        return self._observation_values(k), info
 
-    def step(
-        self, action: SupportsInt
-    ) -> tuple[npt.NDArray[np.float32], SupportsFloat, bool, bool, dict[str, Any]]:
+    def _begin_decision(self, action: SupportsInt) -> None:
+        """Validate and apply ``action`` (lane commands, the POV's target speed)."""
+        assert self._k is not None
+        self._target = self._apply_action(self._validate_action(action), self._k)
+        self._accel = 0.0
+
+    def _command_pov(self) -> None:
+        """The actuator's next POV speed, commanded for the coming SUMO step."""
         pair = self._pair
-        if pair is None or self._k is None:
-            raise ActionError("step() called before reset()")
-        a = self._validate_action(action)
-        target = self._apply_action(a, self._k)
-        session = pair.session
+        assert pair is not None
         actuator = self._actuator
-        v = self._v_pov
-        collided = False
-        accel = 0.0
-        for _ in range(self._substeps):
-            accel = pov_acceleration(v, target, actuator)
-            v = next_speed(v, accel, self._dt_s, actuator)
-            pair.command_pov_speed(v)
-            session.step()
-            if pair.collided(session.colliding_ids()):
-                collided = True
-                break
-        self._v_pov = v
+        accel = self._accel = pov_acceleration(self._v_pov, self._target, actuator)
+        v = self._v_pov = next_speed(self._v_pov, accel, self._dt_s, actuator)
+        pair.command_pov_speed(v)
+
+    def _end_decision(
+        self, collided: bool
+    ) -> tuple[tuple[float, ...], float, bool, bool, dict[str, Any]]:
+        """Read SUMO back after the decision's steps.
+
+        Args:
+            collided: the pair collided in the last SUMO step (the decision ended there).
+
+        Returns:
+            ``(observation values, reward, terminated, truncated, info)``; the values are
+            plain floats, made an array by the caller (the vec env makes one for all pairs).
+        """
+        pair = self._pair
+        assert pair is not None
         self._decisions += 1
         k = self._k = self._kinematics()
         r_a, extra = self._reward_terms(k, collided)
@@ -183,24 +256,35 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         info = {
             "headway_m": k.headway_m,
             "ttc_s": time_to_collision_s(k.headway_m, k.vut_speed_mps, k.pov_speed_mps),
-            "pov_accel_mps2": accel,
+            "pov_accel_mps2": self._accel,
             "vut_accel_mps2": pair.vut_accel_mps2(),
-            "target_speed_mps": target,
+            "target_speed_mps": self._target,
             "collision": collided,
             "reward_adversarial": r_a,
             "reward_collision": -1.0 if collided else 0.0,
             "sumo_seed": self.sumo_seed,
             **extra,
         }
-        return self._observation(k), reward, terminated, truncated, info
+        return self._observation_values(k), reward, terminated, truncated, info
 
-    def close(self) -> None:
-        """Close SUMO; safe to call twice."""
-        if self._session is not None:
-            self._session.close()
+    def _join_shared(self, pair: VehiclePair, sumo_seed: int) -> None:
+        """Become a member of a vec env: drive ``pair`` in a simulation the env does not own.
+
+        The member's own ``reset``/``step`` then refuse to run (each would step every pair of
+        the shared simulation); the vec env calls the phases above instead.
+        """
+        self._pair = pair
         self._session = None
-        self._pair = None
-        super().close()
+        self._shared = True
+        self.sumo_seed = sumo_seed
+
+    def _step_error(self) -> ActionError:
+        if self._shared:
+            return ActionError(
+                f"{type(self).__name__} is a member of a PairVecEnv: step and reset it "
+                "through the vec env (its own step would move every pair of the shared SUMO)"
+            )
+        return ActionError("step() called before reset()")
 
     # ------------------------------------------------------------------ internals
 
@@ -232,8 +316,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         cfg = self.config
         if self.sumo_seed is None:
             self.sumo_seed = int(self.np_random.integers(0, 2**31 - 1))
-        vtypes = {f"vut_{name}": vt for name, vt in cfg.vuts.items()}
-        vtypes["pov"] = cfg.pov
+        vtypes = session_vtypes(cfg)
         network = cfg.network if cfg.network is not None else network_path(cfg.case)  # type: ignore[arg-type]
         session = SumoSession(
             network, vtypes, cfg.sim, self.sumo_seed, owner=f"{type(self).__name__}({cfg.vut})"

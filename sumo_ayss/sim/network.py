@@ -24,6 +24,9 @@ NETWORK_OF_CASE: dict[Case, str] = {
     "cut_in": "straight_2lane",
 }
 
+#: Lanes of each case's built-in road (and of every road of its parallel network).
+LANES_OF_CASE: dict[Case, int] = {"car_following": 1, "cut_in": 2}
+
 #: The only edge of every built-in network; lane ``road_0`` is the rightmost.
 ROAD_EDGE = "road"
 ROAD_LENGTH_M = 1000.0
@@ -72,6 +75,59 @@ def build_network(stem: str, directory: Path = NETWORK_DIR, out_dir: Path | None
     if result.returncode != 0:
         raise SimulationError(f"netconvert failed for {stem}: {result.stderr.strip()}")
     return out
+
+
+#: Lateral distance between neighbouring roads of a parallel network [m]. SUMO's vehicles
+#: perceive and collide only along lanes of their own edge; the spacing keeps the drawn
+#: bodies apart too (a 2-lane road is 6.4 m wide), e.g. in sumo-gui.
+PARALLEL_ROAD_SPACING_M = 50.0
+
+
+def parallel_road_edge(index: int) -> str:
+    """Edge id of road ``index`` of a parallel network (lanes ``road<index>_<lane>``)."""
+    return f"road{index}"
+
+
+def parallel_road_y_m(index: int) -> float:
+    """World y [m] of road ``index``'s reference line (road 0 lies where the built-in road does)."""
+    return 0.0 - PARALLEL_ROAD_SPACING_M * index  # 0.0 - ...: no -0.0 for road 0
+
+
+def build_parallel_network(n_roads: int, lanes: int, out_dir: Path) -> Path:
+    """Build ``n_roads`` parallel copies of the built-in straight road into ``out_dir``.
+
+    Road ``i`` is edge :func:`parallel_road_edge` ``(i)`` from node ``s<i>`` at ``(0, y_i)`` to
+    ``e<i>`` at ``(ROAD_LENGTH_M, y_i)``, with ``y_i =`` :func:`parallel_road_y_m` ``(i)``: every
+    road has the built-in road's length (1000 m), lane count, lane width (3.2 m) and speed
+    limit (30 m/s), and road 0 has exactly its geometry. The roads share no node, so a vehicle
+    on one can never reach, perceive or touch a vehicle on another. Writes ``parallel_<n>x<lanes>
+    .nod.xml``/``.edg.xml`` and builds the ``.net.xml`` with the pip-installed netconvert.
+
+    Args:
+        n_roads: number of roads, >= 1.
+        lanes: lanes per road (1 for car-following, 2 for cut-in), >= 1.
+        out_dir: existing folder for the plain-XML sources and the network.
+
+    Returns:
+        Path of the built ``.net.xml``.
+    """
+    if n_roads < 1 or lanes < 1:
+        raise SimulationError(f"a parallel network needs >= 1 road and lane, got {n_roads}x{lanes}")
+    stem = f"parallel_{n_roads}x{lanes}"
+    nodes = [
+        f'    <node id="s{i}" x="0.0" y="{parallel_road_y_m(i)!r}" type="priority"/>\n'
+        f'    <node id="e{i}" x="{ROAD_LENGTH_M!r}" y="{parallel_road_y_m(i)!r}" type="priority"/>'
+        for i in range(n_roads)
+    ]
+    edges = [
+        f'    <edge id="{parallel_road_edge(i)}" from="s{i}" to="e{i}" numLanes="{lanes}" '
+        f'speed="{SPEED_LIMIT_MPS!r}" width="{LANE_WIDTH_M!r}" priority="1"/>'
+        for i in range(n_roads)
+    ]
+    head = '<?xml version="1.0" encoding="UTF-8"?>\n'
+    (out_dir / f"{stem}.nod.xml").write_text(head + "<nodes>\n" + "\n".join(nodes) + "\n</nodes>\n")
+    (out_dir / f"{stem}.edg.xml").write_text(head + "<edges>\n" + "\n".join(edges) + "\n</edges>\n")
+    return build_network(stem, directory=out_dir)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -14,8 +14,10 @@ are always downstream of the insertion spot, so they cannot block the insertion.
 from __future__ import annotations
 
 import contextlib
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import libsumo
 from libsumo import _libsumo
@@ -217,7 +219,103 @@ class VehiclePair:
         except SUMO_ERRORS as e:
             raise SimulationError(f"setting lcOvertakeRight of {self.vut} failed: {e}") from e
 
+    # ------------------------------------------------------------------ VUT driven by a controller
+
+    def take_vut_control(self) -> None:
+        """Switch SUMO's checks off for the VUT (speed mode 0), as for the POV.
+
+        From now on the VUT drives exactly the speed given to :meth:`command_vut_speed`
+        before each step: no safe-speed, acceleration, deceleration or speed-limit check.
+        Its limits are the controller's (:mod:`sumo_ayss.controllers`). Call after
+        :meth:`place`, before the episode's first step.
+        """
+        try:
+            libsumo.vehicle.setSpeedMode(self.vut, SPEED_MODE_UNCHECKED)
+        except SUMO_ERRORS as e:
+            raise SimulationError(f"taking control of {self.vut} failed: {e}") from e
+
+    def command_vut_speed(self, speed_mps: float) -> None:
+        """The VUT drives at exactly ``speed_mps`` during the next step (after
+        :meth:`take_vut_control`). SUMO's default (Euler) update then moves it by
+        ``speed_mps · step_length`` in that step."""
+        _set_speed(self.vut, speed_mps)
+
+    def vut_sensing(self, range_m: float) -> VutSensing:
+        """What the VUT's own sensors see now: its speed and lane, and its leader.
+
+        The leader is the POV when (a) its body reaches into the VUT's lane — its lateral
+        extent, centre ± width / 2, overlaps the lane between the lane's edges; during a
+        cut-in that is before SUMO's lane index of the POV flips — and (b) its front is
+        ahead of the VUT's front, and (c) the gap is at most ``range_m``. The gap is
+        bumper to bumper from lane positions and the POV's length (POV rear minus VUT
+        front, as the env's headway h); it is <= 0 while a cut-in's rear is still beside
+        the VUT. Computed from positions because ``vehicle.getLeader`` does not report a
+        vehicle that only reaches into the lane (checked on SUMO 1.28: it returned no
+        leader until the POV's lane index flipped) and its gap subtracts the follower's
+        minGap. Lane positions of neighbouring lanes are compared directly, which holds on
+        the straight built-in roads.
+
+        Args:
+            range_m: Sensor range [m]: a leader farther than this is not seen.
+
+        Returns:
+            The reading; without a leader ``gap_m`` is ``inf`` and ``leader_speed_mps``
+            NaN.
+        """
+        vut, pov = self.vut, self.pov
+        try:
+            vut_pos, vut_speed = _get_lane_pos(vut), _get_speed(vut)
+            vut_lane = _get_lane_index(vut)
+            time_s = float(libsumo.simulation.getTime())
+            pov_pos, pov_speed = _get_lane_pos(pov), _get_speed(pov)
+            pov_lane = _get_lane_index(pov)
+            centres, widths = self._lane_geometry()
+            d = (centres[pov_lane] + _get_lateral_lane_pos(pov)) - (
+                centres[vut_lane] + _get_lateral_lane_pos(vut)
+            )
+            reach = 0.5 * (widths[vut_lane] + libsumo.vehicle.getWidth(pov))
+            gap = pov_pos - libsumo.vehicle.getLength(pov) - vut_pos
+        except SUMO_ERRORS as e:
+            raise SimulationError(
+                f"pair {self.prefix}: reading the VUT's sensors failed: {e}"
+            ) from e
+        if abs(d) < reach and pov_pos > vut_pos and gap <= range_m:
+            return VutSensing(time_s, vut_speed, vut_lane, gap, pov_speed)
+        return VutSensing(time_s, vut_speed, vut_lane, math.inf, math.nan)
+
+    def _lane_geometry(self) -> tuple[list[float], list[float]]:
+        """Lateral centre of each lane of the edge from lane 0's centre [m] (+ left), widths."""
+        cached: tuple[list[float], list[float]] | None = getattr(self, "_lane_geom", None)
+        if cached is None:
+            n = libsumo.edge.getLaneNumber(self.edge)
+            widths = [libsumo.lane.getWidth(f"{self.edge}_{i}") for i in range(n)]
+            centres = [0.0]
+            for i in range(1, n):
+                centres.append(centres[-1] + 0.5 * (widths[i - 1] + widths[i]))
+            cached = (centres, widths)
+            self._lane_geom = cached
+        return cached
+
 
 # Getters of the lateral (cut-in) methods, bound like the hot-path ones above.
 _get_lateral_speed = _libsumo.vehicle_getLateralSpeed
 _get_lateral_lane_pos = _libsumo.vehicle_getLateralLanePosition
+
+
+class VutSensing(NamedTuple):
+    """A reading of the VUT's own sensors (:meth:`VehiclePair.vut_sensing`).
+
+    Attributes:
+        time_s: Simulation time of the reading [s] (SUMO's time after the last step).
+        speed_mps: The VUT's speed [m/s].
+        lane_index: The VUT's lane (0 = rightmost).
+        gap_m: Bumper-to-bumper gap to the leader [m], leader rear minus VUT front;
+            ``inf`` without a leader.
+        leader_speed_mps: The leader's speed [m/s]; NaN without a leader.
+    """
+
+    time_s: float
+    speed_mps: float
+    lane_index: int
+    gap_m: float
+    leader_speed_mps: float
