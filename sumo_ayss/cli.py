@@ -17,6 +17,7 @@ COMMANDS = {
     "evaluate": ("sumo_ayss.evaluate", "outcome table and Monte Carlo AYSS of a run's SPCP"),
     "report": ("sumo_ayss.report.__main__", "HTML + Markdown report from run folders"),
     "pipeline": ("sumo_ayss.pipeline", "the grid cases x VUTs x seeds, resumable"),
+    "rank": ("sumo_ayss.rank", "leaderboard of K VUTs by safety index"),
     "networks": ("sumo_ayss.sim.network", "rebuild the built-in networks and vType file"),
 }
 

@@ -38,7 +38,7 @@ def _require(cond: bool, message: str) -> None:
         raise ConfigError(message)
 
 
-def _check_range(where: str, value: tuple[float, float], low: float = -math.inf) -> None:
+def _check_range(where: str, value: tuple[float, ...], low: float = -math.inf) -> None:
     _require(
         len(value) == 2 and all(math.isfinite(v) for v in value),
         f"{where} must be [min, max] with finite numbers, got {list(value)}",

@@ -83,7 +83,8 @@ class ExperimentConfig:
         return dataclasses.replace(self, env=dataclasses.replace(self.env, vut=vut))
 
     def to_dict(self) -> dict[str, Any]:
-        return to_dict(self)  # type: ignore[no-any-return]
+        data: dict[str, Any] = to_dict(self)
+        return data
 
 
 def load_experiment(path: str | Path | None) -> ExperimentConfig:
