@@ -23,7 +23,7 @@ from typing import Any, ClassVar, Literal
 
 import yaml
 
-from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE, VehicleType
+from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE, ControllerSpec, VehicleType
 from sumo_ayss.errors import ConfigError
 
 Case = Literal["car_following", "cut_in"]
@@ -275,6 +275,10 @@ def _unknown_key(where: str, key: str, allowed: list[str]) -> ConfigError:
 def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> Any:
     origin = typing.get_origin(tp)
     args = typing.get_args(tp)
+    if tp is ControllerSpec:  # free-form params: parsed and validated by the catalog
+        if isinstance(value, ControllerSpec):
+            return value
+        return ControllerSpec.from_mapping(value, where)
     if dataclasses.is_dataclass(tp) and isinstance(tp, type):
         if isinstance(value, tp):
             return value
@@ -336,17 +340,21 @@ def _vehicle_type(value: Any, where: str) -> VehicleType:
         return value
     if not isinstance(value, Mapping):
         raise ConfigError(f"{where} must be a mapping with model and params, got {value!r}")
-    allowed = ["model", "params", "description"]
+    allowed = ["model", "params", "description", "controller"]
     for key in value:
         if key not in allowed:
             raise _unknown_key(where, str(key), allowed)
     params = value.get("params", {}) or {}
     if not isinstance(params, Mapping):
         raise ConfigError(f"{where}.params must be a mapping, got {params!r}")
+    controller = value.get("controller")
     vt = VehicleType(
         model=str(value.get("model", "IDM")),
         params=dict(params),
         description=str(value.get("description", "")),
+        controller=None
+        if controller is None
+        else _convert(ControllerSpec, controller, f"{where}.controller", Path.cwd(), None),
     )
     vt.validate(where)
     return vt
@@ -386,8 +394,6 @@ def to_dict(obj: Any) -> Any:
     """Plain YAML-safe form of a config (the exact resolved config a run used)."""
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         return {f.name: to_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
-    if isinstance(obj, VehicleType):
-        return {"model": obj.model, "params": dict(obj.params), "description": obj.description}
     if isinstance(obj, Mapping):
         return {str(k): to_dict(v) for k, v in obj.items()}
     if isinstance(obj, tuple | list):
