@@ -19,6 +19,7 @@ import numpy.typing as npt
 
 from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config import EnvConfig
+from sumo_ayss.controllers import ControlledVut
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_condition
 from sumo_ayss.envs.rewards import total_reward
 from sumo_ayss.errors import ActionError, ConfigError
@@ -101,6 +102,9 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         self._max_decisions = config.max_decisions
         self._actuator = config.actuator
         self._reward_cfg = config.reward
+        # A user controller VUT (None for SUMO's own models): it computes the VUT's speed
+        # before every SUMO step, from what a real vehicle would sense.
+        self._vut_control = ControlledVut.from_vehicle_type(config.vut_type, self._dt_s)
         self._decisions = 0
         self._v_pov = 0.0
         self._target = 0.0  # the POV's target speed of the current decision [m/s]
@@ -204,6 +208,8 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         pair = self._pair
         assert pair is not None
         pair.place(self._placement(ic))
+        if self._vut_control is not None:
+            self._vut_control.start(pair)  # speed mode 0 for the VUT, controller.reset()
         self.initial_condition = ic
         self._decisions = 0
         self._v_pov = ic.pov_speed_mps
@@ -230,6 +236,8 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         accel = self._accel = pov_acceleration(self._v_pov, self._target, actuator)
         v = self._v_pov = next_speed(self._v_pov, accel, self._dt_s, actuator)
         pair.command_pov_speed(v)
+        if self._vut_control is not None:
+            self._vut_control.before_step(pair)  # the controller's speed for the coming step
 
     def _end_decision(
         self, collided: bool

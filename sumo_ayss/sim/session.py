@@ -67,6 +67,7 @@ class SumoSession:
         self.seed = int(seed)
         self.owner = owner
         self._tmp: tempfile.TemporaryDirectory[str] | None = None
+        self._routes: set[str] = set()  # routes known to be in the running simulation
 
     @property
     def running(self) -> bool:
@@ -129,6 +130,7 @@ class SumoSession:
                 logger.warning("libsumo.close() failed: %s", e)
             finally:
                 SumoSession._live = None
+        self._routes.clear()
         self._cleanup()
 
     def _cleanup(self) -> None:
@@ -154,8 +156,14 @@ class SumoSession:
         return tuple(_colliding_ids())
 
     def add_route(self, route_id: str, edges: Sequence[str]) -> None:
+        """Add route ``route_id`` over ``edges`` unless this simulation has it already."""
+        # Known routes are remembered: libsumo's getIDList costs O(routes) per call, and a
+        # pair asks at every episode start (N pairs in one simulation: O(N) each).
+        if route_id in self._routes:
+            return
         if route_id not in libsumo.route.getIDList():
             libsumo.route.add(route_id, list(edges))
+        self._routes.add(route_id)
 
     def call(self, fn: Any, *args: Any) -> Any:
         """Call a libsumo function, turning its errors into :class:`SimulationError`."""
