@@ -424,6 +424,6 @@ def env_config_from_mapping(data: Mapping[str, Any], base_dir: Path | None = Non
 
 def write_yaml(path: Path, data: Any) -> None:
     """Write YAML atomically (temp file + rename), so a kill never leaves half a file."""
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(yaml.safe_dump(data, sort_keys=False))
-    tmp.replace(path)
+    from sumo_ayss.atomic import atomic_write_text
+
+    atomic_write_text(path, yaml.safe_dump(data, sort_keys=False))

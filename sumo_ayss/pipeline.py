@@ -206,10 +206,11 @@ def _fingerprint(*parts: Any) -> str:
 
 def run_job(spec: JobSpec) -> dict[str, Any]:
     """Train (or resume, or skip) and evaluate one job. Runs in a worker process."""
+    from sumo_ayss.atomic import atomic_write_json
     from sumo_ayss.evaluate import evaluate_run
     from sumo_ayss.experiment import experiment_from_dict
     from sumo_ayss.scenarios.ayss import AyssConfig
-    from sumo_ayss.train import atomic_write_json, train
+    from sumo_ayss.train import train
 
     run_dir = spec.run_dir
     run_dir.mkdir(parents=True, exist_ok=True)
@@ -368,7 +369,7 @@ def run_pipeline(
     """Run the grid, then the report over every finished job; return statuses and report."""
     jobs = plan_jobs(cfg)
     cfg.out.mkdir(parents=True, exist_ok=True)
-    from sumo_ayss.train import atomic_write_json
+    from sumo_ayss.atomic import atomic_write_json
 
     atomic_write_json(cfg.out / "pipeline.json", to_dict(cfg))
     if backend == "ray":

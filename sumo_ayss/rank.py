@@ -73,7 +73,7 @@ def ranking_rows(run_dirs: Sequence[Path]) -> list[dict[str, Any]]:
 
 def write_ranking(rows: Sequence[dict[str, Any]], out: Path) -> tuple[Path, Path]:
     """``ranking.csv`` and ``ranking.md`` in ``out`` (written atomically)."""
-    from sumo_ayss.train import atomic_write_text
+    from sumo_ayss.atomic import atomic_write_text
 
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=RANKING_COLUMNS, lineterminator="\n")

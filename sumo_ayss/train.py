@@ -62,6 +62,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor
 from sumo_ayss.agents.dqn import AyssDQN
 from sumo_ayss.agents.greedy import GreedyPolicy
 from sumo_ayss.agents.hparams import DQNHyperParams
+from sumo_ayss.atomic import atomic_write_json, atomic_write_text
 from sumo_ayss.config import to_dict, write_yaml
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
@@ -88,16 +89,6 @@ EVAL_COLUMNS = [
 
 
 # ---------------------------------------------------------------------- atomic file helpers
-
-
-def atomic_write_text(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
-
-
-def atomic_write_json(path: Path, data: Any) -> None:
-    atomic_write_text(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
 
 
 def write_eval_table(path: Path, rows: Sequence[dict[str, Any]]) -> None:

@@ -16,15 +16,7 @@ import yaml
 from sumo_ayss.config import PROJECT_ROOT
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.pipeline import load_pipeline, plan_jobs, run_pipeline
-
-TINY_AGENT = {
-    "feature_net_arch": [32],
-    "value_net_arch": [32],
-    "advantage_net_arch": [32],
-    "learning_starts": 100,
-    "buffer_size": 5000,
-    "learning_rate": 1e-3,
-}
+from tests.helpers import TINY_AGENT
 
 
 def write_configs(tmp_path: Path, seeds: list[int], **extra) -> Path:

@@ -33,25 +33,11 @@ from sumo_ayss.scenarios.ayss import AyssConfig
 from sumo_ayss.scenarios.tables import AYSS_SCHEMA, OUTCOME_SCHEMA, read_table
 from sumo_ayss.sim.export import read_fcd
 from sumo_ayss.train import train
+from tests.helpers import tiny_experiment
 
 pytestmark = pytest.mark.sumo
 
-TINY = {
-    "agent": {
-        "feature_net_arch": [32],
-        "value_net_arch": [32],
-        "advantage_net_arch": [32],
-        "learning_starts": 100,
-        "buffer_size": 5000,
-        "learning_rate": 1e-3,
-    },
-    "train": {
-        "n_eval_scenarios": 10,
-        "progress_bar": False,
-        "total_timesteps": 600,
-        "eval_every": 200,
-    },
-}
+TINY = tiny_experiment()
 #: Observation tolerance (the env's observations are float32) [m/s, m].
 OBS_TOL = 1e-3
 

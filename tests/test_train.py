@@ -18,21 +18,12 @@ from sumo_ayss.errors import CheckpointError
 from sumo_ayss.experiment import load_experiment
 from sumo_ayss.selection import select_spcp
 from sumo_ayss.train import read_eval_table, train
+from tests.helpers import TINY_AGENT
 
 pytestmark = pytest.mark.sumo
 
 #: A tiny learner so that tests spend their time in the machinery, not in gradient steps.
-TINY = {
-    "agent": {
-        "feature_net_arch": [32],
-        "value_net_arch": [32],
-        "advantage_net_arch": [32],
-        "learning_starts": 100,
-        "buffer_size": 5000,
-        "learning_rate": 1e-3,
-    },
-    "train": {"n_eval_scenarios": 10, "progress_bar": False},
-}
+TINY = {"agent": TINY_AGENT, "train": {"n_eval_scenarios": 10, "progress_bar": False}}
 
 
 def tiny_config(tmp_path: Path, total: int, every: int) -> Path:

@@ -35,7 +35,6 @@ import csv
 import io
 import json
 import math
-import os
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -45,6 +44,7 @@ import numpy as np
 import numpy.typing as npt
 
 import sumo_ayss.errors as _errors
+from sumo_ayss.atomic import atomic_write_text
 from sumo_ayss.errors import AyssError, CheckpointError
 
 __all__ = [
@@ -368,18 +368,6 @@ def _check_values(col: Column, arr: npt.NDArray[Any], where: str) -> None:
 
 
 # --------------------------------------------------------------------------- writing
-
-
-def atomic_write_text(path: str | Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same folder + rename."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
 
 
 def _format_column(col: Column, values: npt.NDArray[Any]) -> list[str]:

@@ -40,6 +40,7 @@ from sumo_ayss.sim.network import (
     parallel_road_edge,
 )
 from sumo_ayss.train import Trainer, evaluate_on_vec, hparams_for_n_envs, read_eval_table, train
+from tests.helpers import TINY_AGENT
 
 pytestmark = pytest.mark.sumo
 
@@ -347,14 +348,7 @@ def test_hparams_keep_gradient_steps_per_transition() -> None:
     )
 
 
-TINY = {
-    "feature_net_arch": [32],
-    "value_net_arch": [32],
-    "advantage_net_arch": [32],
-    "learning_starts": 100,
-    "buffer_size": 5000,
-    "learning_rate": 1e-3,
-}
+TINY = TINY_AGENT
 
 
 def test_dqn_learns_on_four_pairs(make_vec) -> None:

@@ -33,6 +33,7 @@ from sumo_ayss.scenarios.tables import (
     table_from_rows,
 )
 from sumo_ayss.train import train
+from tests.helpers import tiny_experiment
 
 #: Car-following actions: k = 0 asks for a stop (target 0), k = 2 holds the POV's speed.
 BRAKE, HOLD = 0, 2
@@ -151,22 +152,7 @@ def test_braking_crashes_more_than_holding_on_the_same_scenarios(cf_env_7: CarFo
 # --------------------------------------------------------------------------- evaluate CLI
 
 #: tests/test_train.py's tiny learner: small nets, 600 steps, a candidate every 200.
-TINY = {
-    "agent": {
-        "feature_net_arch": [32],
-        "value_net_arch": [32],
-        "advantage_net_arch": [32],
-        "learning_starts": 100,
-        "buffer_size": 5000,
-        "learning_rate": 1e-3,
-    },
-    "train": {
-        "n_eval_scenarios": 10,
-        "progress_bar": False,
-        "total_timesteps": 600,
-        "eval_every": 200,
-    },
-}
+TINY = tiny_experiment()
 
 
 @pytest.mark.sumo
