@@ -50,9 +50,7 @@ def select_spcp(rows: Sequence[Row], criterion: str = "mean_reward") -> Selectio
         ConfigError: unknown criterion or empty table.
     """
     if criterion not in CRITERIA:
-        raise ConfigError(
-            f"train.selection must be one of {sorted(CRITERIA)}, got {criterion!r}"
-        )
+        raise ConfigError(f"train.selection must be one of {sorted(CRITERIA)}, got {criterion!r}")
     if not rows:
         raise ConfigError("cannot select an SPCP from an empty evaluation table")
     score = CRITERIA[criterion]
