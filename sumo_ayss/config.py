@@ -284,7 +284,7 @@ def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> A
             return value
         return build(tp, value, where, base_dir, default)
     if tp is VehicleType:
-        return _vehicle_type(value, where)
+        return VehicleType.from_mapping(value, where)
     if origin in (types.UnionType, typing.Union):
         if value is None and type(None) in args:
             return None
@@ -333,31 +333,6 @@ def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> A
             merged[str(k)] = _convert(args[1], v, f"{where}.{k}", base_dir, merged.get(str(k)))
         return merged
     raise ConfigError(f"{where}: unsupported type {tp!r}")  # pragma: no cover
-
-
-def _vehicle_type(value: Any, where: str) -> VehicleType:
-    if isinstance(value, VehicleType):
-        return value
-    if not isinstance(value, Mapping):
-        raise ConfigError(f"{where} must be a mapping with model and params, got {value!r}")
-    allowed = ["model", "params", "description", "controller"]
-    for key in value:
-        if key not in allowed:
-            raise _unknown_key(where, str(key), allowed)
-    params = value.get("params", {}) or {}
-    if not isinstance(params, Mapping):
-        raise ConfigError(f"{where}.params must be a mapping, got {params!r}")
-    controller = value.get("controller")
-    vt = VehicleType(
-        model=str(value.get("model", "IDM")),
-        params=dict(params),
-        description=str(value.get("description", "")),
-        controller=None
-        if controller is None
-        else _convert(ControllerSpec, controller, f"{where}.controller", Path.cwd(), None),
-    )
-    vt.validate(where)
-    return vt
 
 
 def build(cls: type, data: Any, where: str, base_dir: Path, default: Any = None) -> Any:

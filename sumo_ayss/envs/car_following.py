@@ -12,10 +12,6 @@ from __future__ import annotations
 
 from typing import Any, ClassVar
 
-import numpy as np
-from gymnasium import spaces
-
-from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import (
     HEADWAY_HIGH_M,
@@ -42,21 +38,9 @@ class CarFollowingEnv(PairEnv):
     """One-lane car-following: POV ahead of the VUT in the same lane."""
 
     CASE: ClassVar[str] = "car_following"
-
-    def __init__(
-        self,
-        config: EnvConfig | None = None,
-        *,
-        vut: str | None = None,
-        sumo_seed: int | None = None,
-    ) -> None:
-        super().__init__(config, vut=vut, sumo_seed=sumo_seed)
-        self.observation_space = spaces.Box(
-            low=np.array([0.0, 0.0, HEADWAY_LOW_M], dtype=np.float32),
-            high=np.array([SPEED_HIGH_MPS, SPEED_HIGH_MPS, HEADWAY_HIGH_M], dtype=np.float32),
-            dtype=np.float32,
-        )
-        self.action_space = spaces.Discrete(N_ACTIONS)
+    OBS_LOW: ClassVar[tuple[float, ...]] = (0.0, 0.0, HEADWAY_LOW_M)
+    OBS_HIGH: ClassVar[tuple[float, ...]] = (SPEED_HIGH_MPS, SPEED_HIGH_MPS, HEADWAY_HIGH_M)
+    N_ACTIONS: ClassVar[int] = N_ACTIONS
 
     def _placement(self, ic: InitialCondition) -> PairPlacement:
         pov_front = VUT_START_POS_M + ic.gap_m + self._pov_length_m

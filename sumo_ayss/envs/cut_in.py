@@ -79,9 +79,6 @@ from __future__ import annotations
 import math
 from typing import Any, ClassVar, NamedTuple
 
-import numpy as np
-from gymnasium import spaces
-
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import (
@@ -163,6 +160,9 @@ class CutInEnv(PairEnv):
     """
 
     CASE: ClassVar[str] = "cut_in"
+    OBS_LOW: ClassVar[tuple[float, ...]] = (0.0, 0.0, HEADWAY_LOW_M, 0.0)
+    OBS_HIGH: ClassVar[tuple[float, ...]] = (SPEED_HIGH_MPS, SPEED_HIGH_MPS, HEADWAY_HIGH_M, 1.0)
+    N_ACTIONS: ClassVar[int] = N_ACTIONS
 
     def __init__(
         self,
@@ -172,12 +172,6 @@ class CutInEnv(PairEnv):
         sumo_seed: int | None = None,
     ) -> None:
         super().__init__(config, vut=vut, sumo_seed=sumo_seed)
-        self.observation_space = spaces.Box(
-            low=np.array([0.0, 0.0, HEADWAY_LOW_M, 0.0], dtype=np.float32),
-            high=np.array([SPEED_HIGH_MPS, SPEED_HIGH_MPS, HEADWAY_HIGH_M, 1.0], dtype=np.float32),
-            dtype=np.float32,
-        )
-        self.action_space = spaces.Discrete(N_ACTIONS)
         self._lane_request_s = self.config.episode_s
         self._lane_change_cfg = self.config.reward.lane_change
         self._same_lane_cfg = self.config.reward.same_lane

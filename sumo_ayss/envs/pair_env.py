@@ -16,6 +16,7 @@ from typing import Any, ClassVar, NamedTuple, SupportsFloat, SupportsInt
 import gymnasium as gym
 import numpy as np
 import numpy.typing as npt
+from gymnasium import spaces
 
 from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config import EnvConfig
@@ -76,6 +77,10 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
     CASE: ClassVar[str]
+    #: Observation bounds (finite; values are clipped into them) and number of actions.
+    OBS_LOW: ClassVar[tuple[float, ...]]
+    OBS_HIGH: ClassVar[tuple[float, ...]]
+    N_ACTIONS: ClassVar[int]
 
     def __init__(
         self,
@@ -92,6 +97,12 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             config = dataclasses.replace(config, vut=vut)
         self._check_road(config)
         self.config = config
+        self.observation_space = spaces.Box(
+            low=np.array(self.OBS_LOW, dtype=np.float32),
+            high=np.array(self.OBS_HIGH, dtype=np.float32),
+            dtype=np.float32,
+        )
+        self.action_space = spaces.Discrete(self.N_ACTIONS)
         self.sumo_seed = sumo_seed
         self._session: SumoSession | None = None
         self._pair: VehiclePair | None = None
