@@ -17,6 +17,7 @@ Pipeline YAML (every key optional)::
     total_timesteps: null       # override every experiment's train.total_timesteps
     eval_every: null            # override every experiment's train.eval_every
     evaluate: {n_outcome: 200, n_ayss: 100000}
+    vuts: {}                    # extra VUTs (name: vehicle type) added to every experiment
     workers: 0                  # 0 = as many as cores
     retries: 1
 """
@@ -33,12 +34,14 @@ import os
 import sys
 import time
 import traceback
+import types
 from collections.abc import Mapping, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar, Literal
 
+from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config import PROJECT_ROOT, Case, _require, build, read_yaml, to_dict
 from sumo_ayss.errors import ConfigError
 
@@ -91,12 +94,18 @@ class PipelineConfig:
     total_timesteps: int | None = None
     eval_every: int | None = None
     evaluate: EvaluateConfig = field(default_factory=EvaluateConfig)
+    vuts: Mapping[str, VehicleType] = field(default_factory=dict)
+    """Extra VUTs (catalog syntax, as in ``env.vuts``) added to every case's experiment, so
+    that a leaderboard defines its VUTs once for all cases."""
     workers: int = 0
     retries: int = 1
 
     def __post_init__(self) -> None:
         _require(self.workers >= 0, f"workers must be >= 0, got {self.workers}")
         _require(self.retries >= 0, f"retries must be >= 0, got {self.retries}")
+        object.__setattr__(self, "vuts", types.MappingProxyType(dict(self.vuts)))
+        for name, vt in self.vuts.items():
+            vt.validate(f"vuts.{name}")
         for case in self.grid.cases:
             _require(
                 case in self.experiments,
@@ -150,6 +159,9 @@ def load_pipeline(path: str | Path | None, **overrides: Any) -> PipelineConfig:
         path = Path(path)
         cfg = build(PipelineConfig, read_yaml(path), "", path.resolve().parent)
     clean = {k: v for k, v in overrides.items() if v is not None}
+    seeds = clean.pop("seeds", None)
+    if seeds is not None:
+        clean["grid"] = dataclasses.replace(cfg.grid, seeds=tuple(int(x) for x in seeds))
     return dataclasses.replace(cfg, **clean) if clean else cfg
 
 
@@ -170,6 +182,10 @@ def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
         if cfg.eval_every is not None:
             overrides["eval_every"] = cfg.eval_every
         exp = dataclasses.replace(exp, train=dataclasses.replace(exp.train, **overrides))
+        if cfg.vuts:
+            exp = dataclasses.replace(
+                exp, env=dataclasses.replace(exp.env, vuts={**exp.env.vuts, **cfg.vuts})
+            )
         for vut in cfg.grid.vuts:
             if vut not in exp.env.vuts:
                 raise ConfigError(
@@ -394,13 +410,16 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("config", type=Path, nargs="?", default=None, help="pipeline YAML")
     parser.add_argument("--out", type=Path, default=None)
     parser.add_argument("--workers", type=int, default=None)
+    parser.add_argument(
+        "--seeds", type=int, nargs="+", default=None, help="replace grid.seeds (e.g. 100 101 102)"
+    )
     parser.add_argument("--backend", choices=["local", "ray"], default="local")
     parser.add_argument("--address", default=None, help="Ray cluster address (ray backend)")
     parser.add_argument("--no-live", action="store_true", help="no live table (logs only)")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
     try:
-        cfg = load_pipeline(args.config, out=args.out, workers=args.workers)
+        cfg = load_pipeline(args.config, out=args.out, workers=args.workers, seeds=args.seeds)
         statuses, report = run_pipeline(
             cfg, backend=args.backend, address=args.address, live=not args.no_live
         )

@@ -101,11 +101,15 @@ def main(argv: Sequence[str] | None = None) -> None:
     )
     parser.add_argument("config", type=Path, help="pipeline YAML listing the VUTs to rank")
     parser.add_argument("--workers", type=int, default=None)
+    parser.add_argument("--out", type=Path, default=None, help="replace the config's out")
+    parser.add_argument(
+        "--seeds", type=int, nargs="+", default=None, help="replace grid.seeds (e.g. 100 101 102)"
+    )
     parser.add_argument("--no-live", action="store_true")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
     try:
-        cfg = load_pipeline(args.config, workers=args.workers)
+        cfg = load_pipeline(args.config, workers=args.workers, out=args.out, seeds=args.seeds)
         statuses, report = run_pipeline(cfg, live=not args.no_live)
     except ConfigError as e:
         sys.exit(f"error: {e}")
