@@ -18,6 +18,8 @@ Pipeline YAML (every key optional)::
     eval_every: null            # override every experiment's train.eval_every
     evaluate: {n_outcome: 200, n_ayss: 100000}
     vuts: {}                    # extra VUTs (name: vehicle type) added to every experiment
+    report: {mode: exposure}    # report options (sumo_ayss.report.options.ReportOptions)
+    expected_order: []          # a known safety order, safest first (validation studies)
     workers: 0                  # 0 = as many as cores
     retries: 1
 """
@@ -44,6 +46,7 @@ from typing import Any, ClassVar, Literal
 from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config import PROJECT_ROOT, Case, _require, build, read_yaml, to_dict
 from sumo_ayss.errors import ConfigError
+from sumo_ayss.report.options import ReportOptions
 
 logger = logging.getLogger(__name__)
 
@@ -97,12 +100,24 @@ class PipelineConfig:
     vuts: Mapping[str, VehicleType] = field(default_factory=dict)
     """Extra VUTs (catalog syntax, as in ``env.vuts``) added to every case's experiment, so
     that a leaderboard defines its VUTs once for all cases."""
+    report: ReportOptions = field(default_factory=ReportOptions)
+    """Statistical settings and analysis mode of the report and the ranking."""
+    expected_order: tuple[str, ...] = ()
+    """A known safety order of the grid's VUTs, safest first (validation studies such as
+    ladders): ``rank`` then reports Kendall's τ of its ranking against it and whether the
+    two ends differ significantly. Empty: no known order."""
     workers: int = 0
     retries: int = 1
 
     def __post_init__(self) -> None:
         _require(self.workers >= 0, f"workers must be >= 0, got {self.workers}")
         _require(self.retries >= 0, f"retries must be >= 0, got {self.retries}")
+        if self.expected_order:
+            _require(
+                sorted(self.expected_order) == sorted(self.grid.vuts),
+                f"expected_order must list exactly the grid's VUTs {sorted(self.grid.vuts)}, "
+                f"got {list(self.expected_order)}",
+            )
         object.__setattr__(self, "vuts", types.MappingProxyType(dict(self.vuts)))
         for name, vt in self.vuts.items():
             vt.validate(f"vuts.{name}")
@@ -399,7 +414,7 @@ def run_pipeline(
     if finished:
         from sumo_ayss.report import write_report
 
-        report = write_report(finished, cfg.out / "report")
+        report = write_report(finished, cfg.out / "report", options=cfg.report)
     return statuses, report
 
 

@@ -1,16 +1,20 @@
-"""Leaderboard: train SPCPs for K VUTs through the pipeline and rank them by safety index.
+"""Leaderboard: train SPCPs for K VUTs through the pipeline and rank them by safety.
 
-    python -m sumo_ayss.rank configs/leaderboard.yaml [--workers N] [--no-live]
+    python -m sumo_ayss.rank configs/ladders/min_gap.yaml [--seeds 100 101 102] [--out DIR]
 
 The config is a pipeline YAML (:mod:`sumo_ayss.pipeline`) whose ``grid.vuts`` lists the
-VUTs to rank (any mix of catalog models defined in the experiments' ``env.vuts``). After
-the grid, this writes ``<out>/ranking.csv`` and ``<out>/ranking.md`` (per case: rank, VUT,
-safety index with its interval, seeds, and the verdict against the next VUT under the
-report's significance rule) and the HTML report, and prints the table.
+VUTs to rank (catalog models from the experiments' ``env.vuts`` or the pipeline's own
+``vuts`` section). After the grid (resumable: finished jobs are skipped), this writes
+``<out>/ranking.csv`` and ``<out>/ranking.md`` (per case: rank, VUT, score with its
+interval, seeds, and the verdict against the next VUT) and the HTML report, and prints the
+table. With ``expected_order`` (a known safety order, e.g. a ladder), it also writes
+``<out>/order_check.json``: Kendall's τ of the ranking against it, whether the two ends
+differ significantly, and how many adjacent pairs do.
 
-Safety index: minus the mean aggressiveness indicator over the AYSS headway range (equal-
-width headway bins, mean of bin means), so larger = safer; its interval is a hierarchical
-bootstrap over seeds, then samples (:func:`sumo_ayss.analysis.ranking.safety_index`).
+The score depends on the report's mode (``report.mode``, :data:`sumo_ayss.report.options.MODES`):
+``exposure`` (default) ranks by the mean episode reward the SPCP extracts (lower = safer),
+comparing VUTs by a paired t-test over shared seeds; ``paper`` ranks by the paper's AYSS
+aggressiveness index (:func:`sumo_ayss.analysis.ranking.safety_index`).
 """
 
 from __future__ import annotations
@@ -19,60 +23,154 @@ import argparse
 import csv
 import io
 import logging
+import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.errors import ConfigError
+
+if TYPE_CHECKING:
+    from sumo_ayss.report.document import CaseAnalysis, ReportOptions
 
 RANKING_COLUMNS = [
     "case",
+    "mode",
     "rank",
     "vut",
-    "safety_index",
+    "score",
     "lo",
     "hi",
     "n_seeds",
     "unit",
-    "vs_next",
+    "p_vs_next",
     "significant_vs_next",
+    "vs_next",
 ]
 
 
-def ranking_rows(run_dirs: Sequence[Path]) -> list[dict[str, Any]]:
-    """Ranking rows for every case among ``run_dirs`` (safest first within a case)."""
+def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> list[CaseAnalysis]:
+    """The report's analysis of every case among ``run_dirs`` (see :func:`analyse_case`)."""
     from sumo_ayss.report.document import ReportOptions, analyse_case
     from sumo_ayss.report.load import group_runs, load_run
 
-    options = ReportOptions()
+    options = options or ReportOptions()
+    groups = group_runs([load_run(d) for d in run_dirs])
+    return [analyse_case(case, runs, options) for case, runs in groups.items()]
+
+
+def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
+    """Ranking rows of every case (safest first within a case), in each analysis's mode.
+
+    Exposure mode: the score is E, the mean episode reward per SPCP (lower = safer).
+    Paper mode: the AYSS safety index (higher = safer).
+    """
+    from sumo_ayss.report.document import exposure_sentence
+
     rows: list[dict[str, Any]] = []
-    for case, runs in group_runs([load_run(d) for d in run_dirs]).items():
-        analysis = analyse_case(case, runs, options)
-        pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in analysis.pairs}
-        order = [r.name for r in analysis.ranking]
-        for i, r in enumerate(analysis.ranking):
-            nxt = order[i + 1] if i + 1 < len(order) else None
-            pair = pairs.get((r.name, nxt)) if nxt else None
+    for a in analyses:
+        if a.mode == "exposure":
+            for r in a.exposure_rows:
+                nxt = r.vs_next
+                rows.append(
+                    {
+                        "case": a.case,
+                        "mode": a.mode,
+                        "rank": r.rank,
+                        "vut": r.name,
+                        "score": r.mean,
+                        "lo": r.lo,
+                        "hi": r.hi,
+                        "n_seeds": r.n_seeds,
+                        "unit": "reward/episode (lower = safer)",
+                        "p_vs_next": nxt.p if nxt else "",
+                        "significant_vs_next": nxt.significant if nxt else "",
+                        "vs_next": exposure_sentence(nxt) if nxt else "",
+                    }
+                )
+            continue
+        pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
+        order = [r.name for r in a.ranking]
+        for i, r in enumerate(a.ranking):
+            nxt_name = order[i + 1] if i + 1 < len(order) else None
+            pair = pairs.get((r.name, nxt_name)) if nxt_name else None
             rows.append(
                 {
-                    "case": case,
+                    "case": a.case,
+                    "mode": a.mode,
                     "rank": r.rank,
                     "vut": r.name,
-                    "safety_index": r.point,
+                    "score": r.point,
                     "lo": r.lo,
                     "hi": r.hi,
                     "n_seeds": r.n_seeds,
-                    "unit": analysis.info.indicator.unit,
-                    "vs_next": pair.sentence if pair else "",
+                    "unit": f"{a.info.indicator.unit} (higher = safer)",
+                    "p_vs_next": pair.verdict.p_seed_welch if pair else "",
                     "significant_vs_next": pair.significant if pair else "",
+                    "vs_next": pair.sentence if pair else "",
                 }
             )
     return rows
 
 
-def write_ranking(rows: Sequence[dict[str, Any]], out: Path) -> tuple[Path, Path]:
-    """``ranking.csv`` and ``ranking.md`` in ``out`` (written atomically)."""
+def order_check(a: CaseAnalysis, expected: Sequence[str]) -> dict[str, Any] | None:
+    """How one case's ranking compares with a known order (safest first).
+
+    Returns:
+        ``{"case", "mode", "order", "tau", "ends_significant", "ends_p",
+        "significant_adjacent", "adjacent"}`` (Kendall τ of the ranking against the known
+        order; whether the expected safest and least safe VUT differ significantly, in the
+        right direction; significant adjacent pairs of the ranking), or None when the
+        case's VUTs are not exactly the expected ones.
+    """
+    if a.mode == "exposure":
+        order = [r.name for r in a.exposure_rows]
+        sig = [bool(r.significant_vs_next) for r in a.exposure_rows[:-1]]
+        ends = {frozenset((c.name_a, c.name_b)): c for c in a.exposure_pairs}
+    else:
+        order = [r.name for r in a.ranking]
+        sig = [bool(r.significant_vs_next) for r in a.ranking[:-1]]
+        ends = {}
+    if sorted(order) != sorted(expected) or len(order) < 2:
+        return None
+    end_cmp = ends.get(frozenset((expected[0], expected[-1])))
+    ends_ok = (
+        end_cmp is not None
+        and end_cmp.significant
+        and end_cmp.name_a == expected[0]  # ranked above, i.e. found safer
+    )
+    if a.mode == "paper":
+        pair = next(
+            (
+                p
+                for p in a.pairs
+                if {p.verdict.name_a, p.verdict.name_b} == {expected[0], expected[-1]}
+            ),
+            None,
+        )
+        ends_ok = pair is not None and pair.safer == expected[0]
+    return {
+        "case": a.case,
+        "mode": a.mode,
+        "order": order,
+        "tau": kendall_tau(order, list(expected)),
+        "ends_significant": ends_ok,
+        "ends_p": end_cmp.p if end_cmp is not None else math.nan,
+        "significant_adjacent": sum(sig),
+        "adjacent": len(sig),
+    }
+
+
+def write_ranking(
+    rows: Sequence[dict[str, Any]],
+    out: Path,
+    checks: Sequence[dict[str, Any]] = (),
+    expected: Sequence[str] = (),
+) -> tuple[Path, Path]:
+    """``ranking.csv`` and ``ranking.md`` in ``out`` (written atomically), and with a known
+    order, ``order_check.json`` (see :func:`order_check`)."""
     from sumo_ayss.atomic import atomic_write_text
 
     buf = io.StringIO()
@@ -81,15 +179,29 @@ def write_ranking(rows: Sequence[dict[str, Any]], out: Path) -> tuple[Path, Path
     writer.writerows(rows)
     atomic_write_text(out / "ranking.csv", buf.getvalue())
     lines = [
-        "| case | rank | VUT | safety index (95 % CI) | seeds | vs next |",
-        "|---|---:|---|---|---:|---|",
+        "| case | mode | rank | VUT | score (95 % CI) | seeds | vs next |",
+        "|---|---|---:|---|---|---:|---|",
     ]
     for r in rows:
+        ci = f" ({r['lo']:.2f} to {r['hi']:.2f})" if math.isfinite(r["lo"]) else ""
         lines.append(
-            f"| {r['case']} | {r['rank']} | {r['vut']} | {r['safety_index']:.2f} "
-            f"({r['lo']:.2f} to {r['hi']:.2f}) {r['unit']} | {r['n_seeds']} | {r['vs_next']} |"
+            f"| {r['case']} | {r['mode']} | {r['rank']} | {r['vut']} | {r['score']:.2f}{ci} "
+            f"{r['unit']} | {r['n_seeds']} | {r['vs_next']} |"
         )
+    for c in checks:
+        lines += [
+            "",
+            f"Known order ({c['case']}, {c['mode']} mode), safest first: "
+            f"{' > '.join(expected)}. Ranking: {' > '.join(c['order'])}. "
+            f"Kendall tau = {c['tau']:.2f}; ends significantly different: "
+            f"{'yes' if c['ends_significant'] else 'no'} (p = {c['ends_p']:.3g}); "
+            f"significant adjacent pairs: {c['significant_adjacent']} of {c['adjacent']}.",
+        ]
     atomic_write_text(out / "ranking.md", "\n".join(lines) + "\n")
+    if checks:
+        from sumo_ayss.atomic import atomic_write_json
+
+        atomic_write_json(out / "order_check.json", {"expected": list(expected), "cases": checks})
     return out / "ranking.csv", out / "ranking.md"
 
 
@@ -114,7 +226,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     except ConfigError as e:
         sys.exit(f"error: {e}")
     done = [s.spec.run_dir for s in statuses if s.state == "done"]
-    _, md = write_ranking(ranking_rows(done), cfg.out)
+    analyses = analyse(done, cfg.report)
+    checks = [c for a in analyses if (c := order_check(a, cfg.expected_order)) is not None]
+    _, md = write_ranking(ranking_rows(analyses), cfg.out, checks, cfg.expected_order)
     print(md.read_text())
     if report is not None:
         print(f"report: {report}")

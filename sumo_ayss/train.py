@@ -170,9 +170,11 @@ class Trainer:
 
     def write_metadata(self, argv: Sequence[str]) -> None:
         self.run_dir.mkdir(parents=True, exist_ok=True)
-        self.ckpt_dir.mkdir(exist_ok=True)
         resolved = {"vut": self.cfg.env.vut, "seed": self.seed, **self.cfg.to_dict()}
+        # config.yaml before checkpoints/: a run killed in between must look resumable
+        # (the pipeline resumes a folder with config.yaml; checkpoints/ alone is refused).
         write_yaml(self.run_dir / "config.yaml", resolved)
+        self.ckpt_dir.mkdir(exist_ok=True)
         atomic_write_text(
             self.run_dir / "command.txt",
             shlex.join([sys.executable, "-m", __spec__.name, *argv])

@@ -4,26 +4,53 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from sumo_ayss.rank import ranking_rows, write_ranking
-from tests.report.test_report import OFFSET, make_run
+from sumo_ayss.rank import analyse, order_check, ranking_rows, write_ranking
+from sumo_ayss.report.options import ReportOptions
+from tests.report.test_report import EXPOSURE, OFFSET, make_run
 
 
-def test_ranking_of_three_vuts_is_ordered_with_intervals(tmp_path: Path, monkeypatch) -> None:
+def _three_vuts(tmp_path: Path, monkeypatch) -> list[Path]:
     monkeypatch.setitem(OFFSET, "cautious", -3.0)  # its SPCPs brake hardest: safest VUT
-    dirs = [
+    monkeypatch.setitem(EXPOSURE, "cautious", -2.5)  # and extract the least reward
+    return [
         make_run(tmp_path, "car_following", vut, seed)
         for vut in ("pi1", "pi2", "cautious")
         for seed in range(3)
     ]
-    rows = ranking_rows(dirs)
+
+
+def test_paper_mode_ranking_of_three_vuts_is_ordered_with_intervals(tmp_path, monkeypatch):
+    dirs = _three_vuts(tmp_path, monkeypatch)
+    rows = ranking_rows(analyse(dirs, ReportOptions(mode="paper", n_boot=400)))
     assert [r["vut"] for r in rows] == ["cautious", "pi2", "pi1"]
     assert [r["rank"] for r in rows] == [1, 2, 3]
     for r in rows:
-        assert r["lo"] <= r["safety_index"] <= r["hi"] and r["n_seeds"] == 3
-    points = [r["safety_index"] for r in rows]
+        assert r["lo"] <= r["score"] <= r["hi"] and r["n_seeds"] == 3 and r["mode"] == "paper"
+    points = [r["score"] for r in rows]
     assert points == sorted(points, reverse=True)
     assert rows[0]["significant_vs_next"] is True
     assert rows[-1]["vs_next"] == ""
     csv_path, md_path = write_ranking(rows, tmp_path)
-    assert csv_path.read_text().splitlines()[0].startswith("case,rank,vut,safety_index")
-    assert "| car_following | 1 | cautious |" in md_path.read_text()
+    assert csv_path.read_text().splitlines()[0].startswith("case,mode,rank,vut,score")
+    assert "| car_following | paper | 1 | cautious |" in md_path.read_text()
+
+
+def test_exposure_mode_ranks_by_outcome_reward_and_checks_a_known_order(tmp_path, monkeypatch):
+    dirs = _three_vuts(tmp_path, monkeypatch)
+    analyses = analyse(dirs, ReportOptions(n_boot=200))
+    rows = ranking_rows(analyses)
+    assert [r["vut"] for r in rows] == ["cautious", "pi2", "pi1"]
+    assert all(r["mode"] == "exposure" for r in rows)
+    scores = [r["score"] for r in rows]
+    assert scores == sorted(scores)  # lower exposure = safer
+    assert rows[0]["significant_vs_next"] is True and "[exposure mode]" in rows[0]["vs_next"]
+    check = order_check(analyses[0], ["cautious", "pi2", "pi1"])
+    assert check is not None
+    assert check["tau"] == 1.0 and check["ends_significant"]
+    assert check["significant_adjacent"] == 2 and check["adjacent"] == 2
+    wrong = order_check(analyses[0], ["pi1", "pi2", "cautious"])
+    assert wrong is not None and wrong["tau"] == -1.0 and not wrong["ends_significant"]
+    assert order_check(analyses[0], ["pi1", "pi2"]) is None
+    _, md = write_ranking(rows, tmp_path, [check], ["cautious", "pi2", "pi1"])
+    assert "Kendall tau = 1.00" in md.read_text()
+    assert (tmp_path / "order_check.json").is_file()

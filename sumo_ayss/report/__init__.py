@@ -13,52 +13,40 @@ Imports neither SUMO nor torch (the reward-shape figure loads :mod:`sumo_ayss.pl
 
 from __future__ import annotations
 
-from sumo_ayss.report.document import (
-    DEFAULT_TITLE,
-    HTML_NAME,
-    MARKDOWN_NAME,
-    PairVerdict,
-    Report,
-    ReportOptions,
-    analyse_case,
-    build_report,
-    pair_verdict,
-    render_html,
-    render_markdown,
-    significance_rule,
-    vut_safety_index,
-    write_report,
-)
-from sumo_ayss.report.load import (
-    AYSS_COLUMNS,
-    OUTCOME_KEYS,
-    RUN_FILES,
-    Run,
-    find_run_dirs,
-    group_runs,
-    load_run,
-)
+import importlib
+from typing import Any
 
-__all__ = [
-    "AYSS_COLUMNS",
-    "DEFAULT_TITLE",
-    "HTML_NAME",
-    "MARKDOWN_NAME",
-    "OUTCOME_KEYS",
-    "RUN_FILES",
-    "PairVerdict",
-    "Report",
-    "ReportOptions",
-    "Run",
-    "analyse_case",
-    "build_report",
-    "find_run_dirs",
-    "group_runs",
-    "load_run",
-    "pair_verdict",
-    "render_html",
-    "render_markdown",
-    "significance_rule",
-    "vut_safety_index",
-    "write_report",
-]
+_LAZY = {
+    "DEFAULT_TITLE": "sumo_ayss.report.document",
+    "HTML_NAME": "sumo_ayss.report.document",
+    "MARKDOWN_NAME": "sumo_ayss.report.document",
+    "PairVerdict": "sumo_ayss.report.document",
+    "Report": "sumo_ayss.report.document",
+    "analyse_case": "sumo_ayss.report.document",
+    "build_report": "sumo_ayss.report.document",
+    "pair_verdict": "sumo_ayss.report.document",
+    "render_html": "sumo_ayss.report.document",
+    "render_markdown": "sumo_ayss.report.document",
+    "significance_rule": "sumo_ayss.report.document",
+    "vut_safety_index": "sumo_ayss.report.document",
+    "write_report": "sumo_ayss.report.document",
+    "AYSS_COLUMNS": "sumo_ayss.report.load",
+    "OUTCOME_KEYS": "sumo_ayss.report.load",
+    "RUN_FILES": "sumo_ayss.report.load",
+    "Run": "sumo_ayss.report.load",
+    "find_run_dirs": "sumo_ayss.report.load",
+    "group_runs": "sumo_ayss.report.load",
+    "load_run": "sumo_ayss.report.load",
+    "ReportOptions": "sumo_ayss.report.options",
+    "MODES": "sumo_ayss.report.options",
+}
+"""Public names and their modules, imported on first use: configuration imports
+:mod:`sumo_ayss.report.options` without loading matplotlib through the document."""
+
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

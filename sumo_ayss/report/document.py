@@ -37,6 +37,7 @@ from typing import Literal
 
 import numpy as np
 
+from sumo_ayss.analysis.premise import Premise, premise_check
 from sumo_ayss.analysis.ranking import (
     Indicator,
     RankedVut,
@@ -45,6 +46,13 @@ from sumo_ayss.analysis.ranking import (
     compare,
     rank,
     safety_index,
+)
+from sumo_ayss.analysis.seeds import (
+    SeedComparison,
+    SeedRankRow,
+    SeedScores,
+    rank_seeds,
+    verdict_sentence,
 )
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.report import figures
@@ -57,6 +65,7 @@ from sumo_ayss.report.load import (
     group_runs,
     load_run,
 )
+from sumo_ayss.report.options import MODES, ReportOptions
 
 __all__ = [
     "DEFAULT_TITLE",
@@ -91,62 +100,16 @@ HTML_NAME = "report.html"
 MARKDOWN_NAME = "summary.md"
 
 
-# --------------------------------------------------------------------------- options
-
-
-@dataclass(frozen=True)
-class ReportOptions:
-    """Statistical settings of a report.
-
-    Attributes:
-        h_max_m: AYSS headway range is ``[0, h_max_m]`` m (the paper keeps h <= 5 m).
-        bin_width_m: Headway bin width of the indicator-vs-headway figure, m.
-        index_bins: Equal-width headway bins of the safety index over ``[0, h_max_m]``.
-        level: Confidence level of every interval.
-        n_boot: Bootstrap replicates per safety index (the same for every VUT).
-        welch_alpha: The seed-level Welch p-value must be below this for significance.
-        rng_seed: Root seed of the bootstraps; each (case, VUT) gets its own stream.
-    """
-
-    h_max_m: float = 5.0
-    bin_width_m: float = 0.25
-    index_bins: int = 10
-    level: float = 0.95
-    n_boot: int = 2000
-    welch_alpha: float = 0.05
-    rng_seed: int = 0
-
-    def __post_init__(self) -> None:
-        if not (math.isfinite(self.h_max_m) and self.h_max_m > 0):
-            raise ConfigError(f"h_max_m must be > 0, got {self.h_max_m}")
-        if not (0 < self.bin_width_m <= self.h_max_m):
-            raise ConfigError(f"bin_width_m must be in (0, h_max_m], got {self.bin_width_m}")
-        if self.index_bins < 1 or self.n_boot < 1:
-            raise ConfigError("index_bins and n_boot must be >= 1")
-        if not (0 < self.level < 1 and 0 < self.welch_alpha < 1):
-            raise ConfigError("level and welch_alpha must be in (0, 1)")
-
-    @property
-    def h_range(self) -> tuple[float, float]:
-        """``(0, h_max_m)``."""
-        return (0.0, self.h_max_m)
-
-    @property
-    def figure_edges(self) -> np.ndarray:
-        """Headway bin edges of the indicator figure, m."""
-        n = max(1, round(self.h_max_m / self.bin_width_m))
-        return np.linspace(0.0, self.h_max_m, n + 1)
-
-
 def significance_rule(options: ReportOptions) -> str:
-    """The rule, in words, for the report."""
+    """The rule of the paper mode, in words, for the report."""
     pct = f"{100 * options.level:g} %"
     return (
-        "Significance rule: a difference between two VUTs is called significant only when "
+        "Paper-mode significance rule: a difference between two VUTs is called significant "
+        "only when "
         f"BOTH the {pct} hierarchical-bootstrap interval of the difference of their safety "
         "indices excludes 0 AND the seed-level Welch t-test on the per-seed indices gives "
         f"p < {options.welch_alpha:g}. With only a few seeds per VUT the bootstrap alone is "
-        "anti-conservative (resampling 3 seeds understates the seed-to-seed spread), so the "
+        "anti-conservative (resampling a few seeds understates the seed-to-seed spread), so the "
         "Welch test, which treats each seed's SPCP as one observation, must agree."
     )
 
@@ -402,6 +365,12 @@ class CaseAnalysis:
         headline_kind: ``"safer"``, ``"none"`` or ``"warning"``.
         ranking_line: ``"pi2 > pi1"`` (``>`` significant under the rule, ``≈`` not).
         problems: Missing or unreadable files, one sentence each.
+        mode: The analysis mode of ``headline``, ``ranking_line`` and :attr:`ranked`.
+        exposure_rows: Exposure-mode ranking, safest first.
+        exposure_pairs: Exposure-mode comparisons of every pair (A ranked above B).
+        premise: Whether the SPCPs reached the same overall outcome, or None.
+        paper_headline: The paper-mode headline (also when ``mode`` is exposure).
+        paper_ranking_line: The paper-mode ranking line.
     """
 
     case: str
@@ -414,6 +383,79 @@ class CaseAnalysis:
     headline_kind: Literal["safer", "none", "warning"] = "warning"
     ranking_line: str = ""
     problems: list[str] = field(default_factory=list)
+    mode: str = "exposure"
+    exposure_rows: list[SeedRankRow] = field(default_factory=list)
+    exposure_pairs: list[SeedComparison] = field(default_factory=list)
+    premise: Premise | None = None
+    paper_headline: str = ""
+    paper_ranking_line: str = ""
+
+
+EXPOSURE_SCORE = "extract {amount} {more_less} reward per episode"
+"""How an exposure difference reads in a verdict sentence."""
+
+
+def _exposure(out: CaseAnalysis, options: ReportOptions) -> None:
+    """Exposure-mode ranking and the premise check, from the runs' outcome summaries."""
+    scores = []
+    for vut, members in out.runs.items():
+        values = {
+            r.seed: r.outcome.mean_return.value
+            for r in members
+            if r.seed is not None and r.outcome is not None and r.outcome.mean_return.known
+        }
+        if values:
+            scores.append(SeedScores(vut, values))
+        else:
+            out.problems.append(f"{vut}: no outcome summary with a seed, so no exposure")
+    if scores:
+        out.exposure_rows, out.exposure_pairs = rank_seeds(
+            scores, higher_is_safer=False, level=options.level, alpha=options.welch_alpha
+        )
+    metrics: dict[str, dict[str, list[float]]] = {
+        "mean_return": {},
+        "crash_rate": {},
+        "mean_final_headway_m": {},
+    }
+    for vut, members in out.runs.items():
+        for r in members:
+            if r.outcome is None:
+                continue
+            for key in metrics:
+                metrics[key].setdefault(vut, []).append(getattr(r.outcome, key).value)
+    out.premise = premise_check(metrics, tolerances=options.premise_tolerances, level=options.level)
+
+
+def exposure_sentence(c: SeedComparison) -> str:
+    """The exposure-mode verdict sentence of one comparison."""
+    return verdict_sentence(
+        c, higher_is_safer=False, score=EXPOSURE_SCORE, unit="", mode="exposure"
+    )
+
+
+def premise_sentence(premise: Premise | None, options: ReportOptions) -> str:
+    """One sentence: did the SPCPs reach the same overall outcome?"""
+    if premise is None or not premise.metrics:
+        return "Premise check: needs outcome summaries of at least two VUTs."
+    parts = []
+    for m in premise.metrics:
+        unit = f" {m.spec.unit}" if m.spec.unit and m.spec.unit != "%" else m.spec.unit
+        parts.append(
+            f"{m.spec.name} spread {_num(m.spread * m.spec.scale)}{unit} "
+            f"(tolerance {_num(m.tolerance * m.spec.scale)}{unit}"
+            f"{'' if m.met else ', exceeded'})"
+        )
+    if premise.met:
+        return (
+            "Premise met: the SPCPs of all VUTs reached the same overall outcome within the "
+            "stated tolerances (" + "; ".join(parts) + ")."
+        )
+    return (
+        "Premise NOT met: the SPCPs of different VUTs did not reach the same overall outcome ("
+        + "; ".join(parts)
+        + "), so a comparison of their aggressiveness (paper mode) is confounded by the "
+        "difference in outcome."
+    )
 
 
 def analyse_case(case: str, runs: dict[str, list[Run]], options: ReportOptions) -> CaseAnalysis:
@@ -460,7 +502,38 @@ def analyse_case(case: str, runs: dict[str, list[Run]], options: ReportOptions) 
             except ConfigError as exc:
                 out.problems.append(f"{a} vs {b}: not comparable ({exc})")
     _headline(out)
+    out.headline = "[paper mode] " + out.headline
+    _exposure(out, options)
+    if out.premise is not None and out.premise.metrics and not out.premise.met:
+        out.headline += (
+            " Confounded: the SPCPs did not reach the same overall outcome (premise check), "
+            "so this aggressiveness comparison does not isolate the VUTs' safety."
+        )
+        if out.headline_kind == "safer":
+            out.headline_kind = "warning"
+    out.paper_headline, out.paper_ranking_line = out.headline, out.ranking_line
+    out.mode = options.mode
+    if options.mode == "exposure":
+        _exposure_headline(out)
     return out
+
+
+def _exposure_headline(out: CaseAnalysis) -> None:
+    """Headline and ranking line of the exposure mode."""
+    rows = out.exposure_rows
+    if len(rows) < 2:
+        out.headline = "[exposure mode] No verdict yet: a verdict needs outcomes of two VUTs."
+        out.headline_kind = "warning"
+        out.ranking_line = rows[0].name if rows else ""
+        return
+    top = rows[0].vs_next
+    assert top is not None
+    out.headline = exposure_sentence(top)
+    out.headline_kind = "safer" if top.significant else "none"
+    out.ranking_line = rows[0].name + "".join(
+        (" > " if prev.significant_vs_next else " ≈ ") + row.name
+        for prev, row in itertools.pairwise(rows)
+    )
 
 
 def _headline(out: CaseAnalysis) -> None:
@@ -542,8 +615,7 @@ def _case_blocks(
     info, case = a.info, a.case
     anchor = f"case-{case}"
     blocks: list[Block] = [Heading(f"{info.title} ({case})", 2, anchor)]
-    lines = [a.headline] + ([f"Ranking, safest first: {a.ranking_line}"] if a.ranking_line else [])
-    blocks.append(Callout(f"Verdict — {info.title}", tuple(lines), a.headline_kind))
+    blocks.append(Callout(f"Verdict — {info.title}", _verdict_lines(a, options), a.headline_kind))
     if a.problems:
         blocks.append(
             Callout("Missing or incomplete data in this case", tuple(a.problems), "warning")
@@ -552,7 +624,166 @@ def _case_blocks(
     blocks += _learning_blocks(a, colors, out_dir)
     blocks += _indicator_blocks(a, colors, out_dir, options)
     blocks += _outcome_blocks(a)
+    blocks += _premise_blocks(a, options)
+    blocks += _exposure_blocks(a, colors, out_dir, options)
     blocks += _ranking_blocks(a, colors, out_dir, options)
+    return blocks
+
+
+def _verdict_lines(a: CaseAnalysis, options: ReportOptions) -> tuple[str, ...]:
+    """The verdict callout: the mode's headline and ranking, the premise, the other mode."""
+    lines = [a.headline]
+    if a.ranking_line:
+        lines.append(f"Ranking ({a.mode} mode), safest first: {a.ranking_line}")
+    lines.append(premise_sentence(a.premise, options))
+    if a.mode != "paper":
+        paper = a.paper_headline
+        if a.paper_ranking_line:
+            paper += f" Ranking (paper mode): {a.paper_ranking_line}."
+        lines.append(paper)
+    return tuple(lines)
+
+
+def _premise_blocks(a: CaseAnalysis, options: ReportOptions) -> list[Block]:
+    blocks: list[Block] = [Heading("(e) Premise check: the same overall outcome?", 3)]
+    premise = a.premise
+    if premise is None or not premise.metrics:
+        return [*blocks, Paragraph(premise_sentence(premise, options))]
+    pct = f"{100 * options.level:g} %"
+    vuts = list(a.runs)
+    rows = []
+    for m in premise.metrics:
+        unit = f" [{m.spec.unit}]" if m.spec.unit else ""
+        cells = []
+        for vut in vuts:
+            if vut not in m.per_vut:
+                cells.append("—")
+                continue
+            mean, lo, hi, _n = m.per_vut[vut]
+            sc = m.spec.scale
+            ci = _interval(lo * sc, hi * sc)
+            cells.append(f"{_num(mean * sc)} ({ci})" if ci else _num(mean * sc))
+        rows.append(
+            (
+                m.spec.name + unit,
+                *cells,
+                _num(m.spread * m.spec.scale),
+                _num(m.tolerance * m.spec.scale),
+                "yes" if m.met else "no",
+            )
+        )
+    blocks.append(
+        Table(
+            "Outcome of the SPCPs per VUT: seed mean (t-interval over seeds)",
+            ("metric", *vuts, "spread (max − min)", "tolerance", "within tolerance"),
+            tuple(rows),
+            (False,) + (True,) * (len(vuts) + 2) + (False,),
+            f"Each VUT: mean over its seeds' SPCPs ({pct} t-interval over seeds; one seed "
+            "gives no interval). Metrics over all outcome episodes. Tolerances are report "
+            "options (premise_reward, premise_crash_rate, premise_final_headway_m).",
+        )
+    )
+    blocks.append(
+        Callout(
+            "Premise",
+            (premise_sentence(premise, options),),
+            "none" if premise.met else "warning",
+        )
+    )
+    return blocks
+
+
+def _exposure_blocks(
+    a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
+) -> list[Block]:
+    blocks: list[Block] = [Heading("(f) Exposure ranking (default mode)", 3)]
+    blocks.append(Paragraph(MODES["exposure"]))
+    if not a.exposure_rows:
+        return [*blocks, Paragraph("No exposure: no outcome summaries in this case yet.")]
+    pct = f"{100 * options.level:g} %"
+    scores = {
+        vut: {
+            r.seed: r.outcome.mean_return.value
+            for r in members
+            if r.seed is not None and r.outcome is not None and r.outcome.mean_return.known
+        }
+        for vut, members in a.runs.items()
+    }
+    path = figures.seed_scores_figure(
+        a.exposure_rows,
+        scores,
+        colors,
+        out_dir / f"{a.case}_exposure_by_seed.png",
+        ylabel="adversarial exposure E (mean episode reward)",
+        title=f"{a.info.title}: exposure per seed (lower = safer)",
+    )
+    blocks.append(
+        FigureBlock(
+            path,
+            f"Exposure E of every seed's SPCP (grey: one line per training seed), safest VUT "
+            f"on the left; diamonds: seed mean with its {pct} t-interval over seeds.",
+        )
+    )
+    rows = []
+    for r in a.exposure_rows:
+        nxt = r.vs_next
+        per_seed = ", ".join(f"s{k}: {_num(v)}" for k, v in scores[r.name].items())
+        rows.append(
+            (
+                str(r.rank),
+                r.name,
+                f"{_num(r.mean)} ({_interval(r.lo, r.hi)})"
+                if _interval(r.lo, r.hi)
+                else _num(r.mean),
+                per_seed,
+                str(r.n_seeds),
+                f"{nxt.test}, p {_fmt_p(nxt.p)}" if nxt else "—",
+                ("yes" if nxt.significant else "no") if nxt else "—",
+            )
+        )
+    blocks.append(
+        Table(
+            "Ranking by exposure E (mean episode reward per SPCP), safest first",
+            (
+                "rank",
+                "VUT",
+                f"E ({pct} CI)",
+                "per-seed E",
+                "seeds",
+                "test vs next",
+                "significant vs next",
+            ),
+            tuple(rows),
+            (True, False, True, True, True, False, False),
+        )
+    )
+    p_rows = tuple(
+        (
+            c.name_a,
+            c.name_b,
+            f"{_num(-c.difference)} ({_interval(-c.hi, -c.lo)})",
+            c.test,
+            _prob(c.p),
+            "yes" if c.significant else "no",
+        )
+        for c in a.exposure_pairs
+    )
+    blocks.append(
+        Table(
+            "Pairwise comparisons (A ranked above B)",
+            (
+                "A",
+                "B",
+                f"E_B − E_A ({pct} CI)",
+                "test",
+                "p",
+                f"significant (p < {options.welch_alpha:g})",
+            ),
+            p_rows,
+            (False, False, True, False, True, False),
+        )
+    )
+    blocks.append(BulletList(tuple(exposure_sentence(c) for c in a.exposure_pairs)))
     return blocks
 
 
@@ -747,7 +978,9 @@ def _ranking_blocks(
 ) -> list[Block]:
     info = a.info
     unit = info.indicator.unit
-    blocks: list[Block] = [Heading("(e) Safety ranking and pairwise verdicts", 3)]
+    blocks: list[Block] = [
+        Heading("(g) Paper mode: safety index from the AYSS and pairwise verdicts", 3)
+    ]
     pct = f"{100 * options.level:g} %"
     blocks.append(
         Paragraph(
@@ -922,16 +1155,18 @@ def build_report(
     if not analyses:
         blocks.append(Callout("No runs", ("No run folder was found.",), "warning"))
     for a in analyses:
-        lines = [a.headline] + ([f"Ranking: {a.ranking_line}"] if a.ranking_line else [])
-        blocks.append(Callout(a.info.title, tuple(lines), a.headline_kind))
+        blocks.append(Callout(a.info.title, _verdict_lines(a, options), a.headline_kind))
+    blocks.append(Paragraph(f"Verdicts above are in {options.mode} mode. " + MODES[options.mode]))
     blocks.append(Paragraph(significance_rule(options)))
     blocks.append(
         Paragraph(
             "How to read this report: against each VUT an adversarial-yet-safe opponent (POV) "
-            "was trained with the same reward; its best checkpoint is the VUT's SPCP. All SPCPs "
-            "reach similar overall outcomes (section d), so a safer VUT is revealed by a more "
-            "aggressive SPCP: harder braking (car-following) or a smaller Δv̄ (cut-in) at the "
-            "same headway (sections c and e)."
+            "was trained with the same reward; its best checkpoint is the VUT's SPCP. Exposure "
+            "mode ranks VUTs by how much of that reward their SPCPs extract (sections d and f): "
+            "less means the opponent could create fewer and less close near-misses. The "
+            "paper's reading (sections c and g) assumes that all SPCPs reached the same overall "
+            "outcome (checked in section e) and then reveals a safer VUT by a more aggressive "
+            "SPCP: harder braking (car-following) or a smaller Δv̄ (cut-in) at the same headway."
         )
     )
     blocks += _inputs_blocks(runs, groups)

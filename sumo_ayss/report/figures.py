@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 
 from sumo_ayss.analysis import DELTA_V_BAR, POV_ACCELERATION, Indicator, binned_mean_ci
 from sumo_ayss.analysis.ranking import SafetyIndex
+from sumo_ayss.analysis.seeds import SeedRankRow
 from sumo_ayss.config import RewardConfig
 from sumo_ayss.report.load import Run
 
@@ -519,4 +520,74 @@ def safety_index_figure(
             pad = 0.08 * (xmax - xmin) if math.isfinite(xmax - xmin) else 0.0
             ax.set_xlim(xmin - pad, xmax + pad)
         ax.grid(axis="y", visible=False)
+        return _save(fig, path)
+
+
+# --------------------------------------------------------------------------- per-seed scores
+
+
+def seed_scores_figure(
+    rows: Sequence[SeedRankRow],
+    scores: Mapping[str, Mapping[int, float]],
+    colors: Mapping[str, str],
+    path: Path,
+    *,
+    ylabel: str,
+    title: str,
+) -> Path:
+    """Per-seed scores of every VUT, seeds joined across VUTs, with the seed mean and CI.
+
+    VUTs are drawn left to right from the safest (rank 1) to the least safe. Each training
+    seed is one grey line through its VUTs' scores: parallel lines show that seeds move all
+    VUTs together (a block effect that the paired comparison removes).
+
+    Args:
+        rows: The seed-level ranking, safest first.
+        scores: ``{vut: {seed: score}}``.
+        colors: ``{vut: colour}``.
+        path: PNG file to write.
+        ylabel: Axis label of the score, with unit.
+        title: Figure title.
+
+    Returns:
+        ``path``.
+    """
+    names = [r.name for r in rows]
+    seeds = sorted({s for v in names for s in scores[v]})
+    with _style():
+        fig = Figure(figsize=(2.2 + 1.6 * max(1, len(names)), 4.6), layout="constrained")
+        ax = fig.subplots()
+        for seed in seeds:
+            xs = [i for i, v in enumerate(names) if seed in scores[v]]
+            ys = [scores[names[i]][seed] for i in xs]
+            ax.plot(xs, ys, color="0.6", lw=1.0, marker="o", ms=4, zorder=1)
+            if xs:
+                ax.annotate(
+                    f"seed {seed}",
+                    xy=(xs[-1], ys[-1]),
+                    xytext=(6, 0),
+                    textcoords="offset points",
+                    va="center",
+                    fontsize=8,
+                    color="0.45",
+                )
+        for i, r in enumerate(rows):
+            lo = r.mean - r.lo if math.isfinite(r.lo) else 0.0
+            hi = r.hi - r.mean if math.isfinite(r.hi) else 0.0
+            ax.errorbar(
+                i + 0.12,
+                r.mean,
+                yerr=[[lo], [hi]],
+                fmt="D",
+                ms=8,
+                color=colors.get(r.name, "C0"),
+                capsize=5,
+                lw=2.0,
+                zorder=3,
+            )
+        ax.set_xticks(range(len(names)), [f"#{r.rank} {r.name}" for r in rows])
+        ax.set_xlim(-0.4, len(names) - 0.4)
+        ax.set_ylabel(ylabel)
+        ax.set_title(title)
+        ax.grid(axis="y", alpha=0.3)
         return _save(fig, path)

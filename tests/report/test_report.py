@@ -39,6 +39,8 @@ EVAL_HEADER = (
 
 #: Mean indicator offset per VUT: pi2's SPCPs are clearly more aggressive (more negative).
 OFFSET = {"pi1": 0.0, "pi2": -1.5, "pi1_again": 0.0}
+#: Mean outcome reward offset per VUT: the SPCPs extract less reward from pi2 (safer).
+EXPOSURE = {"pi1": 0.0, "pi2": -1.0, "pi1_again": 0.0}
 
 FAST = ReportOptions(n_boot=400)
 
@@ -90,10 +92,13 @@ def make_run(
         }
         (run_dir / RUN_FILES.spcp).write_text(json.dumps(spcp))
     if "outcome" in files:
+        outcome_rng = np.random.default_rng([seed, zlib.crc32(vut.encode()), 7])
         outcome = {
             OUTCOME_KEYS.n: 200,
             OUTCOME_KEYS.crash_rate: _estimate(0.01 * (seed % 3), 0.01),
-            OUTCOME_KEYS.mean_return: _estimate(19.4 - 0.05 * seed, 0.2),
+            OUTCOME_KEYS.mean_return: _estimate(
+                19.4 + EXPOSURE.get(vut, 0.0) + outcome_rng.normal(0.0, 0.1), 0.2
+            ),
             OUTCOME_KEYS.mean_final_headway_m: _estimate(1.7 + 0.8 * (vut == "pi2"), 0.3),
         }
         if case == "cut_in":
@@ -164,13 +169,16 @@ def test_html_is_self_contained(full_report: Path) -> None:
 
 def test_html_holds_every_figure_and_table(full_report: Path) -> None:
     text = full_report.read_text(encoding="utf-8")
-    # Per case: reward shapes, learning curves, indicator vs headway, safety index.
-    assert text.count("<img") == 8
+    # Per case: reward shapes, learning curves, indicator vs headway, exposure per seed,
+    # safety index.
+    assert text.count("<img") == 10
     assert "Table II equivalent" in text and "Table III equivalent" in text
     assert "19.48" in text and "20.99" in text  # the paper's reference numbers
-    assert "Significance rule" in text and "Welch" in text
+    assert "significance rule" in text and "Welch" in text and "paired t-test" in text
+    assert "[exposure mode]" in text and "[paper mode]" in text and "Premise" in text
     pngs = sorted(p.name for p in full_report.parent.glob("*.png"))
-    assert len(pngs) == 8 and "car_following_indicator_vs_headway.png" in pngs
+    assert len(pngs) == 10 and "car_following_indicator_vs_headway.png" in pngs
+    assert "cut_in_exposure_by_seed.png" in pngs
 
 
 def test_verdict_names_the_safer_vut(full_report: Path) -> None:
@@ -178,14 +186,15 @@ def test_verdict_names_the_safer_vut(full_report: Path) -> None:
     assert "pi2 is safer than pi1: its SPCPs brake" in text
     assert "pi2 is safer than pi1: its SPCPs close in" in text
     verdicts = text.split('id="inputs"')[0]  # the summary at the top names it too
-    assert verdicts.count("pi2 is safer than pi1") == 2
+    assert verdicts.count("[exposure mode] pi2 is safer than pi1") == 2
+    assert verdicts.count("[paper mode] pi2 is safer than pi1") == 2
 
 
 def test_summary_md_links_resolve(full_report: Path) -> None:
     md = full_report.parent / "summary.md"
     text = md.read_text(encoding="utf-8")
     links = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", text)
-    assert len(links) == 8
+    assert len(links) == 10
     for link in links:
         assert not link.startswith(("/", "http"))
         assert (md.parent / link).is_file(), link

@@ -1,0 +1,108 @@
+"""Statistical settings and analysis modes of a report (no heavy imports: configuration
+loads this module, the report and the leaderboard use it)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import ClassVar, Literal
+
+import numpy as np
+
+from sumo_ayss.errors import ConfigError
+
+__all__ = ["MODES", "ReportOptions"]
+
+
+# --------------------------------------------------------------------------- options
+
+MODES: Mapping[str, str] = {
+    "exposure": (
+        "Exposure mode (default): a VUT's score is the adversarial exposure E, the mean "
+        "episode reward its SPCP extracts over the common outcome scenarios (the same "
+        "scenarios for every VUT and seed); a lower E is a safer VUT, because the same "
+        "adversarial-yet-safe reward paid for fewer or less close near-misses. Each training "
+        "seed's SPCP is one observation; seeds are shared across VUTs (same seed values), so "
+        "two VUTs are compared by a paired t-test on their per-seed differences (Welch's "
+        "t-test when the seed sets differ); significant when p < alpha."
+    ),
+    "paper": (
+        "Paper mode: the paper's indicator, the aggressiveness of the SPCP's action in the "
+        "adversarial-yet-safe states (POV acceleration in car-following, Δv̄ in cut-in), "
+        "condensed into a safety index over headway bins; meaningful only when the SPCPs "
+        "reached the same overall outcome (the premise check)."
+    ),
+}
+"""The analysis modes of a report, with their description."""
+
+
+@dataclass(frozen=True)
+class ReportOptions:
+    """Statistical settings of a report.
+
+    Attributes:
+        h_max_m: AYSS headway range is ``[0, h_max_m]`` m (the paper keeps h <= 5 m).
+        bin_width_m: Headway bin width of the indicator-vs-headway figure, m.
+        index_bins: Equal-width headway bins of the safety index over ``[0, h_max_m]``.
+        level: Confidence level of every interval.
+        n_boot: Bootstrap replicates per safety index (the same for every VUT).
+        welch_alpha: The seed-level Welch p-value must be below this for significance.
+        rng_seed: Root seed of the bootstraps; each (case, VUT) gets its own stream.
+        mode: Which analysis gives the verdicts and the ranking (see :data:`MODES`):
+            ``"exposure"`` (default) or ``"paper"``. Both are computed and shown.
+        premise_reward: Tolerance on the spread of the VUTs' mean episode reward for the
+            premise check ("same overall outcome"), reward per episode.
+        premise_crash_rate: Tolerance on the spread of crash rates, fraction.
+        premise_final_headway_m: Tolerance on the spread of mean final headways, m.
+    """
+
+    SECTION: ClassVar[str] = "report"
+
+    h_max_m: float = 5.0
+    bin_width_m: float = 0.25
+    index_bins: int = 10
+    level: float = 0.95
+    n_boot: int = 2000
+    welch_alpha: float = 0.05
+    rng_seed: int = 0
+    mode: Literal["exposure", "paper"] = "exposure"
+    premise_reward: float = 1.0
+    premise_crash_rate: float = 0.02
+    premise_final_headway_m: float = 2.0
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise ConfigError(f"mode must be one of {list(MODES)}, got {self.mode!r}")
+        for name in ("premise_reward", "premise_crash_rate", "premise_final_headway_m"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise ConfigError(f"{name} must be a finite number >= 0, got {value!r}")
+        if not (math.isfinite(self.h_max_m) and self.h_max_m > 0):
+            raise ConfigError(f"h_max_m must be > 0, got {self.h_max_m}")
+        if not (0 < self.bin_width_m <= self.h_max_m):
+            raise ConfigError(f"bin_width_m must be in (0, h_max_m], got {self.bin_width_m}")
+        if self.index_bins < 1 or self.n_boot < 1:
+            raise ConfigError("index_bins and n_boot must be >= 1")
+        if not (0 < self.level < 1 and 0 < self.welch_alpha < 1):
+            raise ConfigError("level and welch_alpha must be in (0, 1)")
+
+    @property
+    def premise_tolerances(self) -> dict[str, float]:
+        """Tolerances of the premise check by metric key."""
+        return {
+            "mean_return": self.premise_reward,
+            "crash_rate": self.premise_crash_rate,
+            "mean_final_headway_m": self.premise_final_headway_m,
+        }
+
+    @property
+    def h_range(self) -> tuple[float, float]:
+        """``(0, h_max_m)``."""
+        return (0.0, self.h_max_m)
+
+    @property
+    def figure_edges(self) -> np.ndarray:
+        """Headway bin edges of the indicator figure, m."""
+        n = max(1, round(self.h_max_m / self.bin_width_m))
+        return np.linspace(0.0, self.h_max_m, n + 1)

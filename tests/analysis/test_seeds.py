@@ -1,0 +1,126 @@
+"""Seed-level comparison and ranking on synthetic data with a known answer."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sumo_ayss.analysis.seeds import SeedScores, compare_seeds, kendall_tau, rank_seeds
+from sumo_ayss.analysis.stats import welch_t_test
+from sumo_ayss.errors import ConfigError
+
+SEEDS = (0, 1, 2)
+
+
+def _scores(name: str, values, seeds=SEEDS) -> SeedScores:
+    return SeedScores(name, dict(zip(seeds, values, strict=True)))
+
+
+def test_paired_comparison_matches_hand_computation():
+    a = _scores("a", [3.0, 4.0, 5.5])
+    b = _scores("b", [1.0, 2.5, 3.0])
+    c = compare_seeds(a, b)
+    d = np.array([2.0, 1.5, 2.5])
+    se = d.std(ddof=1) / math.sqrt(3)  # 0.2887
+    assert c.test == "paired t"
+    assert c.difference == pytest.approx(2.0)
+    # t = 2 / 0.2887 = 6.93 on 2 df: two-sided p = 0.0202 (scipy.stats.t.sf(6.928, 2) * 2)
+    assert c.p == pytest.approx(0.0202, abs=5e-4)
+    assert c.lo == pytest.approx(2.0 - 4.3027 * se, abs=1e-3)
+    assert c.significant and c.a_higher() is True
+
+
+def test_blocking_removes_shared_seed_noise():
+    # Seed effects of +-2 shared by both VUTs swamp a 0.5 difference for Welch, not for the
+    # paired test: the situation seen on the minGap ladder.
+    a = _scores("a", [10.5, 12.6, 8.4])
+    b = _scores("b", [10.0, 12.0, 8.0])
+    assert compare_seeds(a, b).significant
+    assert welch_t_test(a.array, b.array)[2] > 0.5
+
+
+def test_different_seed_sets_fall_back_to_welch():
+    a = _scores("a", [3.0, 4.0, 5.0])
+    b = _scores("b", [1.0, 2.0, 3.0], seeds=(10, 11, 12))
+    c = compare_seeds(a, b)
+    assert c.test == "Welch t"
+    assert c.p == pytest.approx(welch_t_test(a.array, b.array)[2])
+
+
+def test_undefined_cases_are_never_significant():
+    one = compare_seeds(_scores("a", [1.0], (0,)), _scores("b", [0.0], (0,)))
+    assert one.test == "none" and math.isnan(one.p) and not one.significant
+    same = compare_seeds(_scores("a", [1.0, 2.0, 3.0]), _scores("b", [0.0, 1.0, 2.0]))
+    assert math.isnan(same.p) and not same.significant  # a constant difference: no spread
+
+
+def test_bad_inputs_are_refused():
+    with pytest.raises(ConfigError, match="not finite"):
+        SeedScores("a", {0: math.nan})
+    with pytest.raises(ConfigError, match="no seed scores"):
+        SeedScores("a", {})
+    with pytest.raises(ConfigError, match="must differ"):
+        compare_seeds(_scores("a", [1, 2, 3]), _scores("a", [1, 2, 3]))
+    with pytest.raises(ConfigError, match="alpha"):
+        compare_seeds(_scores("a", [1, 2, 3]), _scores("b", [1, 2, 3]), alpha=1.5)
+
+
+def _ladder(rng, effects, n_seeds, seed_sd=0.5, noise_sd=0.15):
+    blocks = rng.normal(0.0, seed_sd, n_seeds)
+    return [
+        SeedScores(f"v{i}", dict(enumerate(mu + blocks + rng.normal(0.0, noise_sd, n_seeds))))
+        for i, mu in enumerate(effects)
+    ]
+
+
+def test_known_ladder_order_is_recovered():
+    rng = np.random.default_rng(1)
+    # Exposure scores: lower = safer, so v3 (lowest) is the safest.
+    truth = ["v3", "v2", "v1", "v0"]
+    taus, ends = [], []
+    for _ in range(200):
+        rows, pairs = rank_seeds(_ladder(rng, [12.6, 11.7, 10.5, 9.7], 3), higher_is_safer=False)
+        taus.append(kendall_tau([r.name for r in rows], truth))
+        ends.append(next(p for p in pairs if {p.name_a, p.name_b} == {"v0", "v3"}).significant)
+    assert np.mean(np.array(taus) == 1.0) > 0.95
+    assert np.mean(ends) > 0.95
+
+
+@pytest.mark.parametrize("shared_seeds", [True, False])
+def test_false_positive_rate_is_at_most_nominal(shared_seeds):
+    """No true difference: the rule calls one in <= 5 % of replicates (plus MC error)."""
+    rng = np.random.default_rng(7)
+    n_rep, hits = 4000, 0
+    for _ in range(n_rep):
+        a, b = _ladder(rng, [10.0, 10.0], 3)
+        if not shared_seeds:
+            b = SeedScores("v1", {s + 100: v for s, v in b.values.items()})
+        hits += compare_seeds(a, b).significant
+    rate = hits / n_rep
+    se = math.sqrt(0.05 * 0.95 / n_rep)
+    assert rate <= 0.05 + 3 * se, rate
+    if shared_seeds:  # the paired test is exact: not grossly conservative either
+        assert rate >= 0.05 - 3 * se, rate
+
+
+def test_rank_seeds_orientation_and_rows():
+    a, b = _scores("safe", [1.0, 1.2, 0.9]), _scores("risky", [3.0, 3.3, 2.8])
+    rows, pairs = rank_seeds([b, a], higher_is_safer=False)
+    assert [r.name for r in rows] == ["safe", "risky"]
+    assert rows[0].vs_next is pairs[0] and rows[0].significant_vs_next
+    assert rows[1].vs_next is None and rows[1].significant_vs_next is None
+    rows, _ = rank_seeds([b, a], higher_is_safer=True)
+    assert [r.name for r in rows] == ["risky", "safe"]
+    with pytest.raises(ConfigError, match="duplicate"):
+        rank_seeds([a, a], higher_is_safer=True)
+
+
+def test_kendall_tau():
+    assert kendall_tau(["a", "b", "c", "d"], ["a", "b", "c", "d"]) == 1.0
+    assert kendall_tau(["d", "c", "b", "a"], ["a", "b", "c", "d"]) == -1.0
+    # one adjacent swap among 6 pairs: (5 - 1) / 6
+    assert kendall_tau(["b", "a", "c", "d"], ["a", "b", "c", "d"]) == pytest.approx(4 / 6)
+    with pytest.raises(ConfigError):
+        kendall_tau(["a", "b"], ["a", "c"])
