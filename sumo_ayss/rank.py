@@ -206,7 +206,10 @@ def write_ranking(
 
 
 def main(argv: Sequence[str] | None = None) -> None:
-    from sumo_ayss.pipeline import load_pipeline, run_pipeline
+    import dataclasses
+
+    from sumo_ayss.pipeline import load_pipeline, plan_jobs, run_pipeline
+    from sumo_ayss.report.options import MODES
 
     parser = argparse.ArgumentParser(
         prog="python -m sumo_ayss.rank", description=__doc__.splitlines()[0]
@@ -217,22 +220,41 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument(
         "--seeds", type=int, nargs="+", default=None, help="replace grid.seeds (e.g. 100 101 102)"
     )
+    parser.add_argument(
+        "--mode", choices=list(MODES), default=None, help="replace report.mode (default exposure)"
+    )
+    parser.add_argument(
+        "--no-run",
+        action="store_true",
+        help="rank the grid's existing run folders (with outcome.json) without running jobs",
+    )
     parser.add_argument("--no-live", action="store_true")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    report = None
     try:
         cfg = load_pipeline(args.config, workers=args.workers, out=args.out, seeds=args.seeds)
-        statuses, report = run_pipeline(cfg, live=not args.no_live)
+        if args.mode is not None:
+            cfg = dataclasses.replace(cfg, report=dataclasses.replace(cfg.report, mode=args.mode))
+        if args.no_run:
+            planned = [j.run_dir for j in plan_jobs(cfg)]
+            done = [d for d in planned if (d / "outcome.json").is_file()]
+            complete = len(done) == len(planned)
+            if not done:
+                raise ConfigError(f"--no-run: no finished run folder under {cfg.out}")
+        else:
+            statuses, report = run_pipeline(cfg, live=not args.no_live)
+            done = [s.spec.run_dir for s in statuses if s.state == "done"]
+            complete = len(done) == len(statuses)
+        analyses = analyse(done, cfg.report)
     except ConfigError as e:
         sys.exit(f"error: {e}")
-    done = [s.spec.run_dir for s in statuses if s.state == "done"]
-    analyses = analyse(done, cfg.report)
     checks = [c for a in analyses if (c := order_check(a, cfg.expected_order)) is not None]
     _, md = write_ranking(ranking_rows(analyses), cfg.out, checks, cfg.expected_order)
     print(md.read_text())
     if report is not None:
         print(f"report: {report}")
-    sys.exit(0 if len(done) == len(statuses) else 1)
+    sys.exit(0 if complete else 1)
 
 
 if __name__ == "__main__":

@@ -322,10 +322,12 @@ def verdict_sentence(
         how = f"Welch t-test, {c.n_a} vs {c.n_b} seeds"
     else:
         how = f"no test: {c.n_a} vs {c.n_b} seeds"
-    stats = f"{pct} CI of the difference {_fmt_ci(c.lo, c.hi)}; {how}, {_fmt_p(c.p)}"
-    amount = f"{abs(c.difference):.2f}" + (f" {unit}" if unit else "")
-    # Difference as "B's SPCPs ... than A's", where A is the one ranked safer.
+    # Stated as "B's SPCPs <score> than A's" (A ranked safer), with the interval of the
+    # stated amount: of B - A when B scores higher, of A - B otherwise.
     b_higher = c.difference < 0
+    lo, hi = (-c.hi, -c.lo) if b_higher else (c.lo, c.hi)
+    stats = f"{pct} CI {_fmt_ci(lo, hi)}; {how}, {_fmt_p(c.p)}"
+    amount = f"{abs(c.difference):.2f}" + (f" {unit}" if unit else "")
     what = score.format(amount=amount, more_less="more" if b_higher else "less")
     if c.significant and (c.difference > 0) == higher_is_safer:
         return (

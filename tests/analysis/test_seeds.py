@@ -124,3 +124,25 @@ def test_kendall_tau():
     assert kendall_tau(["b", "a", "c", "d"], ["a", "b", "c", "d"]) == pytest.approx(4 / 6)
     with pytest.raises(ConfigError):
         kendall_tau(["a", "b"], ["a", "c"])
+
+
+def test_verdict_sentence_states_amount_with_its_interval():
+    from sumo_ayss.analysis.seeds import verdict_sentence
+
+    safe, risky = _scores("safe", [9.0, 10.1, 8.0]), _scores("risky", [11.0, 12.2, 10.1])
+    c = compare_seeds(safe, risky)
+    text = verdict_sentence(
+        c,
+        higher_is_safer=False,
+        score="extract {amount} {more_less} reward per episode",
+        unit="",
+        mode="exposure",
+    )
+    assert text.startswith("[exposure mode] safe is safer than risky: risky's SPCPs extract")
+    assert "2.07 more reward per episode than safe's (95 % CI 1.9" in text
+    assert "paired t-test over 3 shared seeds, p < 0.001" in text
+    null = compare_seeds(_scores("a", [1.0, 2.0, 3.0]), _scores("b", [1.5, 1.5, 3.5]))
+    text = verdict_sentence(
+        null, higher_is_safer=False, score="score {amount} {more_less}", unit="m", mode="exposure"
+    )
+    assert text.startswith("[exposure mode] No significant difference in safety between a and b")
