@@ -104,3 +104,42 @@ def test_sigkill_then_rerun_finishes_without_redoing_finished_stages(tmp_path: P
             run = out / vut / f"seed_{seed}"
             assert (run / "spcp.json").is_file() and (run / "ayss.csv").is_file()
             assert json.loads((run / "evaluate.done.json").read_text())["inputs"]
+
+
+def test_pipeline_vuts_report_and_known_order_sections(tmp_path: Path) -> None:
+    ladder = {
+        "cautious": {"model": "IDM", "params": {"minGap": 12.0, "tau": 2.0}},
+        "bold": {"model": "IDM", "params": {"minGap": 1.0, "tau": 0.6}},
+    }
+    path = write_configs(
+        tmp_path,
+        [0, 1],
+        vuts=ladder,
+        report={"mode": "paper", "premise_reward": 0.5},
+        expected_order=["cautious", "bold"],
+    )
+    data = yaml.safe_load(path.read_text())
+    data["grid"]["vuts"] = ["bold", "cautious"]
+    path.write_text(yaml.safe_dump(data))
+    cfg = load_pipeline(path, seeds=[5, 6, 7])
+    assert cfg.grid.seeds == (5, 6, 7)
+    assert cfg.report.mode == "paper" and cfg.report.premise_reward == 0.5
+    jobs = plan_jobs(cfg)
+    assert [j.name for j in jobs[:3]] == [f"car_following/bold/seed_{s}" for s in (5, 6, 7)]
+    params = jobs[0].experiment["env"]["vuts"]["bold"]["params"]
+    assert params["minGap"] == 1.0 and params["tau"] == 0.6
+    assert "pi1" in jobs[0].experiment["env"]["vuts"]  # the built-ins stay
+
+
+@pytest.mark.parametrize(
+    ("extra", "match"),
+    [
+        ({"expected_order": ["pi1"]}, r"expected_order must list exactly the grid's VUTs"),
+        ({"report": {"mode": "fancy"}}, r"mode must be one of \['exposure', 'paper'\]"),
+        ({"report": {"premise_reward": -1}}, r"premise_reward must be a finite number >= 0"),
+        ({"vuts": {"x": {"model": "IDM", "params": {"tau": -1}}}}, r"vuts\.x"),
+    ],
+)
+def test_bad_pipeline_sections_are_refused(tmp_path: Path, extra: dict, match: str) -> None:
+    with pytest.raises(ConfigError, match=match):
+        load_pipeline(write_configs(tmp_path, [0], **extra))
