@@ -20,9 +20,9 @@ from pathlib import Path
 import matplotlib as mpl
 
 mpl.use("Agg")
-from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.figure import Figure
 
-from sumo_ayss.atomic import atomic_write_text  # noqa: E402
+from sumo_ayss.atomic import atomic_write_text
 
 
 def _per_seed(study: Path, case: str, vut: str) -> dict[int, float]:
