@@ -37,6 +37,7 @@ What is compared, and where the worlds legitimately differ:
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,10 +52,15 @@ from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import VUT_START_POS_M
 from sumo_ayss.sim.network import LANE_WIDTH_M, SPEED_LIMIT_MPS
 
-hw_road = pytest.importorskip("highway_env.road.road", reason="pip install -e '.[hwenv]'")
-from highway_env.road.lane import StraightLane  # noqa: E402
-from highway_env.vehicle.behavior import IDMVehicle  # noqa: E402
-from highway_env.vehicle.controller import ControlledVehicle  # noqa: E402
+try:
+    import highway_env  # noqa: F401
+except ImportError:  # pragma: no cover - the extra is missing
+    if os.environ.get("CI"):
+        raise  # CI installs the extra (make test): a missing highway-env is an error there
+    pytest.skip("highway-env missing: pip install -e '.[hwenv]'", allow_module_level=True)
+from highway_env.road.lane import StraightLane
+from highway_env.vehicle.behavior import IDMVehicle
+from highway_env.vehicle.controller import ControlledVehicle
 
 pytestmark = pytest.mark.sumo
 
