@@ -157,7 +157,7 @@ def run_highway_env(
     def record(tr: Trace) -> None:
         tr.h.append(float(pov.position[0] - vut.position[0] - L))
         tr.v_vut.append(float(vut.speed))
-        tr.v_pov.append(float(pov.speed))
+        tr.v_pov.append(float(pov.velocity[0]))  # longitudinal speed (the paper's v')
         tr.y_off.append(float(abs(pov.position[1])))
         tr.dvb.append(_dvb(pov.position, pov.velocity, vut.position, vut.velocity))
 

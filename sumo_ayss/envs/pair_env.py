@@ -363,7 +363,8 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         The POV (mode highway_env) is integrated first (its law ignores the VUT), giving its
         state at every sub-instant; the VUT's IDM is then re-evaluated at each sub-instant
         against it, as highway-env's ``Road.act`` / ``Road.step`` do. SUMO receives the
-        end state exactly: the POV by ``moveToXY``; a highway-env VUT by the mean of its
+        end state exactly: the POV by ``moveToXY`` (its speed in SUMO = its longitudinal
+        velocity, the paper's observed v'); a highway-env VUT by the mean of its
         sub-step speeds (SUMO's Euler update moves it by ``speed · step``, = highway-env's
         sum of ``speed · dt`` over the sub-steps); both speeds are put back after the step
         (:meth:`_sync_hwenv_speeds`). With the clipped actuator the POV drives its commanded
@@ -381,7 +382,9 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             pov_states = hw_pov.advance(n, dt)
             end = pov_states[-1]
             pair.move_pov_xy(end.x_m + half_pov, end.y_m, end.heading_rad)
-            pov_speed = self._v_pov = end.speed_mps
+            # SUMO holds the POV's longitudinal speed (what the paper's POV observes as v',
+            # "POV longitudinal speed"): speed · cos(heading), = speed outside lane changes.
+            pov_speed = self._v_pov = end.vx_mps
             self._accel = hw_pov.last_accel_mps2
         else:
             actuator = self._actuator
