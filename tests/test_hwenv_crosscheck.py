@@ -10,28 +10,41 @@ for the cut-in, the POV's lateral position and Δv̄ (relative velocity projecte
 relative position of the centres, velocities as speed along the heading).
 
 Tolerance: ``TOL`` = 1e-6 (m, m/s) on every decision of every episode. Why this and not
-more: both sides evaluate the same formulas on the same state in double precision; what
-differs is only bookkeeping that rounds, never modelling. SUMO holds positions along the
-lane and receives the POV's position by ``moveToXY`` (mapped back from world x, y) and the
-VUT's by a commanded speed over 0.2 s (``x += v·0.2`` instead of three ``v_k/15``);
-highway-env uses numpy (``np.power``, 2-D vectors) where we use ``math``. These are
-rounding differences of order 1e-12 m per step (measured max over all episodes: printed by
-the test on failure, about 1e-9); a real difference in the law (the zero clamp of the
-desired gap, bumper vs centre distance, a clip, one sub-step too few or an implicit
-instead of explicit Euler) moves h or v by 1e-3 to 1 within one decision, so 1e-6 tells
-them apart by three orders of magnitude either way.
+more or less: both sides evaluate the same formulas on the same state in double precision;
+what differs is only bookkeeping that rounds, never modelling. SUMO holds positions along
+the lane and receives the POV's position by ``moveToXY`` (mapped back from world x, y) and
+the VUT's by a commanded speed over 0.2 s (``x += v̄·0.2`` instead of three ``v_k/15``),
+and highway-env uses numpy (``np.power``, 2-D vectors) where we use ``math``. Measured
+over all 200 episodes: at most 1.1e-13 m in h, 3e-14 m laterally, 2e-14 m/s in speeds and
+1.3e-13 m/s in Δv̄, i.e. rounding. A real difference in a law (the zero clamp of the desired gap, bumper
+instead of centre distance, a missing clip, one sub-step too few, implicit instead of
+explicit Euler, a 1 m different DISTANCE_WANTED) moves h or v by 1e-3 to 1 within one
+decision (``test_crosscheck_detects_a_different_law``: 10 vs 20 m gives > 0.1 m/s), so 1e-6
+separates the two by three orders of magnitude or more either way. Collisions must be
+flagged at the same decision in every episode (measured: all agree, 32 collisions).
 
 What is compared, and where the worlds legitimately differ:
 
 * until the first collision in either world (after it highway-env pushes the cars apart
-  and freezes them; our env ends the episode). Collisions are checked by highway-env with
-  rotated rectangles every 1/15 s and by SUMO on lane-aligned bodies after each 0.2 s
-  step; the test asserts they flag the same decision in all but ``MAX_COLLISION_MISMATCH``
-  episodes and counts them;
-* highway-env lets a speed go negative (an IDM car at standstill too close backs away);
-  SUMO cannot. The initial conditions keep both speeds >= 5 m/s and the test asserts that
-  highway-env's speeds never went below 0 in the compared decisions, so this difference
-  is not exercised (it is documented in :mod:`sumo_ayss.hwenv_laws`).
+  and freezes them; our env ends the episode). In this mode our env checks collisions as
+  highway-env does (rotated 5 m x 2 m bodies after every 1/15 s sub-step, with its
+  one-sub-step look-ahead), not with SUMO's lane-aligned check; the test asserts both
+  worlds flag the same decision in every episode (``MAX_COLLISION_MISMATCH`` = 0);
+* initial VUT speeds from 0.5 m/s, not 0: a VUT created at speed v0 gets target speed v0,
+  and highway-env's IDM free-road term ``3·(1 − (v/v0)^4)`` has slope ``−12/v0`` at v0;
+  explicit Euler with dt = 1/15 s is unstable where ``12·dt/v0 > 2``, i.e. v0 < 0.4 m/s:
+  there the speed oscillates around v0, bounded only by the ±6 m/s² clip, and any rounding
+  difference grows by about ``12·dt/v0 − 1`` per sub-step (measured: an episode starting
+  at 0.26 m/s drifted to 1e-4 m/s after 18 decisions). Both implementations are then
+  equally right and no tolerance can hold; the law itself is the same (the test compares
+  it everywhere else);
+* up to the decision during which highway-env's speed first goes negative: highway-env
+  lets an IDM car at standstill too close to its leader back away (down to −40 m/s); a
+  SUMO vehicle cannot, ours stops at 0 (documented in :mod:`sumo_ayss.hwenv_laws`). Over
+  the paper's ODD (speeds 0-40 m/s) with these random POV commands that happens in a few
+  of the 50 episodes (measured: car-following 0 (pi1) / 1 (pi2), cut-in 0 / 1); those are
+  compared up to it and counted (at most ``MAX_REVERSALS``), and collisions are compared
+  only in episodes without it.
 """
 
 from __future__ import annotations
@@ -67,6 +80,11 @@ pytestmark = pytest.mark.sumo
 N_EPISODES = 50
 TOL = 1e-6
 MAX_COLLISION_MISMATCH = 0
+#: Below 6·a_max·dt = 0.4 m/s of target speed (= start speed) highway-env's explicit Euler
+#: IDM is unstable (see the module docstring): no tolerance holds there.
+MIN_VUT_SPEED_MPS = 0.5
+#: Episodes allowed to hit highway-env's reversing (compared only up to it), of 50.
+MAX_REVERSALS = 5
 SIM_HZ = 15
 DECISIONS = 25
 L = 5.0
@@ -102,12 +120,16 @@ class Trace:
     collision_at: int | None  # decision (1-based) at which a collision was flagged
 
 
-def _ics(seed: int) -> list[InitialCondition]:
+def _ics(seed: int, case: str = "car_following") -> list[InitialCondition]:
+    """The paper-fidelity ODD (configs/*_fidelity.yaml): speeds 0-40 m/s, gaps 2 (cut-in:
+    0) to 25 m; the VUT's speed from ``MIN_VUT_SPEED_MPS`` (see the module docstring)."""
     rng = np.random.default_rng(seed)
+    low_gap = 0.0 if case == "cut_in" else 2.0
     out = []
     for _ in range(N_EPISODES):
-        v_pov, v_vut = rng.uniform(5.0, 30.0, 2)
-        out.append(InitialCondition(float(v_pov), float(v_vut), float(rng.uniform(2.0, 25.0))))
+        v_pov = rng.uniform(0.0, 40.0)
+        v_vut = rng.uniform(MIN_VUT_SPEED_MPS, 40.0)
+        out.append(InitialCondition(float(v_pov), float(v_vut), float(rng.uniform(low_gap, 25.0))))
     return out
 
 
@@ -128,8 +150,9 @@ def _dvb(pov_xy, pov_v, vut_xy, vut_v) -> float:
 
 def run_highway_env(
     case: str, distance_wanted_m: float, ic: InitialCondition, profile: list[int], lc_at: int | None
-) -> tuple[Trace, float]:
-    """highway-env's own vehicles on its own road: lane i centred at y = i·3.2 m."""
+) -> tuple[Trace, int | None]:
+    """highway-env's own vehicles on its own road (lane i centred at y = i·3.2 m): the
+    trace, and the decision (1-based) during which a speed first went below 0, or None."""
     from highway_env.road.road import Road, RoadNetwork
 
     net = RoadNetwork()
@@ -163,7 +186,7 @@ def run_highway_env(
 
     tr = Trace([], [], [], [], [], None)
     record(tr)
-    min_speed = min(vut.speed, pov.speed)
+    reversed_at = None
     for j, k in enumerate(profile):
         if case == "car_following":
             pov.target_speed = cf_target(k, pov.speed)
@@ -174,14 +197,15 @@ def run_highway_env(
         for _ in range(SIM_HZ // 5):
             road.act()
             road.step(1 / SIM_HZ)
+            if reversed_at is None and min(vut.speed, pov.speed) < 0:
+                reversed_at = j + 1
             if vut.crashed or pov.crashed:
                 break
         if vut.crashed or pov.crashed:
             tr.collision_at = j + 1
             break
         record(tr)
-        min_speed = min(min_speed, vut.speed, pov.speed)
-    return tr, float(min_speed)
+    return tr, reversed_at
 
 
 def run_ours(
@@ -229,26 +253,33 @@ def test_trajectories_match_highway_env(case: str, vut: str, distance_wanted_m: 
     cls = CarFollowingEnv if case == "car_following" else CutInEnv
     env = cls(_config(case, vut), sumo_seed=0)
     worst = dict.fromkeys(("h", "v_vut", "v_pov", "y_off", "dvb"), 0.0)
-    collisions = mismatched = 0
+    collisions = mismatched = reversals = compared = 0
     try:
-        for i, ic in enumerate(_ics(seed=12)):
+        for i, ic in enumerate(_ics(seed=12, case=case)):
             profile, lc_at = _profile(case, seed=1000 + i)
-            ref, min_speed = run_highway_env(case, distance_wanted_m, ic, profile, lc_at)
+            ref, reversed_at = run_highway_env(case, distance_wanted_m, ic, profile, lc_at)
             ours = run_ours(env, ic, profile, lc_at)
-            assert min_speed >= 0.0, f"episode {i}: highway-env reversed ({min_speed} m/s)"
             n = min(len(ref.h), len(ours.h))
+            if reversed_at is not None:  # highway-env drives backwards, SUMO stops at 0
+                reversals += 1
+                n = min(n, reversed_at)  # states before that decision's end
+            compared += n - 1
             for name in worst:
                 a = np.asarray(getattr(ref, name)[:n])
                 b = np.asarray(getattr(ours, name)[:n])
                 worst[name] = max(worst[name], float(np.max(np.abs(a - b))))
             collisions += ref.collision_at is not None
-            if ref.collision_at != ours.collision_at:
+            if reversed_at is None and ref.collision_at != ours.collision_at:
                 mismatched += 1
                 print(f"episode {i}: collision hwenv {ref.collision_at} ours {ours.collision_at}")
     finally:
         env.close()
-    print(f"{case} {vut}: worst abs differences {worst}; collisions {collisions}")
+    print(
+        f"{case} {vut}: worst abs differences {worst}; collisions {collisions}; "
+        f"reversed in highway-env {reversals}; decisions compared {compared}"
+    )
     assert mismatched <= MAX_COLLISION_MISMATCH, f"{mismatched} collision mismatches"
+    assert reversals <= MAX_REVERSALS and compared >= 0.8 * N_EPISODES * DECISIONS
     for name, value in worst.items():
         assert value <= TOL, f"{name}: max |highway-env - ours| = {value:.3g} > {TOL} ({worst})"
     assert not math.isnan(sum(worst.values()))

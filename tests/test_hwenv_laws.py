@@ -109,3 +109,22 @@ def test_actuator_mode_errors_name_the_field() -> None:
         ActuatorConfig(mode="hwenv")  # type: ignore[arg-type]
     with pytest.raises(ConfigError, match=r"not used in mode highway_env"):
         ActuatorConfig(mode="highway_env", accel_min_mps2=-9.0)
+
+
+def test_paper_fidelity_pipeline_plans_the_grid() -> None:
+    """configs/paper_fidelity.yaml: both cases x hwenv pair x 3 seeds, highway-env laws."""
+    from sumo_ayss.config import PROJECT_ROOT
+    from sumo_ayss.pipeline import load_pipeline, plan_jobs
+
+    jobs = plan_jobs(load_pipeline(PROJECT_ROOT / "configs" / "paper_fidelity.yaml"))
+    assert sorted((j.case, j.vut, j.seed) for j in jobs) == sorted(
+        (c, v, s)
+        for c in ("car_following", "cut_in")
+        for v in ("hwenv_pi1", "hwenv_pi2")
+        for s in (0, 1, 2)
+    )
+    for job in jobs:
+        env = job.experiment["env"]
+        assert env["actuator"]["mode"] == "highway_env"
+        assert env["odd"]["vut_speed_mps"] == [0.0, 40.0]
+        assert env["vuts"][job.vut]["controller"]["target"].endswith(":HighwayEnvIDM")
