@@ -18,10 +18,11 @@ and highway-env uses numpy (``np.power``, 2-D vectors) where we use ``math``. Me
 over all 200 episodes: at most 1.1e-13 m in h, 3e-14 m laterally, 2e-14 m/s in speeds and
 1.3e-13 m/s in Δv̄, i.e. rounding. A real difference in a law (the zero clamp of the
 desired gap, bumper instead of centre distance, a missing clip, one sub-step too few,
-implicit instead of explicit Euler, a 1 m different DISTANCE_WANTED) moves h or v by 1e-3 to 1 within one
-decision (``test_crosscheck_detects_a_different_law``: 10 vs 20 m gives > 0.1 m/s), so 1e-6
-separates the two by three orders of magnitude or more either way. Collisions must be
-flagged at the same decision in every episode (measured: all agree, 32 collisions).
+implicit instead of explicit Euler, a 1 m different DISTANCE_WANTED) moves h or v by 1e-3
+to 1 within one decision (``test_crosscheck_detects_a_different_law``: 10 vs 20 m gives >
+0.1 m/s), so 1e-6 separates the two by three orders of magnitude or more either way.
+Collisions must be flagged at the same decision in every episode (measured: all agree, 32
+collisions).
 
 What is compared, and where the worlds legitimately differ:
 
