@@ -41,6 +41,14 @@ switched off for the VUT
 (:meth:`~sumo_ayss.sim.pair.VehiclePair.allow_vut_overtake_right`): without it, a VUT
 beside or behind a slower POV in the left lane would match its speed, not drive freely.
 
+Paper-fidelity mode (``env.actuator.mode: highway_env``, docs/paper_fidelity.md): the
+lane change instead retargets highway-env's lane-centring loop (its lateral speed rises
+and decays smoothly, about 2.3 s to settle within 0.1 m for 3.2 m); the POV's position is
+integrated in Python and put into SUMO (sublane model); "changing lanes" lasts until its
+centre is within ``env.actuator.lane_change_done_m`` of the target centre line; Δv̄ uses
+its velocity ``speed·(cos ψ, sin ψ)``; collisions are highway-env's when the VUT runs
+highway-env's IDM too.
+
 Reward ``R = α_A·R_A + α_C·R_C`` (:mod:`sumo_ayss.envs.rewards`), R_A on the state at the end
 of the decision (``info["reward_phase"]``):
 

@@ -4,6 +4,11 @@ A case (car-following, cut-in) subclasses :class:`PairEnv` and supplies its obse
 action decoding and reward. Timing: the policy acts every ``decision_period_s`` (0.2 s,
 5 Hz); an episode lasts ``episode_s`` (5 s, 25 decisions) and ends *truncated* after the
 last decision, or *terminated* at a collision.
+
+Paper-fidelity mode (docs/paper_fidelity.md): with ``env.actuator.mode: highway_env`` and/or
+a :class:`~sumo_ayss.hwenv_laws.HighwayEnvIDM` VUT (``hwenv_pi1``/``hwenv_pi2``), the env
+integrates highway-env's laws itself at ``env.actuator.substeps`` sub-steps per SUMO step
+and gives SUMO the exact end state (:meth:`PairEnv._command_hwenv`).
 """
 
 from __future__ import annotations
