@@ -811,9 +811,37 @@ def _paper_idm(min_gap_m: float, spacing_m: float) -> VehicleType:
     )
 
 
-#: The paper's two VUTs (Table I): pi1 (s0 = 10 m) and pi2 (s0 = 20 m).
+def _hwenv_idm(distance_wanted_m: float) -> VehicleType:
+    # highway-env's own IDMVehicle law (sumo_ayss.hwenv_laws), not SUMO's IDM: centre-to-
+    # centre distance, no zero clamp in the desired gap, +-6 m/s^2 clip, v0 = speed at the
+    # episode start (clipped to 30 m/s), 15 Hz Euler. Body: highway-env's 5 m x 2 m.
+    return VehicleType(
+        model="IDM",
+        params={"length": 5.0, "width": 2.0, "minGap": 0.0},
+        description=(
+            f"highway-env IDMVehicle, DISTANCE_WANTED = {distance_wanted_m:g} m "
+            "(centre to centre; the paper's s0)"
+        ),
+        controller=ControllerSpec(
+            target="sumo_ayss.hwenv_laws:HighwayEnvIDM",
+            params={"distance_wanted_m": distance_wanted_m},
+            max_accel_mps2=6.0,
+            max_decel_mps2=6.0,
+            max_speed_mps=40.0,
+        ),
+    )
+
+
+#: The paper's two VUTs (Table I): pi1 (s0 = 10 m) and pi2 (s0 = 20 m), as SUMO's IDM
+#: (``pi1``/``pi2``, s0 converted to minGap) and as highway-env's own IDMVehicle law
+#: (``hwenv_pi1``/``hwenv_pi2``, DISTANCE_WANTED 10 / 20 m; the paper-fidelity mode).
 BUILTIN_VUTS: Mapping[str, VehicleType] = MappingProxyType(
-    {"pi1": _paper_idm(5.0, 10.0), "pi2": _paper_idm(15.0, 20.0)}
+    {
+        "pi1": _paper_idm(5.0, 10.0),
+        "pi2": _paper_idm(15.0, 20.0),
+        "hwenv_pi1": _hwenv_idm(10.0),
+        "hwenv_pi2": _hwenv_idm(20.0),
+    }
 )
 
 #: The POV: speed and lane are commanded by our actuator, SUMO's own checks are off, so the

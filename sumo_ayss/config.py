@@ -57,6 +57,10 @@ class SimConfig:
     """SUMO step [s]; the policy acts every ``env.decision_period_s``."""
     lanechange_duration_s: float = 1.0
     """Duration of a POV lane change [s] (continuous lateral motion, ``--lanechange.duration``)."""
+    lateral_resolution_m: float | None = None
+    """SUMO's sublane model (``--lateral-resolution``) [m], or None (off). Needed by the
+    highway-env POV in cut-in (free lateral positions); SUMO then ignores
+    ``lanechange_duration_s`` (the two options exclude each other)."""
     collision_mingap_factor: float = 0.0
     """0: only physical overlap counts as a collision (SUMO's default flags a 0.3 m gap)."""
     extra_args: tuple[str, ...] = ()
@@ -70,25 +74,58 @@ class SimConfig:
             f"{s}.lanechange_duration_s must be > 0, got {self.lanechange_duration_s}",
         )
         _require(
+            self.lateral_resolution_m is None or self.lateral_resolution_m > 0,
+            f"{s}.lateral_resolution_m must be > 0 or null, got {self.lateral_resolution_m}",
+        )
+        _require(
             0 <= self.collision_mingap_factor <= 1,
             f"{s}.collision_mingap_factor must be in [0, 1], got {self.collision_mingap_factor}",
         )
 
 
+ActuatorMode = Literal["clipped", "highway_env"]
+
+
 @dataclass(frozen=True)
 class ActuatorConfig:
-    """The POV's speed controller: ``a = clip((v_target - v) / time_constant_s, min, max)``.
+    """The POV's controller. Section ``env.actuator``.
 
-    highway-env uses the same law with a 0.6 s time constant but no clipping; we clip to
-    the VUT's physical range [-6, 6] m/s² by default. Section ``env.actuator``.
+    ``mode: clipped`` (default): ``a = clip((v_target - v) / time_constant_s, min, max)``,
+    evaluated once per SUMO step; lane changes are SUMO's (constant lateral speed over
+    ``env.sim.lanechange_duration_s``).
+
+    ``mode: highway_env``: highway-env 1.8.2's ControlledVehicle (the paper's POV,
+    :mod:`sumo_ayss.hwenv_laws`): ``a = (v_target - v) / time_constant_s`` **unclipped**,
+    re-evaluated at each of ``substeps`` explicit-Euler sub-steps per SUMO step (3 per
+    0.2 s = highway-env's 15 Hz), and its lane-centring steering loop on a kinematic
+    bicycle for the cut-in (the lateral speed rises and decays smoothly, so Δv̄ depends
+    on it as in highway-env). The POV's state is integrated in Python and put into SUMO
+    exactly (``moveToXY``; cut-in needs SUMO's sublane model, ``env.sim.
+    lateral_resolution_m``). ``accel_min_mps2``/``accel_max_mps2`` must keep their
+    defaults there (highway-env does not clip); ``max_speed_mps`` is highway-env's
+    ``MAX_SPEED`` soft cap.
     """
 
     SECTION: ClassVar[str] = "env.actuator"
 
     time_constant_s: float = 0.6
+    """Speed-law time constant [s] (highway-env's ``TAU_ACC``)."""
     accel_min_mps2: float = -6.0
     accel_max_mps2: float = 6.0
     max_speed_mps: float = 40.0
+    mode: ActuatorMode = "clipped"
+    """``clipped`` (ours, default) or ``highway_env`` (highway-env's ControlledVehicle)."""
+    substeps: int = 3
+    """Euler sub-steps per SUMO step of highway-env's laws (POV in mode ``highway_env``,
+    and any highway-env IDM VUT): 3 with a 0.2 s step = highway-env's 15 Hz."""
+    tau_lateral_s: float = 0.6
+    """highway-env ``TAU_LATERAL`` [s] (mode ``highway_env``)."""
+    tau_heading_s: float = 0.2
+    """highway-env ``TAU_HEADING`` [s] (mode ``highway_env``)."""
+    lane_change_done_m: float = 0.1
+    """Mode ``highway_env``: the POV counts as changing lanes (cut-in reward phase) until
+    its centre is within this distance [m] of its target lane's centre line (highway-env's
+    lateral loop approaches the centre line only asymptotically)."""
 
     def __post_init__(self) -> None:
         s = self.SECTION
@@ -101,6 +138,29 @@ class ActuatorConfig:
             f"[{self.accel_min_mps2}, {self.accel_max_mps2}]",
         )
         _require(self.max_speed_mps > 0, f"{s}.max_speed_mps must be > 0, got {self.max_speed_mps}")
+        _require(
+            self.mode in typing.get_args(ActuatorMode),
+            f"{s}.mode must be one of {list(typing.get_args(ActuatorMode))}, got {self.mode!r}",
+        )
+        _require(
+            isinstance(self.substeps, int) and self.substeps >= 1,
+            f"{s}.substeps must be an integer >= 1, got {self.substeps!r}",
+        )
+        for name in ("tau_lateral_s", "tau_heading_s", "lane_change_done_m"):
+            value = getattr(self, name)
+            _require(value > 0, f"{s}.{name} must be > 0, got {value}")
+        if self.mode == "highway_env":
+            _require(
+                (self.accel_min_mps2, self.accel_max_mps2) == (-6.0, 6.0),
+                f"{s}.accel_min_mps2/accel_max_mps2 are not used in mode highway_env "
+                "(highway-env's ControlledVehicle does not clip); remove them, got "
+                f"[{self.accel_min_mps2}, {self.accel_max_mps2}]",
+            )
+
+    @property
+    def highway_env(self) -> bool:
+        """Whether the POV runs highway-env's ControlledVehicle."""
+        return self.mode == "highway_env"
 
 
 @dataclass(frozen=True)
@@ -241,6 +301,22 @@ class EnvConfig:
             self.decision_period_s > 0 and abs(ratio - round(ratio)) < 1e-9 and round(ratio) >= 1,
             f"{s}.decision_period_s must be a positive multiple of sim.step_length_s "
             f"({self.sim.step_length_s}), got {self.decision_period_s}",
+        )
+        _require(
+            not self.actuator.highway_env or round(ratio) == 1,
+            f"{s}.decision_period_s must equal sim.step_length_s with env.actuator.mode "
+            f"highway_env (one SUMO step per decision, {self.actuator.substeps} highway-env "
+            f"sub-steps inside it: actuator.substeps), got {self.decision_period_s} and "
+            f"{self.sim.step_length_s}",
+        )
+        _require(
+            not (
+                self.actuator.highway_env
+                and self.case == "cut_in"
+                and self.sim.lateral_resolution_m is None
+            ),
+            f"{s}.sim.lateral_resolution_m must be set (e.g. 0.1) with env.actuator.mode "
+            "highway_env in cut_in: the POV's free lateral position needs SUMO's sublane model",
         )
         if self.network is not None:
             path = Path(self.network)

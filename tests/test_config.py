@@ -38,7 +38,7 @@ def test_yaml_overrides_merge_over_defaults(tmp_path: Path) -> None:
         tmp_path,
     )
     assert cfg.vut_type.model == "Krauss"
-    assert set(cfg.vuts) == {"pi1", "pi2", "mine"}  # built-ins kept
+    assert set(cfg.vuts) == {"pi1", "pi2", "hwenv_pi1", "hwenv_pi2", "mine"}  # built-ins kept
     assert cfg.odd.gap_m == (1.0, 10.0)
     assert cfg.odd.vut_speed_mps == OddConfig().vut_speed_mps
     assert cfg.reward.same_lane.kind == "quadratic" and cfg.reward.same_lane.zero_m == 20.0
@@ -58,7 +58,10 @@ def test_round_trip_through_plain_dict(tmp_path: Path) -> None:
         ({"odd": {"gap_m": [10, 2]}}, r"env\.odd\.gap_m must have min <= max"),
         ({"odd": {"gap_m": [1, 2, 3]}}, r"env\.odd\.gap_m must have 2 items"),
         ({"case": "merge"}, r"env\.case must be one of \['car_following', 'cut_in'\]"),
-        ({"vut": "pi3"}, r"env\.vut must be one of \['pi1', 'pi2'\], got 'pi3'"),
+        (
+            {"vut": "pi3"},
+            r"env\.vut must be one of \['hwenv_pi1', 'hwenv_pi2', 'pi1', 'pi2'\], got 'pi3'",
+        ),
         (
             {"vuts": {"x": {"model": "IDMX"}}},
             r"env\.vuts\.x\.model must be one of \[.*'IDM'.*\], got 'IDMX' \(did you mean",

@@ -41,6 +41,14 @@ switched off for the VUT
 (:meth:`~sumo_ayss.sim.pair.VehiclePair.allow_vut_overtake_right`): without it, a VUT
 beside or behind a slower POV in the left lane would match its speed, not drive freely.
 
+Paper-fidelity mode (``env.actuator.mode: highway_env``, docs/paper_fidelity.md): the
+lane change instead retargets highway-env's lane-centring loop (its lateral speed rises
+and decays smoothly, about 2.3 s to settle within 0.1 m for 3.2 m); the POV's position is
+integrated in Python and put into SUMO (sublane model); "changing lanes" lasts until its
+centre is within ``env.actuator.lane_change_done_m`` of the target centre line; Δv̄ uses
+its velocity ``speed·(cos ψ, sin ψ)``; collisions are highway-env's when the VUT runs
+highway-env's IDM too.
+
 Reward ``R = α_A·R_A + α_C·R_C`` (:mod:`sumo_ayss.envs.rewards`), R_A on the state at the end
 of the decision (``info["reward_phase"]``):
 
@@ -178,6 +186,7 @@ class CutInEnv(PairEnv):
         self._vut_length_m = self.config.vut_type.length_m
         # h at which the POV's front is level with the VUT's rear (POV entirely behind).
         self._both_lengths_m = self._pov_length_m + self._vut_length_m
+        self._lc_done_m = self.config.actuator.lane_change_done_m
         self._lane: LaneState | None = None
         self._target_mps = 0.0
         self._lc_started = False
@@ -189,7 +198,10 @@ class CutInEnv(PairEnv):
         """See :meth:`PairEnv._start_episode`; adds the lateral state to ``info``."""
         values, info = super()._start_episode(ic)
         assert self._pair is not None and self._k is not None
-        self._pair.allow_vut_overtake_right()  # before the first step: the VUT drives freely
+        if self.config.sim.lateral_resolution_m is None:
+            # Before the first step: the VUT drives freely. (SUMO's sublane model has no
+            # per-vehicle lcOvertakeRight; the session passes the global option instead.)
+            self._pair.allow_vut_overtake_right()
         self._target_mps = ic.pov_speed_mps
         self._lc_started = self._lc_ignored = False
         info.update(self._lane_info(self._k))
@@ -219,6 +231,11 @@ class CutInEnv(PairEnv):
         if action == LANE_CHANGE:
             if lane.same_lane or lane.changing:
                 self._lc_ignored = True
+            elif self._hw_pov is not None:
+                # highway-env's ControlledVehicle: the lane change is a new target lane for
+                # its steering loop (integrated in Python, put into SUMO each step).
+                self._hw_pov.target_lane_y_m = pair.lane_centre_y_m(lane.vut_lane)
+                self._lc_started = True
             else:
                 # The request's duration only says how long SUMO keeps trying; the motion
                 # itself takes --lanechange.duration. Keep it for the whole episode.
@@ -257,13 +274,22 @@ class CutInEnv(PairEnv):
         pov_lane, vut_lane = pair.lanes()
         offset = pair.pov_lateral_offset_m()
         lat_pov, lat_vut = pair.lateral_speeds()
-        (pov_x, pov_y), (vut_x, vut_y) = pair.positions_xy()
+        (pov_x, pov_y), (vut_x, vut_y) = pair.world_fronts()
         pov_len, vut_len = self._pov_length_m, self._vut_length_m
-        changing = abs(offset) > _LATERAL_EPS or abs(lat_pov) > _LATERAL_EPS
+        hw = self._hw_pov
+        if hw is None:
+            changing = abs(offset) > _LATERAL_EPS or abs(lat_pov) > _LATERAL_EPS
+            pov_vx = k.pov_speed_mps
+        else:
+            # highway-env's POV: velocity = speed along its heading (SUMO, moved by moveToXY,
+            # reports no lateral speed); changing until settled near the target centre line.
+            st = hw.state
+            pov_vx, lat_pov = st.vx_mps, st.vy_mps
+            changing = abs(st.y_m - hw.target_lane_y_m) > self._lc_done_m
         dvb = _delta_v_bar(
             (vut_x - 0.5 * vut_len) - (pov_x - 0.5 * pov_len),
             vut_y - pov_y,
-            k.vut_speed_mps - k.pov_speed_mps,
+            k.vut_speed_mps - pov_vx,
             lat_vut - lat_pov,
         )
         self._lane = LaneState(

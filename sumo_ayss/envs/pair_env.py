@@ -4,6 +4,11 @@ A case (car-following, cut-in) subclasses :class:`PairEnv` and supplies its obse
 action decoding and reward. Timing: the policy acts every ``decision_period_s`` (0.2 s,
 5 Hz); an episode lasts ``episode_s`` (5 s, 25 decisions) and ends *truncated* after the
 last decision, or *terminated* at a collision.
+
+Paper-fidelity mode (docs/paper_fidelity.md): with ``env.actuator.mode: highway_env`` and/or
+a :class:`~sumo_ayss.hwenv_laws.HighwayEnvIDM` VUT (``hwenv_pi1``/``hwenv_pi2``), the env
+integrates highway-env's laws itself at ``env.actuator.substeps`` sub-steps per SUMO step
+and gives SUMO the exact end state (:meth:`PairEnv._command_hwenv`).
 """
 
 from __future__ import annotations
@@ -24,6 +29,13 @@ from sumo_ayss.controllers import ControlledVut
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_condition
 from sumo_ayss.envs.rewards import total_reward
 from sumo_ayss.errors import ActionError, ConfigError
+from sumo_ayss.hwenv_laws import (
+    HighwayEnvIDM,
+    HighwayEnvPov,
+    KinematicState,
+    LateralParams,
+    collision_check,
+)
 from sumo_ayss.sim.actuator import next_speed, pov_acceleration
 from sumo_ayss.sim.network import ROAD_EDGE, ROAD_LENGTH_M, network_path
 from sumo_ayss.sim.pair import PairPlacement, VehiclePair
@@ -116,6 +128,41 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         # A user controller VUT (None for SUMO's own models): it computes the VUT's speed
         # before every SUMO step, from what a real vehicle would sense.
         self._vut_control = ControlledVut.from_vehicle_type(config.vut_type, self._dt_s)
+        # highway-env's laws (sumo_ayss.hwenv_laws), integrated here at ``substeps`` Euler
+        # sub-steps per SUMO step: the POV in actuator mode highway_env, and a VUT whose
+        # controller is HighwayEnvIDM. None in the default mode (no per-step cost there).
+        self._hw_pov: HighwayEnvPov | None = None
+        if self._actuator.highway_env:
+            act = self._actuator
+            self._hw_pov = HighwayEnvPov(
+                act.time_constant_s,
+                LateralParams(
+                    tau_lateral_s=act.tau_lateral_s,
+                    tau_heading_s=act.tau_heading_s,
+                    length_m=self._pov_length_m,
+                ),
+                act.max_speed_mps,
+            )
+        controller = None if self._vut_control is None else self._vut_control.controller
+        self._hw_vut: HighwayEnvIDM | None = (
+            controller if isinstance(controller, HighwayEnvIDM) else None
+        )
+        self._hw = self._hw_pov is not None or self._hw_vut is not None
+        # Both vehicles on highway-env's laws: collisions are highway-env's too (rotated
+        # bodies checked every sub-step, incl. its one-sub-step look-ahead), not SUMO's.
+        self._hw_collisions = self._hw_pov is not None and self._hw_vut is not None
+        self._hw_collided = False
+        self._hw_impact = False  # highway-env's look-ahead hit: crashed at the next sub-step
+        self._hw_bodies = (
+            (config.vut_type.length_m, config.pov.length_m),
+            (
+                float(config.vut_type.params.get("width", 1.8)),
+                float(config.pov.params.get("width", 1.8)),
+            ),
+        )
+        self._hw_pending: tuple[float | None, float | None] | None = None
+        self._hw_vut_lane_y = 0.0
+        self._hw_vut_lane_w = 0.0
         self._decisions = 0
         self._v_pov = 0.0
         self._target = 0.0  # the POV's target speed of the current decision [m/s]
@@ -221,6 +268,8 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         pair.place(self._placement(ic))
         if self._vut_control is not None:
             self._vut_control.start(pair)  # speed mode 0 for the VUT, controller.reset()
+        if self._hw:
+            self._start_hwenv(pair, ic)
         self.initial_condition = ic
         self._decisions = 0
         self._v_pov = ic.pov_speed_mps
@@ -243,6 +292,9 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         """The actuator's next POV speed, commanded for the coming SUMO step."""
         pair = self._pair
         assert pair is not None
+        if self._hw:
+            self._command_hwenv(pair)
+            return
         actuator = self._actuator
         accel = self._accel = pov_acceleration(self._v_pov, self._target, actuator)
         v = self._v_pov = next_speed(self._v_pov, accel, self._dt_s, actuator)
@@ -264,6 +316,10 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         """
         pair = self._pair
         assert pair is not None
+        if self._hw_pending is not None:
+            self._sync_hwenv_speeds(pair)
+        if self._hw_collisions:
+            collided = self._hw_collided
         self._decisions += 1
         k = self._k = self._kinematics()
         r_a, extra = self._reward_terms(k, collided)
@@ -276,7 +332,11 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             "headway_m": k.headway_m,
             "ttc_s": time_to_collision_s(k.headway_m, k.vut_speed_mps, k.pov_speed_mps),
             "pov_accel_mps2": self._accel,
-            "vut_accel_mps2": pair.vut_accel_mps2(),
+            "vut_accel_mps2": (
+                pair.vut_accel_mps2()
+                if self._hw_vut is None or self._vut_control is None
+                else self._vut_control.last_command_mps2
+            ),
             "target_speed_mps": self._target,
             "collision": collided,
             "reward_adversarial": r_a,
@@ -285,6 +345,102 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             **extra,
         }
         return self._observation_values(k), reward, terminated, truncated, info
+
+    # ------------------------------------------------------------------ highway-env laws
+
+    def _start_hwenv(self, pair: VehiclePair, ic: InitialCondition) -> None:
+        """Initialise highway-env's POV / VUT states from the placed vehicles."""
+        (pov_x, pov_y), _ = pair.world_fronts()
+        pov_lane, vut_lane = pair.lanes()
+        self._hw_vut_lane_y = pair.lane_centre_y_m(vut_lane)
+        self._hw_vut_lane_w = pair.lane_width_m(vut_lane)
+        self._hw_pending = None
+        self._hw_collided = self._hw_impact = False
+        if self._hw_pov is not None:
+            state = KinematicState(pov_x - 0.5 * self._pov_length_m, pov_y, 0.0, ic.pov_speed_mps)
+            self._hw_pov.start(state, pair.lane_centre_y_m(pov_lane))
+        if self._hw_vut is not None:
+            self._hw_vut.start(ic.vut_speed_mps)
+
+    def _command_hwenv(self, pair: VehiclePair) -> None:
+        """One SUMO step of highway-env's laws: ``substeps`` Euler sub-steps in Python.
+
+        The POV (mode highway_env) is integrated first (its law ignores the VUT), giving its
+        state at every sub-instant; the VUT's IDM is then re-evaluated at each sub-instant
+        against it, as highway-env's ``Road.act`` / ``Road.step`` do. SUMO receives the
+        end state exactly: the POV by ``moveToXY`` (its speed in SUMO = its longitudinal
+        velocity, the paper's observed v'); a highway-env VUT by the mean of its
+        sub-step speeds (SUMO's Euler update moves it by ``speed · step``, = highway-env's
+        sum of ``speed · dt`` over the sub-steps); both speeds are put back after the step
+        (:meth:`_sync_hwenv_speeds`). With the clipped actuator the POV drives its commanded
+        speed over the whole step (SUMO's Euler), which the VUT sees sub-step by sub-step.
+        """
+        if self._hw_pending is not None:
+            self._sync_hwenv_speeds(pair)
+        n = self._actuator.substeps
+        dt = self._dt_s / n
+        half_pov = 0.5 * self._pov_length_m
+        pov_speed: float | None = None
+        hw_pov = self._hw_pov
+        if hw_pov is not None:
+            hw_pov.target_speed_mps = self._target
+            pov_states = hw_pov.advance(n, dt)
+            end = pov_states[-1]
+            pair.move_pov_xy(end.x_m + half_pov, end.y_m, end.heading_rad)
+            # SUMO holds the POV's longitudinal speed (what the paper's POV observes as v',
+            # "POV longitudinal speed"): speed · cos(heading), = speed outside lane changes.
+            pov_speed = self._v_pov = end.vx_mps
+            self._accel = hw_pov.last_accel_mps2
+        else:
+            actuator = self._actuator
+            accel = self._accel = pov_acceleration(self._v_pov, self._target, actuator)
+            v = self._v_pov = next_speed(self._v_pov, accel, self._dt_s, actuator)
+            pair.command_pov_speed(v)
+            pov_states = []
+            if self._hw_vut is not None:
+                (x, y), _ = pair.world_fronts()
+                x0 = x - half_pov
+                pov_states = [KinematicState(x0 + v * j * dt, y, 0.0, v) for j in range(n)]
+        vut_speed: float | None = None
+        if self._hw_vut is not None and self._vut_control is not None:
+            (_, _), (vx, vy) = pair.world_fronts()
+            _, _, _, v_vut = pair.longitudinal()
+            own = KinematicState(vx - 0.5 * self._hw_vut.length_m, vy, 0.0, v_vut)
+            states = self._hw_vut.advance(
+                own, self._hw_vut_lane_y, self._hw_vut_lane_w, pov_states[:n], dt
+            )
+            mean_speed = (states[-1].x_m - own.x_m) / self._dt_s
+            pair.command_vut_speed(mean_speed)
+            vut_speed = states[-1].speed_mps
+            self._vut_control.last_command_mps2 = (vut_speed - v_vut) / self._dt_s
+            if self._hw_collisions:
+                self._check_hwenv_collisions(states, pov_states[1:], dt)
+        elif self._vut_control is not None:
+            self._vut_control.before_step(pair)
+        self._hw_pending = (pov_speed, vut_speed)
+
+    def _check_hwenv_collisions(
+        self, vut: list[KinematicState], pov: list[KinematicState], dt_s: float
+    ) -> None:
+        """highway-env's collision test after each sub-step (``Road.step``): overlap now,
+        or a look-ahead hit at the previous sub-step (its ``impact``, crashed one later)."""
+        lengths, widths = self._hw_bodies
+        for a, b in zip(vut, pov, strict=True):
+            if self._hw_impact:
+                self._hw_collided = True
+                return
+            hit, will_hit = collision_check(a, b, dt_s, lengths, widths)
+            if hit:
+                self._hw_collided = True
+                return
+            self._hw_impact = will_hit
+
+    def _sync_hwenv_speeds(self, pair: VehiclePair) -> None:
+        """After a SUMO step: give SUMO highway-env's end-of-step speeds (see above)."""
+        pending = self._hw_pending
+        self._hw_pending = None
+        if pending is not None:
+            pair.set_speed_state(*pending)
 
     def _join_shared(self, pair: VehiclePair, sumo_seed: int) -> None:
         """Become a member of a vec env: drive ``pair`` in a simulation the env does not own.

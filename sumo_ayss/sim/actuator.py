@@ -20,8 +20,13 @@ def pov_acceleration(speed_mps: float, target_speed_mps: float, cfg: ActuatorCon
     """Acceleration [m/s²] that drives ``speed_mps`` toward ``target_speed_mps``.
 
     ``a = clip((v_target - v) / time_constant_s, accel_min_mps2, accel_max_mps2)``, with the
-    target first clipped to ``[0, max_speed_mps]``.
+    target first clipped to ``[0, max_speed_mps]``. In ``mode: highway_env``:
+    highway-env's ``ControlledVehicle.speed_control``, ``(v_target - v) / time_constant_s``
+    with neither clip (what the action implies at the decision's first sub-step; the speed
+    itself is soft-capped at ``max_speed_mps`` by the kinematics).
     """
+    if cfg.mode == "highway_env":
+        return (target_speed_mps - speed_mps) / cfg.time_constant_s
     target = min(max(target_speed_mps, 0.0), cfg.max_speed_mps)
     accel = (target - speed_mps) / cfg.time_constant_s
     return min(max(accel, cfg.accel_min_mps2), cfg.accel_max_mps2)
@@ -31,6 +36,9 @@ def pov_acceleration_array(
     speed_mps: npt.ArrayLike, target_speed_mps: npt.ArrayLike, cfg: ActuatorConfig
 ) -> npt.NDArray[np.float64]:
     """Vectorised :func:`pov_acceleration` (same law, elementwise)."""
+    if cfg.mode == "highway_env":
+        v_target = np.asarray(target_speed_mps, dtype=float)
+        return (v_target - np.asarray(speed_mps, dtype=float)) / cfg.time_constant_s
     target = np.clip(np.asarray(target_speed_mps, dtype=float), 0.0, cfg.max_speed_mps)
     accel = (target - np.asarray(speed_mps, dtype=float)) / cfg.time_constant_s
     return np.clip(accel, cfg.accel_min_mps2, cfg.accel_max_mps2)

@@ -180,6 +180,83 @@ class VehiclePair:
         """Whether either vehicle of the pair is in ``colliding`` (ids from the session)."""
         return bool(colliding) and (self.vut in colliding or self.pov in colliding)
 
+    # ------------------------------------------------------------------ highway-env laws
+
+    def move_pov_xy(self, x_front_m: float, y_m: float, heading_rad: float) -> None:
+        """Put the POV's front bumper centre at world ``(x, y)`` in the next step.
+
+        For highway-env's POV (:mod:`sumo_ayss.hwenv_laws`), whose state is integrated in
+        Python: ``moveToXY`` (keepRoute 1: stay on the road, free lateral position with
+        SUMO's sublane model; without it SUMO snaps the POV to the nearest lane centre,
+        exact in car-following). SUMO's body stays aligned with the lane; ``heading_rad``
+        (from +x toward +y) only sets the drawn angle. SUMO then reports the distance moved
+        over the step as the speed: :meth:`set_speed_state` puts highway-env's speed back.
+        """
+        angle_deg = 90.0 - math.degrees(heading_rad)
+        try:
+            _move_to_xy(self.pov, self.edge, -1, x_front_m, y_m, angle_deg, 1)
+        except SUMO_ERRORS as e:
+            raise SimulationError(
+                f"moving POV {self.pov} to ({x_front_m}, {y_m}) failed: {e}"
+            ) from e
+
+    def set_speed_state(self, pov_speed_mps: float | None, vut_speed_mps: float | None) -> None:
+        """Overwrite the speed SUMO holds for the POV and/or the VUT (``None``: leave it).
+
+        With highway-env's explicit Euler a vehicle moves by its speed *before* a sub-step;
+        the env commands the mean of those speeds for the SUMO step (so the position is
+        exact) and then sets the speed at the step's end here (``setPreviousSpeed``), so
+        that everything reading SUMO afterwards sees highway-env's state.
+        """
+        try:
+            if pov_speed_mps is not None:
+                _set_previous_speed(self.pov, pov_speed_mps)
+            if vut_speed_mps is not None:
+                _set_previous_speed(self.vut, vut_speed_mps)
+        except SUMO_ERRORS as e:
+            raise SimulationError(f"pair {self.prefix}: setting speeds failed: {e}") from e
+
+    def lane_centre_y_m(self, lane: int) -> float:
+        """World y of the centre line of ``lane`` of the pair's road [m] (straight roads)."""
+        return self._world_lanes()[1][lane]
+
+    def road_origin_x_m(self) -> float:
+        """World x of the road's start [m]: world x = this + lane position (straight roads)."""
+        return self._world_lanes()[0]
+
+    def _world_lanes(self) -> tuple[float, list[float]]:
+        """(world x of the road's start, world y of each lane's centre line), cached."""
+        cached: tuple[float, list[float]] | None = getattr(self, "_world_lanes_cache", None)
+        if cached is None:
+            n = libsumo.edge.getLaneNumber(self.edge)
+            shapes = [libsumo.lane.getShape(f"{self.edge}_{i}") for i in range(n)]
+            cached = (float(shapes[0][0][0]), [float(sh[0][1]) for sh in shapes])
+            self._world_lanes_cache = cached
+        return cached
+
+    def world_fronts(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """World ``(x, y)`` of the POV's and the VUT's front bumper centre [m], from lane
+        coordinates (lane position, lane centre, lateral offset; straight roads along +x).
+
+        Unlike :meth:`positions_xy`, right after :meth:`place` (before a step) this is
+        already the placed state: SUMO updates ``getPosition`` only in the next step.
+        """
+        x0 = self.road_origin_x_m()
+        out = []
+        for vid in (self.pov, self.vut):
+            try:
+                lane = _get_lane_index(vid)
+                x = x0 + _get_lane_pos(vid)
+                y = self.lane_centre_y_m(lane) + _get_lateral_lane_pos(vid)
+            except SUMO_ERRORS as e:
+                raise SimulationError(f"pair {self.prefix}: reading {vid} failed: {e}") from e
+            out.append((x, y))
+        return out[0], out[1]
+
+    def lane_width_m(self, lane: int) -> float:
+        """Width of ``lane`` of the pair's road [m]."""
+        return self._lane_geometry()[1][lane]
+
     # ------------------------------------------------------------------ lateral (cut-in)
 
     def lateral_speeds(self) -> tuple[float, float]:
@@ -300,6 +377,8 @@ class VehiclePair:
 # Getters of the lateral (cut-in) methods, bound like the hot-path ones above.
 _get_lateral_speed = _libsumo.vehicle_getLateralSpeed
 _get_lateral_lane_pos = _libsumo.vehicle_getLateralLanePosition
+_move_to_xy = libsumo.vehicle.moveToXY
+_set_previous_speed = libsumo.vehicle.setPreviousSpeed
 
 
 class VutSensing(NamedTuple):

@@ -89,8 +89,18 @@ class SumoSession:
             "--collision.mingap-factor", repr(s.collision_mingap_factor),
             "--time-to-teleport", "-1",
             # Continuous lateral motion for lane changes (the POV's cut-in has a real
-            # lateral velocity); without it SUMO changes lanes instantaneously.
-            "--lanechange.duration", repr(s.lanechange_duration_s),
+            # lateral velocity); without it SUMO changes lanes instantaneously. The sublane
+            # model (free lateral positions, for highway-env's POV) excludes this option.
+            *(
+                ("--lanechange.duration", repr(s.lanechange_duration_s))
+                if s.lateral_resolution_m is None
+                # The sublane model's lane-change model (SL2015) has no per-vehicle
+                # lcOvertakeRight: allow overtaking on the right globally instead.
+                else (
+                    "--lateral-resolution", repr(s.lateral_resolution_m),
+                    "--lanechange.overtake-right", "true",
+                )
+            ),
             "--no-step-log", "true",
             "--no-warnings", "true",
             "--duration-log.disable", "true",
