@@ -42,6 +42,7 @@ from sumo_ayss.scenarios.ayss import DEFAULT_AYSS_SEED, AyssConfig, run_ayss
 from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_N, DEFAULT_OUTCOME_SEED, run_outcome
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.scenarios.tables import read_json, write_json, write_table
+from sumo_ayss.threads import set_torch_threads
 
 __all__ = ["EvaluationResult", "evaluate_run", "load_run", "main"]
 
@@ -281,6 +282,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
     t0 = time.perf_counter()
     try:
+        set_torch_threads(load_run(args.run_dir).config.train.torch_threads)
         overrides: dict[str, Any] = {"n_samples": args.n_ayss}
         if args.seed is not None:
             overrides["seed"] = args.seed

@@ -10,6 +10,7 @@ Every key is optional (defaults in code); unknown keys are rejected with a sugge
 from __future__ import annotations
 
 import dataclasses
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
@@ -38,6 +39,11 @@ class TrainConfig:
     torch_threads: int = 1
     """PyTorch intra-op threads; 1 lets parallel runs share cores without contention."""
     progress_bar: bool = True
+    device: str = "cpu"
+    """Torch device of the learner: ``"cpu"`` or ``"cuda"`` (``"cuda:<index>"`` for one GPU of
+    several). SUMO, the replay buffer's storage and candidate evaluation stay on the CPU; the
+    networks, the minibatches and the gradient steps run on ``device``. A CUDA device that
+    torch cannot see fails the run at its start (:func:`sumo_ayss.train.check_device`)."""
     n_envs: int = 1
     """VUT-POV pairs collecting transitions side by side. 1: one env (SB3 ``DummyVecEnv``);
     > 1: that many pairs in the process's one SUMO simulation
@@ -62,6 +68,11 @@ class TrainConfig:
             self.eval_every <= self.total_timesteps,
             f"{s}.eval_every ({self.eval_every}) must be <= total_timesteps "
             f"({self.total_timesteps})",
+        )
+        _require(
+            isinstance(self.device, str)
+            and re.fullmatch(r"cpu|cuda(:[0-9]+)?", self.device) is not None,
+            f"{s}.device must be 'cpu', 'cuda' or 'cuda:<index>', got {self.device!r}",
         )
         _require(
             self.selection in CRITERIA,

@@ -241,6 +241,7 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
     from sumo_ayss.evaluate import evaluate_run
     from sumo_ayss.experiment import experiment_from_dict
     from sumo_ayss.scenarios.ayss import AyssConfig
+    from sumo_ayss.threads import set_torch_threads
     from sumo_ayss.train import train
 
     run_dir = spec.run_dir
@@ -254,6 +255,7 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
     stages: dict[str, str] = {}
     try:
         cfg = experiment_from_dict(spec.experiment, run_dir)
+        set_torch_threads(cfg.train.torch_threads)  # for evaluate too, when training is skipped
         if (run_dir / "spcp.json").is_file() and (run_dir / "config.yaml").is_file():
             from sumo_ayss.train import _check_same_config
 
@@ -338,15 +340,25 @@ def _die_with_parent() -> None:
         libc.prctl(pr_set_pdeathsig, signal.SIGKILL)
 
 
+def _init_worker() -> None:
+    """Worker initializer: die with the parent; one BLAS/OpenMP thread unless the user set one.
+
+    Runs in the fresh (spawned) worker before any job imports torch, so torch's intra-op pool
+    starts with one thread (``run_job`` then applies ``train.torch_threads``).
+    """
+    _die_with_parent()
+    from sumo_ayss.threads import single_thread_env
+
+    single_thread_env()
+
+
 def run_grid_local(
     jobs: Sequence[JobSpec], workers: int, retries: int, live: bool
 ) -> list[JobStatus]:
     """Run ``jobs`` on a local process pool with retries and a live table."""
     statuses = [JobStatus(j) for j in jobs]
     ctx = multiprocessing.get_context("spawn")  # fresh interpreters: no inherited libsumo
-    with ProcessPoolExecutor(
-        max_workers=workers, mp_context=ctx, initializer=_die_with_parent
-    ) as pool:
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker) as pool:
         pending: dict[Future[dict[str, Any]], JobStatus] = {}
 
         def submit(s: JobStatus) -> None:

@@ -200,7 +200,7 @@ class Trainer:
             hparams_for_n_envs(self.cfg.agent, self.n_envs),
             seed=self.seed,
             tensorboard_log=str(self.run_dir / "tb"),
-            device="cpu",
+            device=check_device(self.cfg.train.device),
         )
         return self.model
 
@@ -357,7 +357,7 @@ class Trainer:
         model = AyssDQN.load(
             str(latest / "model.zip"),
             env=self.vec_env,
-            device="cpu",
+            device=check_device(self.cfg.train.device),
             tensorboard_log=str(self.run_dir / "tb"),
         )
         model.load_replay_buffer(latest / "replay.pkl")
@@ -436,6 +436,31 @@ class _CandidateCallback(BaseCallback):
         elif bool(self.locals["dones"][0]):
             trainer.candidate()
         return True
+
+
+def check_device(device: str) -> str:
+    """Return ``device`` (``train.device``) if torch can use it, else raise :class:`ConfigError`.
+
+    Args:
+        device: ``"cpu"``, ``"cuda"`` or ``"cuda:<index>"``.
+
+    Raises:
+        ConfigError: a CUDA device was asked for and torch has no CUDA (CPU-only build, no
+            driver, no GPU) or fewer GPUs than the index.
+    """
+    if device.startswith("cuda"):
+        if not th.cuda.is_available():
+            raise ConfigError(
+                f"train.device is {device!r} but torch {th.__version__} sees no CUDA device "
+                f"(torch built with CUDA {th.version.cuda}); use train.device: cpu"
+            )
+        index = int(device.partition(":")[2] or 0)
+        if index >= th.cuda.device_count():
+            raise ConfigError(
+                f"train.device is {device!r} but torch sees {th.cuda.device_count()} CUDA "
+                f"device(s): cuda:0 .. cuda:{th.cuda.device_count() - 1}"
+            )
+    return device
 
 
 def hparams_for_n_envs(hparams: DQNHyperParams, n_envs: int) -> DQNHyperParams:

@@ -15,12 +15,14 @@ class GreedyPolicy:
     """``obs (N, d) float32 -> actions (N,) int64``: argmax of the online Q network.
 
     One batched forward pass per call, without SB3's ``predict`` bookkeeping, so a Monte
-    Carlo stage can evaluate many thousands of observations at once.
+    Carlo stage can evaluate many thousands of observations at once. Runs on the model's
+    device (observations in and actions out are numpy arrays on the host).
     """
 
     def __init__(self, model: AyssDQN) -> None:
         self.q_net = model.q_net
         self.q_net.set_training_mode(False)
+        self.device = model.device
 
     @classmethod
     def load(cls, path: str | Path) -> GreedyPolicy:
@@ -28,7 +30,8 @@ class GreedyPolicy:
 
     def q_values(self, obs: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
         with th.no_grad():
-            return self.q_net(th.as_tensor(np.asarray(obs, dtype=np.float32))).numpy()
+            obs_t = th.as_tensor(np.asarray(obs, dtype=np.float32), device=self.device)
+            return self.q_net(obs_t).cpu().numpy()
 
     def __call__(self, obs: npt.NDArray[np.float32]) -> npt.NDArray[np.int64]:
         return self.q_values(obs).argmax(axis=1).astype(np.int64)
