@@ -8,9 +8,10 @@
 * Huber loss, weighted by the importance weights when ``prioritized``; the sampled
   transitions' priorities are then set to ``|δ| + eps``, and β is annealed linearly from
   ``per_beta0`` to 1 (:attr:`AyssDQN.per_beta`);
-* per gradient step: one buffer sample, three forward passes, one backward, a gradient-norm
-  clip, one fused-Adam step, one device->host copy (the TD errors, only with PER) and no
-  logger calls (the loss is logged once per ``train()`` call).
+* per gradient step: one buffer sample, three forward passes (functional calls on the
+  layers, :func:`~sumo_ayss.agents.policies._run_mlp`), one backward, a gradient-norm clip,
+  one fused-Adam step, one device->host copy (the TD errors, only with PER) and no logger
+  calls (the loss is logged once per ``train()`` call).
 """
 
 from __future__ import annotations
@@ -196,7 +197,8 @@ class AyssDQN(DQN):
             else:
                 loss = F.smooth_l1_loss(current_q, target_q)
 
-            optimizer.zero_grad(set_to_none=True)
+            for param in params:  # optimizer.zero_grad(set_to_none=True), minus its wrappers
+                param.grad = None
             loss.backward()
             _clip_grad_norm(params, max_norm)
             optimizer.step()

@@ -22,6 +22,7 @@ from stable_baselines3.common.torch_layers import (
 from stable_baselines3.common.type_aliases import PyTorchObs, Schedule
 from stable_baselines3.dqn.policies import DQNPolicy
 from torch import nn
+from torch.nn import functional as F
 
 DEFAULT_ARCH: tuple[int, ...] = (256, 256)
 
@@ -92,12 +93,21 @@ class DuelingQNetwork(BasePolicy):
             )
 
     def forward(self, obs: PyTorchObs) -> th.Tensor:
-        """Return Q-values, shape (batch, n_actions)."""
-        hidden = self.feature_net(self.extract_features(obs, self.features_extractor))
+        """Return Q-values, shape (batch, n_actions).
+
+        The MLPs run as direct ``F.linear``/``F.relu`` calls on their layers' parameters (the
+        same ops ``nn.Linear``/``nn.ReLU`` run, so bitwise the same result and gradients)
+        without ``nn.Module.__call__`` per layer: about 20 module calls per forward, three
+        forwards per gradient step. Forward hooks registered on the MLPs' layers are
+        therefore not called; an MLP with any layer other than ``Linear``/``ReLU`` runs
+        through its modules as usual.
+        """
+        hidden = _run_mlp(self.feature_net, self.extract_features(obs, self.features_extractor))
         if not self.dueling:
-            return self.q_head(hidden)
-        advantages = self.advantage_net(hidden)
-        return self.value_net(hidden) + advantages - advantages.mean(dim=1, keepdim=True)
+            return _run_mlp(self.q_head, hidden)
+        advantages = _run_mlp(self.advantage_net, hidden)
+        value = _run_mlp(self.value_net, hidden)
+        return value + advantages - advantages.mean(dim=1, keepdim=True)
 
     def _predict(self, observation: PyTorchObs, deterministic: bool = True) -> th.Tensor:
         """Return the greedy action per observation, shape (batch,)."""
@@ -195,6 +205,25 @@ class AyssDQNPolicy(DQNPolicy):
         data.pop("net_arch", None)
         data.update(self._head_args)
         return data
+
+
+def _run_mlp(mlp: nn.Sequential, x: th.Tensor) -> th.Tensor:
+    """``mlp(x)`` as direct functional calls when every layer is ``nn.Linear`` or ``nn.ReLU``.
+
+    ``nn.Linear.forward`` is ``F.linear(x, weight, bias)`` and ``nn.ReLU.forward`` is
+    ``F.relu(x, inplace)``: the same kernels on the same tensors, so the output and the
+    gradients are bitwise those of ``mlp(x)``. Any other layer: ``mlp(x)`` itself.
+    """
+    y = x
+    for layer in mlp:
+        kind = type(layer)
+        if kind is nn.Linear:
+            y = F.linear(y, layer.weight, layer.bias)
+        elif kind is nn.ReLU and not layer.inplace:
+            y = F.relu(y)
+        else:
+            return mlp(x)  # start over, through the modules
+    return y
 
 
 _MODE_FREE_TYPES: frozenset[type[nn.Module]] = frozenset(

@@ -268,3 +268,62 @@ def test_clip_grad_norm_matches_torch(scale: float) -> None:
     nn.utils.clip_grad_norm_(ref, 10.0)
     for p, q in zip(ours, ref, strict=True):
         th.testing.assert_close(p.grad, q.grad)
+
+
+class _ReferenceDQN(AyssDQN):
+    """Frozen copy of ``AyssDQN.train`` before the lean paths: the Q-networks' MLPs called as
+    ``nn.Module``s and the optimizer's own ``zero_grad``."""
+
+    def train(self, gradient_steps: int, batch_size: int = 100) -> None:
+        from torch.nn import functional as F
+
+        import sumo_ayss.agents.policies as policies
+
+        saved, policies._run_mlp = policies._run_mlp, lambda mlp, x: mlp(x)
+        try:
+            self.policy.set_training_mode(True)
+            self._update_learning_rate(self.policy.optimizer)
+            buffer = self.replay_buffer
+            assert isinstance(buffer, PrioritizedReplayBuffer)
+            beta = self.per_beta
+            q_net, q_net_target = self.q_net, self.q_net_target
+            optimizer = self.policy.optimizer
+            for _ in range(gradient_steps):
+                data = buffer.sample(batch_size, env=self._vec_normalize_env, beta=beta)
+                with th.no_grad():
+                    next_q_target = q_net_target(data.next_observations)
+                    next_actions = q_net(data.next_observations).argmax(dim=1, keepdim=True)
+                    next_q = next_q_target.gather(1, next_actions)
+                    target_q = data.rewards + (1.0 - data.dones) * self.gamma * next_q
+                current_q = q_net(data.observations).gather(1, data.actions.long())
+                elementwise = F.smooth_l1_loss(current_q, target_q, reduction="none")
+                loss = (data.weights * elementwise).mean()
+                optimizer.zero_grad(set_to_none=True)
+                loss.backward()
+                _clip_grad_norm(self._q_params, float(self.max_grad_norm))
+                optimizer.step()
+                td_errors = (current_q.detach() - target_q).abs_().reshape(-1)
+                buffer.update_priorities(data.indices, td_errors.cpu().numpy())
+            self._n_updates += gradient_steps
+        finally:
+            policies._run_mlp = saved
+
+
+@pytest.mark.parametrize("dueling", [True, False])
+def test_lean_learner_is_bitwise_the_reference(dueling: bool) -> None:
+    """Same seed, same transitions: the lean train() gives exactly the reference's weights
+    (double DQN + PER, dueling or plain head)."""
+    hp = DQNHyperParams(**{**TINY, "dueling": dueling})
+    models = []
+    for cls in (AyssDQN, _ReferenceDQN):
+        model = cls(make_vec_env(TinyEnv, n_envs=2, seed=0), hp, seed=0)
+        model.learn(total_timesteps=400)
+        models.append(model)
+    lean, ref = models
+    assert lean._n_updates == ref._n_updates > 0
+    for a, b in zip(lean.q_net.parameters(), ref.q_net.parameters(), strict=True):
+        assert th.equal(a, b)
+    buffers = lean.replay_buffer, ref.replay_buffer
+    assert isinstance(buffers[0], PrioritizedReplayBuffer)
+    assert isinstance(buffers[1], PrioritizedReplayBuffer)
+    np.testing.assert_array_equal(buffers[0].priorities(), buffers[1].priorities())

@@ -134,3 +134,34 @@ def test_mode_dependent_layers_get_the_mode() -> None:
     assert policy.q_net.features_extractor.training
     policy.set_training_mode(False)
     assert not policy.q_net.features_extractor.training
+
+
+@pytest.mark.parametrize("dueling", [True, False])
+def test_functional_forward_is_bitwise_the_module_forward(dueling: bool) -> None:
+    """``_run_mlp`` (F.linear/F.relu on the layers) == calling the modules, values and grads."""
+    import sumo_ayss.agents.policies as policies
+
+    th.manual_seed(0)
+    net = make_net(dueling=dueling)
+    obs = th.rand(64, net.observation_space.shape[0])
+    results = []
+    for run in (policies._run_mlp, lambda mlp, x: mlp(x)):
+        saved, policies._run_mlp = policies._run_mlp, run
+        try:
+            net.zero_grad(set_to_none=True)
+            q = net(obs)
+            (q * th.linspace(-1, 1, q.shape[1])).sum().backward()
+        finally:
+            policies._run_mlp = saved
+        results.append((q.detach(), [p.grad.clone() for p in net.parameters()]))
+    (q_lean, g_lean), (q_ref, g_ref) = results
+    assert th.equal(q_lean, q_ref)
+    assert all(th.equal(a, b) for a, b in zip(g_lean, g_ref, strict=True))
+
+
+def test_functional_forward_falls_back_to_modules_for_other_layers() -> None:
+    from sumo_ayss.agents.policies import _run_mlp
+
+    mlp = nn.Sequential(nn.Linear(3, 4), nn.Tanh(), nn.Linear(4, 2))
+    x = th.rand(5, 3)
+    assert th.equal(_run_mlp(mlp, x), mlp(x))
