@@ -16,7 +16,11 @@ For each ``--device`` (default: cpu), in this process:
    gradient clipping, no SB3. Interleaved rounds; medians.
 3. **ratios**: learner step / raw-torch step (target <= 1.2), and the job's transitions/s
    as a fraction of the learner-bound limit ``1 / (learner step x gradient steps per
-   transition)`` (target >= 0.8).
+   transition)`` (target >= 0.8). The job makes no gradient steps before
+   ``agent.learning_starts`` (1,000 transitions), so a short job can pass 1. Also printed:
+   the share of the job's time spent inside ``AyssDQN.train`` (timed in the job itself), a
+   direct reading of how learner-bound it is that does not mix two moments of a noisy
+   machine.
 
     python benchmarks/throughput.py [--transitions 20000] [--device cpu cuda]
 
@@ -72,6 +76,8 @@ class JobTimes:
     learn_s: float
     candidates_s: float
     n_candidates: int
+    n_updates: int
+    gradient_steps_s: float
 
 
 def _clocks() -> tuple[float, float]:
@@ -103,15 +109,34 @@ def run_job(
         calls[0] += 1
 
     trainer.candidate = timed_candidate  # type: ignore[method-assign]
-    t1 = _clocks()
-    trainer.learn(progress_bar=False)
-    t2 = _clocks()
+    model = trainer.model
+    assert model is not None
+    learner = [0.0, 0.0]
+    cls = type(model)
+    original_train = cls.train
+
+    def timed_train(self: AyssDQN, gradient_steps: int, batch_size: int = 100) -> None:
+        start = _clocks()
+        original_train(self, gradient_steps, batch_size)
+        end = _clocks()
+        learner[0] += end[0] - start[0]
+        learner[1] += end[1] - start[1]
+
+    # On the class, for the job only: SB3's save pickles instance attributes.
+    cls.train = timed_train  # type: ignore[method-assign]
+    try:
+        t1 = _clocks()
+        trainer.learn(progress_bar=False)
+        t2 = _clocks()
+    finally:
+        cls.train = original_train  # type: ignore[method-assign]
     trainer.select()
     t3 = _clocks()
-    assert trainer.model is not None
     times = tuple(
         JobTimes(
-            transitions=trainer.model.num_timesteps,
+            transitions=model.num_timesteps,
+            n_updates=model._n_updates,
+            gradient_steps_s=learner[k],
             total_s=t3[k] - t0[k],
             setup_s=t1[k] - t0[k],
             learn_s=t2[k] - t1[k],
@@ -251,7 +276,6 @@ def bench_device(args: argparse.Namespace, device: str) -> dict[str, float]:
             buffer_kind = (
                 "PER" if isinstance(model.replay_buffer, PrioritizedReplayBuffer) else "uniform"
             )
-            n_updates = model._n_updates
         finally:
             trainer.close()
 
@@ -259,8 +283,8 @@ def bench_device(args: argparse.Namespace, device: str) -> dict[str, float]:
     print(
         f"job: {args.config.name}, n_envs {cfg.train.n_envs}, {jobs[0].transitions:,} transitions, "
         f"{grad_per_transition:g} gradient steps per transition (train_freq {hp.train_freq}, "
-        f"gradient_steps {hp.gradient_steps}; {n_updates:,} done: none before learning_starts "
-        f"{hp.learning_starts:,}), batch {hp.batch_size}, {buffer_kind} replay"
+        f"gradient_steps {hp.gradient_steps}; {jobs[0].n_updates:,} done: none before "
+        f"learning_starts {hp.learning_starts:,}), batch {hp.batch_size}, {buffer_kind} replay"
     )
     figures: dict[str, float] = {}
     for k, clock in enumerate(("wall", "cpu")):
@@ -273,12 +297,13 @@ def bench_device(args: argparse.Namespace, device: str) -> dict[str, float]:
         job_rate = job.transitions / job.total_s
         learn_rate = job.transitions / job.learn_s
         steady_rate = job.transitions / (job.learn_s - job.candidates_s)
-        grad_share = n_updates * learner_s / job.total_s
+        grad_share = job.gradient_steps_s / job.total_s
         print(
             f"[{clock}] job {job.total_s:.1f} s = setup {job.setup_s:.1f} + learn "
             f"{job.learn_s:.1f} (of which {job.n_candidates} candidates {job.candidates_s:.1f}) "
-            f"+ select {job.total_s - job.setup_s - job.learn_s:.2f}; "
-            f"gradient steps {grad_share:.0%} of the job"
+            f"+ select {job.total_s - job.setup_s - job.learn_s:.2f}; in AyssDQN.train "
+            f"{job.gradient_steps_s:.1f} = {grad_share:.0%} of the job "
+            f"({job.gradient_steps_s / job.n_updates * 1e3:.3f} ms per gradient step)"
         )
         print(
             f"[{clock}]   transitions/s: whole job {job_rate:.0f}, learn phase {learn_rate:.0f}, "
@@ -300,6 +325,7 @@ def bench_device(args: argparse.Namespace, device: str) -> dict[str, float]:
                 f"{clock}_raw_ms": raw_s * 1e3,
                 f"{clock}_ratio": ratio,
                 f"{clock}_fraction": job_rate / limit,
+                f"{clock}_grad_share": grad_share,
             }
         )
     return figures
@@ -328,7 +354,7 @@ def main(argv: list[str] | None = None) -> None:
     results = {device: bench_device(args, device) for device in args.device}
     print(
         f"\n{'device':<9}{'clock':<6}{'job tr/s':>9}{'step ms':>9}{'raw ms':>8}"
-        f"{'ratio':>7}{'job/limit':>10}"
+        f"{'ratio':>7}{'job/limit':>10}{'in train()':>11}"
     )
     for device, r in results.items():
         for clock in ("wall", "cpu"):
@@ -336,6 +362,7 @@ def main(argv: list[str] | None = None) -> None:
                 f"{device:<9}{clock:<6}{r[clock + '_job_rate']:>9.0f}"
                 f"{r[clock + '_learner_ms']:>9.3f}{r[clock + '_raw_ms']:>8.3f}"
                 f"{r[clock + '_ratio']:>7.2f}{r[clock + '_fraction']:>10.2f}"
+                f"{r[clock + '_grad_share']:>11.0%}"
             )
     print(f"\n{_load()}")
 
