@@ -47,6 +47,7 @@ typecheck: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/env_throughput.py
+	$(BIN)/python benchmarks/throughput.py
 
 networks: $(STAMP)
 	$(BIN)/python -m sumo_ayss.sim.network
