@@ -78,3 +78,24 @@ def test_training_on_cuda_end_to_end(tmp_path: Path) -> None:
     assert next(model.q_net.parameters()).device.type == "cpu"
     obs = model.observation_space.sample()[None, :]
     assert GreedyPolicy(model)(obs).shape == (1,)
+
+
+def _worker_threads() -> tuple[str | None, int]:
+    import torch
+
+    return os.environ.get("OMP_NUM_THREADS"), torch.get_num_threads()
+
+
+@pytest.mark.slow
+def test_pipeline_workers_start_torch_with_one_thread(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A spawned pipeline worker imports torch after its initializer: one intra-op thread."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from sumo_ayss.pipeline import _init_worker
+
+    for name in THREAD_ENV_VARS:
+        monkeypatch.delenv(name, raising=False)
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=_init_worker) as pool:
+        assert pool.submit(_worker_threads).result(timeout=120) == ("1", 1)
