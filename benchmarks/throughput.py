@@ -132,8 +132,9 @@ def run_job(
         cls.train = original_train  # type: ignore[method-assign]
     trainer.select()
     t3 = _clocks()
-    times = tuple(
-        JobTimes(
+
+    def job_times(k: int) -> JobTimes:
+        return JobTimes(
             transitions=model.num_timesteps,
             n_updates=model._n_updates,
             gradient_steps_s=learner[k],
@@ -143,8 +144,8 @@ def run_job(
             candidates_s=spent[k],
             n_candidates=calls[0],
         )
-        for k in (0, 1)
-    )
+
+    times = (job_times(0), job_times(1))
     return times, trainer
 
 

@@ -9,7 +9,7 @@ is SB3's :class:`~stable_baselines3.dqn.policies.DQNPolicy` with that network, s
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, cast
 
 import torch as th
 from gymnasium import spaces
@@ -218,7 +218,8 @@ def _run_mlp(mlp: nn.Sequential, x: th.Tensor) -> th.Tensor:
     for layer in mlp:
         kind = type(layer)
         if kind is nn.Linear:
-            y = F.linear(y, layer.weight, layer.bias)
+            linear = cast(nn.Linear, layer)
+            y = F.linear(y, linear.weight, linear.bias)
         elif kind is nn.ReLU and not layer.inplace:
             y = F.relu(y)
         else:
