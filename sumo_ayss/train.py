@@ -543,6 +543,7 @@ def train(
     argv: Sequence[str] = (),
 ) -> Path:
     """Train one (case, VUT, seed) into its run folder; return the folder."""
+    check_device(cfg.train.device)  # before the run folder exists
     run_dir = run_dir_for(out, cfg, seed)
     config_file = run_dir / "config.yaml"
     if resume:
@@ -596,6 +597,9 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     )
     parser.add_argument("--eval-every", type=int, default=None, help="override train.eval_every")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument(
+        "--device", default=None, help="override train.device (cpu, cuda, cuda:<index>)"
+    )
     return parser.parse_args(argv)
 
 
@@ -612,6 +616,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             overrides["eval_every"] = args.eval_every
         if args.no_progress:
             overrides["progress_bar"] = False
+        if args.device is not None:
+            overrides["device"] = args.device
         cfg = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, **overrides))
         run_dir = train(cfg, args.seed, args.out, resume=args.resume, argv=argv)
     except (ConfigError, CheckpointError) as e:

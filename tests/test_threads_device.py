@@ -99,3 +99,12 @@ def test_pipeline_workers_start_torch_with_one_thread(monkeypatch: pytest.Monkey
     ctx = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=_init_worker) as pool:
         assert pool.submit(_worker_threads).result(timeout=120) == ("1", 1)
+
+
+@pytest.mark.skipif(th.cuda.is_available(), reason="this machine has CUDA")
+def test_training_on_missing_cuda_fails_before_writing(tmp_path: Path) -> None:
+    cfg = load_experiment(tiny_config(tmp_path, 600, 200))
+    cfg = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, device="cuda"))
+    with pytest.raises(ConfigError, match=r"train\.device is 'cuda'"):
+        train(cfg, seed=0, out=tmp_path / "runs")
+    assert not (tmp_path / "runs").exists()
