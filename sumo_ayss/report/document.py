@@ -530,6 +530,9 @@ def _exposure_headline(out: CaseAnalysis) -> None:
     assert top is not None
     out.headline = exposure_sentence(top)
     out.headline_kind = "safer" if top.significant else "none"
+    if out.info.exposure_caution:
+        out.headline += " " + out.info.exposure_caution
+        out.headline_kind = "warning"
     out.ranking_line = rows[0].name + "".join(
         (" > " if prev.significant_vs_next else " ≈ ") + row.name
         for prev, row in itertools.pairwise(rows)

@@ -79,6 +79,8 @@ class CaseInfo:
         symbol: The indicator's symbol in text (HTML / Markdown).
         paper_figure: The paper figure the indicator plot reproduces.
         paper_table: The paper table the outcome table reproduces.
+        exposure_caution: Empty when exposure mode recovered known safety orders in this
+            case (results/ladders); otherwise the caution every exposure verdict carries.
     """
 
     title: str
@@ -87,6 +89,7 @@ class CaseInfo:
     symbol: str
     paper_figure: str
     paper_table: str
+    exposure_caution: str = ""
 
 
 CASES: Mapping[str, CaseInfo] = {
@@ -105,6 +108,11 @@ CASES: Mapping[str, CaseInfo] = {
         symbol="Δv̄",
         paper_figure="Fig. 6",
         paper_table="Table III",
+        exposure_caution=(
+            "Caution: in cut-in, exposure mode has NOT recovered a known safety order: on the "
+            "minGap ladder (results/ladders) the SPCPs extracted more reward from the VUTs "
+            "with larger gaps, not less (docs/ranking.md). Treat this verdict as unvalidated."
+        ),
     ),
 }
 

@@ -187,6 +187,7 @@ def test_verdict_names_the_safer_vut(full_report: Path) -> None:
     assert "pi2 is safer than pi1: its SPCPs close in" in text
     verdicts = text.split('id="inputs"')[0]  # the summary at the top names it too
     assert verdicts.count("[exposure mode] pi2 is safer than pi1") == 2
+    assert verdicts.count("in cut-in, exposure mode has NOT recovered a known safety order") >= 1
     assert verdicts.count("[paper mode] pi2 is safer than pi1") == 2
 
 
