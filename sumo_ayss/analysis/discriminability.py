@@ -123,7 +123,7 @@ class BoxGrid:
 
     @staticmethod
     def _axis(lo: float, hi: float, step: float) -> FloatArray:
-        n = int(math.floor((hi - lo) / step + 1e-9))
+        n = math.floor((hi - lo) / step + 1e-9)
         return np.round(lo + step * np.arange(n + 1), 9)
 
     def states(self) -> BoxStates:
