@@ -124,5 +124,5 @@ def test_ensure_reuses_a_record_made_from_the_same_inputs(
 def test_bad_vut_lists_are_refused(args: list[str], match: str) -> None:
     with pytest.raises(ConfigError, match=match):
         disc.load_target(PROJECT_ROOT / "configs" / "car_following.yaml", args[1:] or None, None)
-    with pytest.raises(SystemExit, match="^error: --vuts"):
+    with pytest.raises(SystemExit, match=r"^error: --vuts"):
         disc.main([str(PROJECT_ROOT / "configs" / "car_following.yaml"), *args])
