@@ -33,7 +33,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.analysis.discriminability import (
     DEFAULT_THRESHOLD_MPS2,
@@ -45,6 +45,9 @@ from sumo_ayss.atomic import atomic_write_json, atomic_write_text
 from sumo_ayss.config import EnvConfig, read_yaml, to_dict
 from sumo_ayss.errors import AyssError, ConfigError
 
+if TYPE_CHECKING:
+    from sumo_ayss.pipeline import PipelineConfig
+
 logger = logging.getLogger(__name__)
 
 JSON_NAME = "discriminability.json"
@@ -52,6 +55,8 @@ CSV_NAME = "discriminability.csv"
 PNG_NAME = "discriminability.png"
 
 #: Keys that mark a pipeline YAML (any other top-level mapping is read as an experiment).
+#: Keys a run folder's config.yaml adds to an experiment.
+_RUN_KEYS = ("vut", "seed")
 _PIPELINE_KEYS = {"grid", "experiments", "out", "evaluate", "workers", "retries", "vuts"}
 
 
@@ -68,7 +73,8 @@ def load_target(path: str | Path, vuts: Sequence[str] | None, case: str | None) 
     """Read an experiment or pipeline YAML and resolve the env and the VUTs to compare.
 
     Args:
-        path: Experiment YAML (``env``/``agent``/``train``) or pipeline YAML (``grid``...).
+        path: Experiment YAML (``env``/``agent``/``train``; a run folder's ``config.yaml``
+            too) or pipeline YAML (``grid``...).
         vuts: VUT names; default: a pipeline's ``grid.vuts`` (an experiment needs them).
         case: Case to use; default: the experiment's ``env.case`` or the pipeline's first
             ``grid.cases`` (a pipeline then uses that case's experiment file; an experiment
@@ -77,7 +83,7 @@ def load_target(path: str | Path, vuts: Sequence[str] | None, case: str | None) 
     Raises:
         ConfigError: On unreadable files, unknown VUTs or cases, fewer than 2 VUTs.
     """
-    from sumo_ayss.experiment import load_experiment
+    from sumo_ayss.experiment import experiment_from_dict
 
     path = Path(path)
     data = read_yaml(path)
@@ -87,16 +93,12 @@ def load_target(path: str | Path, vuts: Sequence[str] | None, case: str | None) 
 
         pipe = load_pipeline(path)
         case = case or pipe.grid.cases[0]
-        if case not in pipe.experiments:
-            raise ConfigError(
-                f"--case {case!r}: the pipeline has no experiment for it; "
-                f"allowed: {sorted(pipe.experiments)}"
-            )
-        exp = load_experiment(pipe.experiments[case])
-        env = dataclasses.replace(exp.env, vuts={**exp.env.vuts, **pipe.vuts})
+        env = pipeline_env(pipe, case)
         names = tuple(vuts) if vuts else tuple(pipe.grid.vuts)
     else:
-        env = load_experiment(path).env
+        # A run folder's config.yaml is an experiment plus the run's ``vut`` and ``seed``.
+        exp_data = {k: v for k, v in data.items() if k not in _RUN_KEYS}
+        env = experiment_from_dict(exp_data, path.resolve().parent).env
         if not vuts:
             raise ConfigError(
                 f"--vuts: an experiment YAML needs the VUTs to compare; allowed: {sorted(env.vuts)}"
@@ -112,6 +114,23 @@ def load_target(path: str | Path, vuts: Sequence[str] | None, case: str | None) 
     if unknown:
         raise ConfigError(f"--vuts: unknown VUT(s) {unknown}; allowed: {sorted(env.vuts)}")
     return Target(env, names, str(path))
+
+
+def pipeline_env(pipe: PipelineConfig, case: str) -> EnvConfig:
+    """The env of ``case``'s experiment in a pipeline, with the pipeline's extra VUTs."""
+    from sumo_ayss.experiment import load_experiment
+
+    if case not in pipe.experiments:
+        raise ConfigError(
+            f"--case {case!r}: the pipeline has no experiment for it; "
+            f"allowed: {sorted(pipe.experiments)}"
+        )
+    exp = load_experiment(pipe.experiments[case])
+    if exp.env.case != case:
+        raise ConfigError(
+            f"experiments.{case}: {pipe.experiments[case]} is a {exp.env.case!r} experiment"
+        )
+    return dataclasses.replace(exp.env, vuts={**exp.env.vuts, **pipe.vuts})
 
 
 def fingerprint(env: EnvConfig, vuts: Sequence[str], settings: dict[str, Any]) -> str:
@@ -354,7 +373,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     except AyssError as e:
         sys.exit(f"error: {e}")
     print(
-        f"Where the VUTs' one-step responses differ by > {args.threshold:g} m/s² "
+        f"Where the VUTs' responses over {args.decisions} decision(s) differ by > "
+        f"{args.threshold:g} m/s² "
         f"({target.env.case}, {time.perf_counter() - t0:.0f} s):"
     )
     for line in meta["summary"]:

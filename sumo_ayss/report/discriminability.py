@@ -69,7 +69,7 @@ def discriminability_figure(
     ve = np.asarray(record["v_edges_mps"], dtype=float)
     hc, vc = 0.5 * (he[:-1] + he[1:]), 0.5 * (ve[:-1] + ve[1:])
     thr = record.get("threshold_mps2", 0.1)
-    colors = colors or figures.vut_colors(list(record["vuts"]))
+    colors = {**figures.vut_colors(list(record["vuts"])), **(colors or {})}
     with figures._style():
         fig = Figure(figsize=(15, 4.4), layout="constrained")
         ax_h, ax_v, ax_m = fig.subplots(1, 3)
@@ -99,15 +99,16 @@ def _pct(x: float | None) -> str:
     return "—" if x is None or not math.isfinite(x) else f"{100 * x:.1f}"
 
 
-def _command(case: str, vuts: Sequence[str], case_dir: Path) -> str:
-    return (
-        f"python -m sumo_ayss.discriminability <experiment YAML of {case}> --vuts "
-        f"{' '.join(vuts)} --out {case_dir}"
-    )
+def _command(config: Path | str, vuts: Sequence[str], case_dir: Path) -> str:
+    return f"python -m sumo_ayss.discriminability {config} --vuts {' '.join(vuts)} --out {case_dir}"
 
 
 def discriminability_blocks(
-    case: str, vuts: Sequence[str], case_dirs: Sequence[Path], out_dir: Path
+    case: str,
+    vuts: Sequence[str],
+    case_dirs: Sequence[Path],
+    out_dir: Path,
+    colors: Mapping[str, str] | None = None,
 ) -> list[Any]:
     """The report blocks of the section, for a case with >= 2 VUTs (else none).
 
@@ -117,6 +118,7 @@ def discriminability_blocks(
         case_dirs: Folders that may hold the record (``<out>/<case>/`` of the runs); the
             first readable record that covers at least 2 of ``vuts`` is used.
         out_dir: The report folder (the figure is drawn there).
+        colors: ``{vut: colour}`` of the report.
 
     Returns:
         Heading, paragraph(s), figure and tables (``sumo_ayss.report.document`` blocks).
@@ -138,15 +140,18 @@ def discriminability_blocks(
             break
     if record is None:
         target = case_dirs[0] if case_dirs else Path(f"<out>/{case}")
+        configs = sorted(target.glob("*/seed_*/config.yaml"))
+        config = configs[0] if configs else f"<experiment YAML of {case}>"
         return [
             heading,
             Paragraph(
-                "Not computed for these VUTs (no discriminability.json beside the runs). "
-                f"Make it with: {_command(case, vuts, target)}"
+                "Not computed for these VUTs (no discriminability.json beside the runs; "
+                "the pipeline writes one). Make it with: "
+                f"{_command(config, vuts, target)}"
             ),
         ]
     missing = sorted(set(vuts) - set(record["vuts"]))
-    path = discriminability_figure(record, out_dir / f"{case}_discriminability.png")
+    path = discriminability_figure(record, out_dir / f"{case}_discriminability.png", colors)
     settings = record.get("settings", {})
     grid = settings.get("grid", {})
     thr = record.get("threshold_mps2", 0.1)
