@@ -18,6 +18,10 @@ COMMANDS = {
     "report": ("sumo_ayss.report.__main__", "HTML + Markdown report from run folders"),
     "pipeline": ("sumo_ayss.pipeline", "the grid cases x VUTs x seeds, resumable"),
     "rank": ("sumo_ayss.rank", "leaderboard of K VUTs by safety index"),
+    "discriminability": (
+        "sumo_ayss.discriminability",
+        "where VUTs' one-step responses differ over the AYSS box (no training)",
+    ),
     "networks": ("sumo_ayss.sim.network", "rebuild the built-in networks and vType file"),
 }
 

@@ -42,7 +42,7 @@ from sumo_ayss.analysis.discriminability import (
     compare_responses,
 )
 from sumo_ayss.atomic import atomic_write_json, atomic_write_text
-from sumo_ayss.config import EnvConfig, read_yaml, to_dict
+from sumo_ayss.config import Case, EnvConfig, read_yaml, to_dict
 from sumo_ayss.errors import AyssError, ConfigError
 
 if TYPE_CHECKING:
@@ -69,7 +69,7 @@ class Target:
     source: str
 
 
-def load_target(path: str | Path, vuts: Sequence[str] | None, case: str | None) -> Target:
+def load_target(path: str | Path, vuts: Sequence[str] | None, case: Case | None) -> Target:
     """Read an experiment or pipeline YAML and resolve the env and the VUTs to compare.
 
     Args:
@@ -116,7 +116,7 @@ def load_target(path: str | Path, vuts: Sequence[str] | None, case: str | None) 
     return Target(env, names, str(path))
 
 
-def pipeline_env(pipe: PipelineConfig, case: str) -> EnvConfig:
+def pipeline_env(pipe: PipelineConfig, case: Case) -> EnvConfig:
     """The env of ``case``'s experiment in a pipeline, with the pipeline's extra VUTs."""
     from sumo_ayss.experiment import load_experiment
 

@@ -76,8 +76,8 @@ def discriminability_figure(
         for i, p in enumerate(pairs):
             label = f"{p['a']} vs {p['b']} ({100 * p['share']:.1f} %)"
             style = dict(marker="o", ms=3.5, lw=1.6, ls=figures._LINESTYLES[(i // 10) % 4])
-            ax_h.plot(hc, 100 * _series(p["share_by_h"]), label=label, **style)  # type: ignore[arg-type]
-            ax_v.plot(vc, 100 * _series(p["share_by_v_vut"]), label=label, **style)  # type: ignore[arg-type]
+            ax_h.plot(hc, 100 * _series(p["share_by_h"]), label=label, **style)
+            ax_v.plot(vc, 100 * _series(p["share_by_v_vut"]), label=label, **style)
         for ax, xlabel in ((ax_h, "headway h [m] (bin centre)"), (ax_v, "VUT speed [m/s]")):
             ax.set_xlabel(xlabel)
             ax.set_ylabel(f"states where |Δa| > {thr:g} m/s² [%]")
