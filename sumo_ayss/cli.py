@@ -28,7 +28,7 @@ COMMANDS = {
 
 def usage() -> str:
     lines = ["usage: sumo-ayss <command> [args...]", "", "commands:"]
-    lines += [f"  {name:<10} {help_}" for name, (_, help_) in COMMANDS.items()]
+    lines += [f"  {name:<17} {help_}" for name, (_, help_) in COMMANDS.items()]
     return "\n".join(lines)
 
 
