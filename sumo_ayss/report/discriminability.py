@@ -167,6 +167,17 @@ def discriminability_blocks(
     )
     blocks: list[Any] = [heading, Paragraph(text)]
     blocks += [Paragraph(line) for line in record.get("summary", [])]
+    if case == "cut_in" and settings.get("decisions", 1) == 1:
+        blocks.append(
+            Paragraph(
+                "Cut-in, one decision: the POV starts its lane change from the centre of its own "
+                "lane, so during the first 0.2 s a SUMO car-following VUT does not see it yet and "
+                "drives freely; one-decision responses then differ only where the VUTs' free "
+                "driving differs, and Δv̄ after one step can differ between SPCPs only through "
+                "the states at which they choose to cut in. The reaction to the cut-in itself "
+                "shows over two decisions (--decisions 2)."
+            )
+        )
     if missing:
         blocks.append(Paragraph(f"Not in the record ({where}): {', '.join(missing)}."))
     if path is not None:
