@@ -28,6 +28,8 @@ logger = logging.getLogger(__name__)
 
 __all__ = ["RECORD_NAME", "discriminability_blocks", "discriminability_figure", "read_record"]
 
+_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
+
 #: File name of the record, in ``<out>/<case>/`` (the same name the CLI writes).
 RECORD_NAME = "discriminability.json"
 
@@ -73,9 +75,18 @@ def discriminability_figure(
     with figures._style():
         fig = Figure(figsize=(15, 4.4), layout="constrained")
         ax_h, ax_v, ax_m = fig.subplots(1, 3)
+        # Pairs (and VUTs) that coincide draw on top of each other: earlier lines are drawn
+        # wider and with other markers, so that a covered line still shows at its edges.
+        n = len(pairs)
         for i, p in enumerate(pairs):
             label = f"{p['a']} vs {p['b']} ({100 * p['share']:.1f} %)"
-            style = dict(marker="o", ms=3.5, lw=1.6, ls=figures._LINESTYLES[(i // 10) % 4])
+            style: dict[str, Any] = {
+                "marker": _MARKERS[i % len(_MARKERS)],
+                "ms": 3 + 3 * (n - i) / n,
+                "lw": 1.2 + 2.8 * (n - 1 - i) / max(1, n - 1),
+                "ls": figures._LINESTYLES[(i // len(_MARKERS)) % len(figures._LINESTYLES)],
+                "alpha": 0.85,
+            }
             ax_h.plot(hc, 100 * _series(p["share_by_h"]), label=label, **style)
             ax_v.plot(vc, 100 * _series(p["share_by_v_vut"]), label=label, **style)
         for ax, xlabel in ((ax_h, "headway h [m] (bin centre)"), (ax_v, "VUT speed [m/s]")):
@@ -85,9 +96,19 @@ def discriminability_figure(
         ax_h.set_title("Where the VUTs' responses differ: by headway")
         ax_v.set_title("... by VUT speed")
         ax_h.legend(loc="upper left", title="pair (share of the box)")
-        for vut, means in record.get("mean_response_by_h_mps2", {}).items():
-            ax_m.plot(hc, _series(means), marker="o", ms=3.5, lw=1.6, color=colors.get(vut),
-                      label=f"{vut} ({record['mean_response_mps2'][vut]:+.2f})")  # fmt: skip
+        by_h = record.get("mean_response_by_h_mps2", {})
+        names = [v for v in record["vuts"] if v in by_h]
+        for i, vut in enumerate(names):
+            ax_m.plot(
+                hc,
+                _series(by_h[vut]),
+                marker=_MARKERS[i % len(_MARKERS)],
+                ms=3 + 3 * (len(names) - i) / len(names),
+                lw=1.2 + 2.8 * (len(names) - 1 - i) / max(1, len(names) - 1),
+                alpha=0.85,
+                color=colors.get(vut),
+                label=f"{vut} ({record['mean_response_mps2'][vut]:+.2f})",
+            )
         ax_m.set_xlabel("headway h [m] (bin centre)")
         ax_m.set_ylabel("mean VUT acceleration [m/s²]")
         ax_m.set_title("Mean one-step response per VUT")
