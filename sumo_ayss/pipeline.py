@@ -435,7 +435,7 @@ def write_discriminability(cfg: PipelineConfig) -> None:
         try:
             env = discriminability.pipeline_env(cfg, case)
             discriminability.ensure(env, cfg.grid.vuts, cfg.out / case)
-        except AyssError as e:
+        except (AyssError, ImportError, OSError) as e:  # never fatal: the report says so
             logger.warning("discriminability of %s not computed: %s", case, e)
 
 
