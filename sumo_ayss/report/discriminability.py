@@ -148,7 +148,7 @@ def discriminability_blocks(
 
     if len(vuts) < 2:
         return []
-    heading = Heading("(f) Discriminability before training: where the VUTs' responses differ", 3)
+    heading = Heading("(h) Discriminability before training: where the VUTs' responses differ", 3)
     record, where = None, None
     for d in case_dirs:
         rec = read_record(d / RECORD_NAME)

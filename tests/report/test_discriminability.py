@@ -60,6 +60,6 @@ def test_report_shows_the_section_when_a_record_is_beside_the_runs(tmp_path: Pat
     (root / "car_following" / JSON_NAME).write_text(json.dumps(_record()))
     html_path = write_report([root], tmp_path / "r1", options=FAST)
     html = html_path.read_text(encoding="utf-8")
-    assert "(f) Discriminability before training" in html
+    assert "(h) Discriminability before training" in html
     assert "pi1 vs pi2 differ in" in html
     assert (tmp_path / "r1" / "car_following_discriminability.png").is_file()
