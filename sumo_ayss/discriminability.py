@@ -11,7 +11,8 @@ grid, :class:`~sumo_ayss.analysis.discriminability.BoxGrid`), each VUT's one-ste
 threshold (0.1 m/s²): the share of the box, by headway bin and by speed bin, for every pair,
 and the mean response per VUT. An SPCP can only adapt to a VUT where the VUT reacts
 differently; where the responses of two VUTs coincide, their AYSS indicators have nothing
-to tell apart. No training is needed: 4 VUTs take about 20 s on the default grid.
+to tell apart. No training is needed: 4 VUTs took 43 s on the default grid here (2 busy
+cores; 20 s of CPU).
 
 CONFIG is an experiment YAML (``env: ...``; VUTs from ``env.vuts`` and the built-ins) or a
 pipeline YAML (``grid: ...``; its ``vuts`` section adds VUTs to every case, and

@@ -27,6 +27,9 @@ Each decision is run as SUMO steps of ``sim.step_length_s``; ``decisions`` decis
 config's ``decision_period_s`` are ``decisions · steps_per_decision`` SUMO steps. A pair
 that collides ends its measurement at the collision step (its response is the mean over
 the steps until then; ``collided`` marks it).
+
+VUT models that draw random numbers (``sigma``, ``speedDev``, EIDM's noise) give noisy
+responses: such a VUT compared with itself differs where the noise exceeds the threshold.
 """
 
 from __future__ import annotations
