@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -9,11 +10,12 @@ import pytest
 
 from examples.acc_controller import TimeGapACC
 from sumo_ayss.catalog import ControllerSpec, VehicleType
-from sumo_ayss.config import EnvConfig
+from sumo_ayss.config import PROJECT_ROOT, EnvConfig
 from sumo_ayss.controllers import ControllerInput, bound_acceleration, commanded_speed
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.errors import ConfigError
+from sumo_ayss.experiment import load_experiment
 from sumo_ayss.scenarios.responses import POV_ACTION, measure_responses
 
 pytestmark = pytest.mark.sumo
@@ -104,3 +106,23 @@ def test_bad_arguments_are_refused() -> None:
         measure_responses(cfg, "pi1", [1.0, 2.0], [1.0], [1.0])
     empty = measure_responses(cfg, "pi1", [], [], [])
     assert len(empty.accel_mps2) == 0 and not math.isnan(empty.step_length_s)
+
+
+def test_highway_env_vut_matches_the_fidelity_env_step() -> None:
+    """Paper-fidelity config (highway-env POV law, highway-env IDM VUT): the measurement
+    runs the POV on the clipped law (it holds its speed either way); the VUT's response
+    equals the single env's step under the config's own highway-env POV law."""
+    exp = load_experiment(PROJECT_ROOT / "configs" / "car_following_fidelity.yaml")
+    cfg = dataclasses.replace(exp.env, vut="hwenv_pi1")
+    assert cfg.actuator.mode == "highway_env"
+    r = _measure(cfg, "hwenv_pi1")
+    env = CarFollowingEnv(cfg)
+    try:
+        for (v_pov, v_vut, h), got in zip(STATES, r.accel_mps2, strict=True):
+            ic = InitialCondition(v_pov, v_vut, h)
+            env.reset(seed=0, options={"initial_condition": ic})
+            obs, _, _, _, info = env.step(POV_ACTION["car_following"])
+            assert obs[0] == pytest.approx(v_pov, abs=1e-4)
+            assert got == pytest.approx(info["vut_accel_mps2"], abs=1e-9)
+    finally:
+        env.close()
