@@ -18,13 +18,17 @@ COMMANDS = {
     "report": ("sumo_ayss.report.__main__", "HTML + Markdown report from run folders"),
     "pipeline": ("sumo_ayss.pipeline", "the grid cases x VUTs x seeds, resumable"),
     "rank": ("sumo_ayss.rank", "leaderboard of K VUTs by safety index"),
+    "discriminability": (
+        "sumo_ayss.discriminability",
+        "where VUTs' one-step responses differ over the AYSS box (no training)",
+    ),
     "networks": ("sumo_ayss.sim.network", "rebuild the built-in networks and vType file"),
 }
 
 
 def usage() -> str:
     lines = ["usage: sumo-ayss <command> [args...]", "", "commands:"]
-    lines += [f"  {name:<10} {help_}" for name, (_, help_) in COMMANDS.items()]
+    lines += [f"  {name:<17} {help_}" for name, (_, help_) in COMMANDS.items()]
     return "\n".join(lines)
 
 

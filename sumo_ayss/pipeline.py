@@ -424,10 +424,31 @@ def run_pipeline(
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
     report = None
     if finished:
+        write_discriminability(cfg)
         from sumo_ayss.report import write_report
 
         report = write_report(finished, cfg.out / "report", options=cfg.report)
     return statuses, report
+
+
+def write_discriminability(cfg: PipelineConfig) -> None:
+    """``<out>/<case>/discriminability.json`` (+ .csv, .png) for every case with >= 2 VUTs.
+
+    Where the grid's VUTs' one-step responses differ over the AYSS box
+    (:mod:`sumo_ayss.discriminability`, default grid, some seconds per VUT); the report shows
+    it. Skipped when an up-to-date record exists; a failure is logged, never fatal.
+    """
+    if len(cfg.grid.vuts) < 2:
+        return
+    from sumo_ayss import discriminability
+    from sumo_ayss.errors import AyssError
+
+    for case in cfg.grid.cases:
+        try:
+            env = discriminability.pipeline_env(cfg, case)
+            discriminability.ensure(env, cfg.grid.vuts, cfg.out / case)
+        except (AyssError, ImportError, OSError) as e:  # never fatal: the report says so
+            logger.warning("discriminability of %s not computed: %s", case, e)
 
 
 def main(argv: Sequence[str] | None = None) -> None:

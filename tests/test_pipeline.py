@@ -72,6 +72,9 @@ def test_failing_job_is_retried_then_reported_others_complete(tmp_path: Path) ->
     assert good.state == "done"
     assert (good.spec.run_dir / "ayss.csv").is_file()
     assert report is not None and report.is_file()
+    # Discriminability of the grid's VUTs (a property of the VUTs, not of the runs).
+    record = json.loads((cfg.out / "car_following" / "discriminability.json").read_text())
+    assert record["vuts"] == ["pi1", "pi2"] and record["pairs"][0]["share"] > 0
 
 
 @pytest.mark.sumo

@@ -56,6 +56,7 @@ from sumo_ayss.analysis.seeds import (
 )
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.report import figures
+from sumo_ayss.report.discriminability import discriminability_blocks
 from sumo_ayss.report.figures import CaseInfo, case_info
 from sumo_ayss.report.load import (
     RUN_FILES,
@@ -630,6 +631,8 @@ def _case_blocks(
     blocks += _premise_blocks(a, options)
     blocks += _exposure_blocks(a, colors, out_dir, options)
     blocks += _ranking_blocks(a, colors, out_dir, options)
+    case_dirs = list(dict.fromkeys(r.path.parent.parent for rs in a.runs.values() for r in rs))
+    blocks += discriminability_blocks(case, list(a.runs), case_dirs, out_dir, colors)
     return blocks
 
 
