@@ -37,6 +37,7 @@ import sys
 import time
 import traceback
 import types
+import typing
 from collections.abc import Mapping, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
@@ -44,8 +45,17 @@ from pathlib import Path
 from typing import Any, ClassVar, Literal
 
 from sumo_ayss.catalog import VehicleType
-from sumo_ayss.config import PROJECT_ROOT, Case, _require, build, read_yaml, to_dict
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.config import (
+    PROJECT_ROOT,
+    Case,
+    _require,
+    build,
+    check_out_dir,
+    check_seed,
+    read_yaml,
+    to_dict,
+)
+from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.report.options import ReportOptions
 
 logger = logging.getLogger(__name__)
@@ -68,6 +78,8 @@ class GridConfig:
             values = getattr(self, name)
             _require(len(values) > 0, f"grid.{name} must not be empty")
             _require(len(set(values)) == len(values), f"grid.{name} has duplicates: {list(values)}")
+        for seed in self.seeds:
+            check_seed(seed, "grid.seeds[]")
 
 
 @dataclass(frozen=True)
@@ -121,6 +133,12 @@ class PipelineConfig:
         object.__setattr__(self, "vuts", types.MappingProxyType(dict(self.vuts)))
         for name, vt in self.vuts.items():
             vt.validate(f"vuts.{name}")
+        known = typing.get_args(Case)
+        for case in self.experiments:
+            _require(
+                case in known,
+                f"experiments.{case}: unknown case; allowed: {list(known)}",
+            )
         for case in self.grid.cases:
             _require(
                 case in self.experiments,
@@ -399,6 +417,7 @@ def run_pipeline(
 ) -> tuple[list[JobStatus], Path | None]:
     """Run the grid, then the report over every finished job; return statuses and report."""
     jobs = plan_jobs(cfg)
+    check_out_dir(cfg.out, "out")
     cfg.out.mkdir(parents=True, exist_ok=True)
     from sumo_ayss.atomic import atomic_write_json
 
@@ -422,7 +441,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
         prog="python -m sumo_ayss.pipeline", description=__doc__.splitlines()[0]
     )
-    parser.add_argument("config", type=Path, nargs="?", default=None, help="pipeline YAML")
+    parser.add_argument(
+        "config", type=Path, help="pipeline YAML (configs/paper.yaml runs the paper's grid)"
+    )
     parser.add_argument("--out", type=Path, default=None)
     parser.add_argument("--workers", type=int, default=None)
     parser.add_argument(
@@ -438,9 +459,12 @@ def main(argv: Sequence[str] | None = None) -> None:
         statuses, report = run_pipeline(
             cfg, backend=args.backend, address=args.address, live=not args.no_live
         )
-    except ConfigError as e:
+    except AyssError as e:
         sys.exit(f"error: {e}")
     failed = [s for s in statuses if s.state == "failed"]
+    for s in statuses:
+        if s.state == "cancelled":
+            print(f"CANCELLED {s.spec.name}")
     for s in failed:
         print(f"FAILED {s.spec.name}: {s.error}  (log: {s.spec.run_dir / 'job.log'})")
     if report is not None:

@@ -41,7 +41,6 @@ import io
 import json
 import logging
 import math
-import os
 import platform
 import random
 import shlex
@@ -62,13 +61,19 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor
 from sumo_ayss.agents.dqn import AyssDQN
 from sumo_ayss.agents.greedy import GreedyPolicy
 from sumo_ayss.agents.hparams import DQNHyperParams
-from sumo_ayss.atomic import atomic_write_json, atomic_write_text
-from sumo_ayss.config import to_dict, write_yaml
+from sumo_ayss.atomic import (
+    atomic_copy,
+    atomic_write_json,
+    atomic_write_text,
+    atomic_write_with,
+    remove_stale_temporaries,
+)
+from sumo_ayss.config import check_out_dir, check_seed, safe_load_yaml, to_dict, write_yaml
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.envs.vec_env import EpisodeTrace, PairVecEnv
-from sumo_ayss.errors import CheckpointError, ConfigError
+from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
 from sumo_ayss.experiment import ExperimentConfig, experiment_from_dict, load_experiment
 from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, run_episodes, summarize
 from sumo_ayss.selection import select_spcp
@@ -100,16 +105,39 @@ def write_eval_table(path: Path, rows: Sequence[dict[str, Any]]) -> None:
 
 
 def read_eval_table(path: Path) -> list[dict[str, Any]]:
+    """The rows of ``eval.csv`` (none if it does not exist).
+
+    Raises:
+        CheckpointError: The file is unreadable, lacks a column, or has a bad cell; the
+            message names the file, the line and the column.
+    """
     if not path.is_file():
         return []
-    with path.open() as f:
-        rows = list(csv.DictReader(f))
-    for row in rows:
-        row["step"] = int(row["step"])
-        row["n_episodes"] = int(row["n_episodes"])
+    try:
+        with path.open(encoding="utf-8", newline="") as f:
+            reader = csv.DictReader(f)
+            missing = [c for c in EVAL_COLUMNS if c not in (reader.fieldnames or [])]
+            if missing:
+                raise CheckpointError(f"{path}: not an eval table (missing columns {missing})")
+            rows = list(reader)
+    except (OSError, UnicodeDecodeError, csv.Error) as e:
+        raise CheckpointError(f"{path}: unreadable ({e})") from e
+    for line, row in enumerate(rows, start=2):
         for key in EVAL_COLUMNS:
-            if key not in ("step", "n_episodes", "checkpoint"):
-                row[key] = float(row[key])
+            if key == "checkpoint":
+                continue
+            cell = row[key]
+            try:
+                value = int(cell) if key in ("step", "n_episodes") else float(cell)
+            except (TypeError, ValueError):
+                raise CheckpointError(
+                    f"{path}, line {line}: column {key!r} must be a number, got {cell!r}"
+                ) from None
+            if key not in ("std_return",) and not math.isfinite(value):
+                raise CheckpointError(
+                    f"{path}, line {line}: column {key!r} must be finite, got {cell!r}"
+                )
+            row[key] = value
     return rows
 
 
@@ -325,9 +353,7 @@ class Trainer:
     def _save_resume_state(self, step_dir: Path, env_state: dict[str, Any]) -> None:
         model = self.model
         assert model is not None
-        tmp = step_dir / ".replay.pkl.tmp"
-        model.save_replay_buffer(tmp)
-        os.replace(tmp, step_dir / "replay.pkl")
+        atomic_write_with(step_dir / "replay.pkl", model.save_replay_buffer)
         state = {
             "num_timesteps": model.num_timesteps,
             "next_eval": self.next_eval,
@@ -335,32 +361,65 @@ class Trainer:
             "numpy_rng": _jsonable(np.random.get_state()),  # noqa: NPY002 (SB3 uses it)
             "python_rng": _jsonable(random.getstate()),
         }
-        th.save(th.get_rng_state(), step_dir / ".torch_rng.pt.tmp")
-        os.replace(step_dir / ".torch_rng.pt.tmp", step_dir / "torch_rng.pt")
+        torch_state = th.get_rng_state()
+        atomic_write_with(step_dir / "torch_rng.pt", lambda tmp: th.save(torch_state, tmp))
         atomic_write_json(step_dir / "state.json", state)
 
     def _latest(self) -> Path | None:
         path = self.ckpt_dir / "latest.json"
         if not path.is_file():
             return None
-        return self.ckpt_dir / json.loads(path.read_text())["dir"]
+        data = _read_json(path)
+        name = data.get("dir") if isinstance(data, dict) else None
+        if not isinstance(name, str) or Path(name).name != name or not name.startswith("step_"):
+            raise CheckpointError(f"{path}: 'dir' must name a step_* folder, got {name!r}")
+        latest = self.ckpt_dir / name
+        if not latest.is_dir():
+            raise CheckpointError(f"{path} points at {name}, which does not exist")
+        return latest
 
     # -- resume --------------------------------------------------------------------------
+
+    def clean_leftovers(self) -> None:
+        """Delete what a killed run left half-done: temporary files, and checkpoint folders
+        newer than ``latest.json`` (a kill during a checkpoint; the resumed run redoes them).
+        """
+        for path in remove_stale_temporaries(self.run_dir):
+            logger.info("removed temporary file %s", path)
+        latest = self._latest()
+        for step_dir in sorted(self.ckpt_dir.glob("step_*")):
+            if step_dir.is_dir() and (latest is None or step_dir.name > latest.name):
+                shutil.rmtree(step_dir)
+                logger.info("removed unfinished checkpoint %s", step_dir)
 
     def resume(self) -> None:
         """Continue from the latest complete checkpoint."""
         latest = self._latest()
         if latest is None:
             raise CheckpointError(f"{self.run_dir}: no checkpoint to resume from")
-        state = json.loads((latest / "state.json").read_text())
+        state = _read_json(latest / "state.json")
+        if not isinstance(state, dict) or not {"num_timesteps", "next_eval"} <= set(state):
+            raise CheckpointError(f"{latest / 'state.json'}: not a checkpoint state")
         th.set_num_threads(self.cfg.train.torch_threads)
-        model = AyssDQN.load(
-            str(latest / "model.zip"),
-            env=self.vec_env,
-            device="cpu",
-            tensorboard_log=str(self.run_dir / "tb"),
-        )
-        model.load_replay_buffer(latest / "replay.pkl")
+        # Resuming trusts the folder: SB3's loader unpickles parts of model.zip and replay.pkl
+        # (see "Trust model" in the README); evaluating and reporting never do.
+        try:
+            model = AyssDQN.load(
+                str(latest / "model.zip"),
+                env=self.vec_env,
+                device="cpu",
+                tensorboard_log=str(self.run_dir / "tb"),
+            )
+        except Exception as e:  # zipfile, pickle, torch: any corruption
+            raise CheckpointError(
+                f"{latest / 'model.zip'}: unreadable checkpoint ({type(e).__name__}: {e})"
+            ) from e
+        try:
+            model.load_replay_buffer(latest / "replay.pkl")
+        except Exception as e:
+            raise CheckpointError(
+                f"{latest / 'replay.pkl'}: unreadable replay buffer ({type(e).__name__}: {e})"
+            ) from e
         self._prune_replays(latest)
         self.model = model
         self.next_eval = int(state["next_eval"])
@@ -382,7 +441,10 @@ class Trainer:
             model._last_episode_starts = np.ones((1,), dtype=bool)
         np.random.set_state(_tuple_state(state["numpy_rng"]))  # noqa: NPY002 (SB3 uses it)
         random.setstate(_tuple_state(state["python_rng"]))
-        th.set_rng_state(th.load(latest / "torch_rng.pt"))
+        try:
+            th.set_rng_state(th.load(latest / "torch_rng.pt", weights_only=True))
+        except Exception as e:
+            raise CheckpointError(f"{latest / 'torch_rng.pt'}: unreadable ({e})") from e
         logger.info("resumed %s at step %d", self.run_dir, model.num_timesteps)
 
     def _resume_pairs(self, state: dict[str, Any]) -> None:
@@ -404,8 +466,7 @@ class Trainer:
     def select(self) -> dict[str, Any]:
         choice = select_spcp(self.rows, self.cfg.train.selection)
         row = self.rows[choice.index]
-        shutil.copyfile(self.run_dir / row["checkpoint"], self.run_dir / ".spcp.zip.tmp")
-        os.replace(self.run_dir / ".spcp.zip.tmp", self.run_dir / "spcp.zip")
+        atomic_copy(self.run_dir / row["checkpoint"], self.run_dir / "spcp.zip")
         record = {**dataclasses.asdict(choice), "checkpoint": row["checkpoint"], "row": row}
         atomic_write_json(self.run_dir / "spcp.json", record)
         return record
@@ -484,10 +545,16 @@ def _episode_result(trace: EpisodeTrace) -> EpisodeResult:
     )
 
 
+def _read_json(path: Path) -> Any:
+    """JSON from a run-folder file; a missing, unreadable or malformed file -> CheckpointError."""
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        raise CheckpointError(f"{path}: unreadable JSON ({e})") from e
+
+
 def _atomic_model_save(model: AyssDQN, path: Path) -> None:
-    tmp = path.with_name(f".{path.stem}.tmp.zip")
-    model.save(tmp)
-    os.replace(tmp, path)
+    atomic_write_with(path, model.save)
 
 
 def _jsonable(obj: Any) -> Any:
@@ -518,6 +585,8 @@ def train(
     argv: Sequence[str] = (),
 ) -> Path:
     """Train one (case, VUT, seed) into its run folder; return the folder."""
+    seed = check_seed(seed, "--seed")
+    check_out_dir(Path(out), "--out")
     run_dir = run_dir_for(out, cfg, seed)
     config_file = run_dir / "config.yaml"
     if resume:
@@ -530,6 +599,8 @@ def train(
         )
     trainer = Trainer(cfg, seed, run_dir)
     try:
+        if resume:
+            trainer.clean_leftovers()
         if resume and trainer._latest() is not None:
             trainer.resume()
         else:
@@ -544,12 +615,16 @@ def train(
 
 
 def _check_same_config(run_dir: Path, cfg: ExperimentConfig, seed: int) -> None:
-    import yaml
-
-    stored = yaml.safe_load((run_dir / "config.yaml").read_text())
-    stored_seed = stored.pop("seed")
-    stored.pop("vut")
-    stored_cfg = experiment_from_dict(stored, run_dir)
+    path = run_dir / "config.yaml"
+    try:
+        stored = safe_load_yaml(path.read_text(encoding="utf-8"), str(path))
+        if not isinstance(stored, dict):
+            raise CheckpointError(f"{path}: not a run configuration (top level is not a mapping)")
+        stored_seed = stored.pop("seed")
+        stored.pop("vut")
+        stored_cfg = experiment_from_dict(stored, run_dir)
+    except (ConfigError, KeyError, OSError, UnicodeDecodeError) as e:
+        raise CheckpointError(f"{path}: unreadable run configuration ({e})") from e
     if stored_seed != seed or to_dict(stored_cfg) != to_dict(cfg):
         raise CheckpointError(
             f"--resume: {run_dir}/config.yaml differs from the requested configuration; "
@@ -589,7 +664,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             overrides["progress_bar"] = False
         cfg = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, **overrides))
         run_dir = train(cfg, args.seed, args.out, resume=args.resume, argv=argv)
-    except (ConfigError, CheckpointError) as e:
+    except AyssError as e:
         sys.exit(f"error: {e}")
     print(run_dir)
 
