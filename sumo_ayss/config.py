@@ -47,6 +47,21 @@ def _check_range(where: str, value: tuple[float, ...], low: float = -math.inf) -
     _require(value[0] >= low, f"{where} min must be >= {low}, got {value[0]}")
 
 
+#: SUMO options that sumo_ayss sets itself (sim/session.py), and where to change them.
+MANAGED_SUMO_OPTIONS: dict[str, str] = {
+    "net-file": "env.network",
+    "n": "env.network",
+    "additional-files": "env.vuts / env.pov",
+    "a": "env.vuts / env.pov",
+    "step-length": "env.sim.step_length_s",
+    "seed": "the run's seed",
+    "collision.action": "always warn: a collision ends the episode",
+    "collision.mingap-factor": "env.sim.collision_mingap_factor",
+    "lanechange.duration": "env.sim.lanechange_duration_s",
+    "begin": "always 0",
+}
+
+
 @dataclass(frozen=True)
 class SimConfig:
     """How SUMO runs. Section ``env.sim``."""
@@ -81,6 +96,18 @@ class SimConfig:
             0 <= self.collision_mingap_factor <= 1,
             f"{s}.collision_mingap_factor must be in [0, 1], got {self.collision_mingap_factor}",
         )
+        args = self.extra_args
+        _require(
+            not args or str(args[0]).startswith("-"),
+            f"{s}.extra_args must start with a SUMO option ('--name'), got {list(args)}",
+        )
+        for arg in args:
+            name = str(arg).lstrip("-").split("=", 1)[0]
+            if str(arg).startswith("-") and name in MANAGED_SUMO_OPTIONS:
+                raise ConfigError(
+                    f"{s}.extra_args: {arg!r} is set by sumo_ayss itself "
+                    f"({MANAGED_SUMO_OPTIONS[name]}); remove it"
+                )
 
 
 ActuatorMode = Literal["clipped", "highway_env"]
