@@ -80,6 +80,9 @@ from sumo_ayss.selection import select_spcp
 
 logger = logging.getLogger(__name__)
 
+#: Files of a checkpoint that only the latest keeps (what a resume needs beyond model.zip).
+RESUME_FILES = ("replay.pkl", "resume_model.zip")
+
 EVAL_COLUMNS = [
     "step",
     "mean_return",
@@ -193,6 +196,11 @@ class Trainer:
             self.pair_vec = PairVecEnv(cfg.env, self.n_envs, sumo_seed=seed)
             self.vec_env = VecMonitor(self.pair_vec)
         self.model: AyssDQN | None = None
+        #: Between a candidate and its checkpoint: the candidate's folder, the env state
+        #: right after the candidate (episode start(s), RNGs) and the actions taken since.
+        self._pending_dir: Path | None = None
+        self._anchor: dict[str, Any] = {}
+        self._actions_since_anchor: list[list[int]] = []
 
     # -- folder ------------------------------------------------------------------------
 
@@ -244,8 +252,10 @@ class Trainer:
                 tb_log_name="dqn",
                 progress_bar=progress_bar,
             )
+        self.save_checkpoint()  # a candidate of the last rollout
         if model.num_timesteps >= self.next_eval:  # the last candidate, at the very end
             self.candidate(at_episode_boundary=False)
+            self.save_checkpoint()
 
     # -- candidates ----------------------------------------------------------------------
 
@@ -299,20 +309,50 @@ class Trainer:
         while self.next_eval <= step:
             self.next_eval += self.cfg.train.eval_every
 
-        self._save_resume_state(step_dir, env_state)
         write_eval_table(self.eval_path, self.rows)
-        atomic_write_json(self.ckpt_dir / "latest.json", {"step": step, "dir": step_dir.name})
-        self._prune_replays(step_dir)
+        # The resume state is written at the next rollout start (save_checkpoint), once SB3
+        # has stored this step's transitions and trained on them: from here on the actions
+        # are recorded, so that a resume replays them from this episode start.
+        self._anchor = env_state
+        self._actions_since_anchor = []
+        self._pending_dir = step_dir
 
-    def _prune_replays(self, keep: Path) -> None:
-        """Keep the replay buffer of the latest checkpoint only (each is ~6 MB per 100k).
+    def record_actions(self, actions: Any) -> None:
+        """Note a step's actions (between a candidate and its checkpoint, for the replay)."""
+        if self._pending_dir is not None:
+            self._actions_since_anchor.append(np.asarray(actions).reshape(-1).tolist())
+
+    def save_checkpoint(self) -> None:
+        """Write the resume state of the last candidate, if one is pending.
+
+        Called where SB3's state is consistent: at the start of a rollout (the previous
+        step's transitions are stored and trained on, ``num_timesteps`` counts exactly the
+        buffer's transitions, a new ``train_freq`` cycle begins) and at the end of ``learn``.
+        The env state is the candidate's episode start(s) plus the actions taken since,
+        which a resume replays (SUMO is deterministic for a VUT without random parameters).
+        """
+        step_dir = self._pending_dir
+        if step_dir is None:
+            return
+        self._save_resume_state(step_dir)
+        atomic_write_json(
+            self.ckpt_dir / "latest.json",
+            {"step": int(step_dir.name.split("_")[1]), "dir": step_dir.name},
+        )
+        self._pending_dir = None
+        self._prune_resume_files(step_dir)
+
+    def _prune_resume_files(self, keep: Path) -> None:
+        """Keep the replay buffer and full model of the latest checkpoint only (the buffer is
+        ~6 MB per 100k transitions).
 
         Run after ``latest.json`` moves on and again at resume, so a kill between the two
         leaves no orphan behind for good.
         """
-        for path in self.ckpt_dir.glob("step_*/replay.pkl"):
-            if path.parent != keep:
-                path.unlink(missing_ok=True)
+        for name in RESUME_FILES:
+            for path in self.ckpt_dir.glob(f"step_*/{name}"):
+                if path.parent != keep:
+                    path.unlink(missing_ok=True)
 
     def _restart_pairs(self, rollout: dict[str, Any] | None) -> None:
         """After an evaluation on the pairs: a fresh training episode on every pair.
@@ -350,16 +390,20 @@ class Trainer:
             "env_rngs": [env.np_random.bit_generator.state for env in self.pair_vec.envs],
         }
 
-    def _save_resume_state(self, step_dir: Path, env_state: dict[str, Any]) -> None:
+    def _save_resume_state(self, step_dir: Path) -> None:
         model = self.model
         assert model is not None
+        _atomic_model_save(model, step_dir / "resume_model.zip")
         atomic_write_with(step_dir / "replay.pkl", model.save_replay_buffer)
         state = {
             "num_timesteps": model.num_timesteps,
             "next_eval": self.next_eval,
-            **env_state,
+            **self._anchor,
+            "actions_since_anchor": self._actions_since_anchor,
             "numpy_rng": _jsonable(np.random.get_state()),  # noqa: NPY002 (SB3 uses it)
             "python_rng": _jsonable(random.getstate()),
+            # SB3 explores with the model's action space's own RNG; its load reseeds it.
+            "action_space_rng": model.action_space.np_random.bit_generator.state,
         }
         torch_state = th.get_rng_state()
         atomic_write_with(step_dir / "torch_rng.pt", lambda tmp: th.save(torch_state, tmp))
@@ -405,14 +449,14 @@ class Trainer:
         # (see "Trust model" in the README); evaluating and reporting never do.
         try:
             model = AyssDQN.load(
-                str(latest / "model.zip"),
+                str(latest / "resume_model.zip"),
                 env=self.vec_env,
                 device="cpu",
                 tensorboard_log=str(self.run_dir / "tb"),
             )
         except Exception as e:  # zipfile, pickle, torch: any corruption
             raise CheckpointError(
-                f"{latest / 'model.zip'}: unreadable checkpoint ({type(e).__name__}: {e})"
+                f"{latest / 'resume_model.zip'}: unreadable checkpoint ({type(e).__name__}: {e})"
             ) from e
         try:
             model.load_replay_buffer(latest / "replay.pkl")
@@ -420,27 +464,42 @@ class Trainer:
             raise CheckpointError(
                 f"{latest / 'replay.pkl'}: unreadable replay buffer ({type(e).__name__}: {e})"
             ) from e
-        self._prune_replays(latest)
+        self._prune_resume_files(latest)
         self.model = model
-        self.next_eval = int(state["next_eval"])
-        self.rows = [r for r in read_eval_table(self.eval_path) if r["step"] <= model.num_timesteps]
-        if self.pair_vec is not None:
-            self._resume_pairs(state)
-        else:
-            # Put the env back at the checkpoint's episode start, with its RNG where it was
-            # (through the Monitor wrapper, which must see the reset too).
-            assert isinstance(self.vec_env, DummyVecEnv) and self.env is not None
-            monitor = self.vec_env.envs[0]
-            monitor.reset(seed=self.seed)  # starts SUMO and creates the env RNG
-            self.env.np_random.bit_generator.state = state["env_rng"]
-            ic = state["initial_condition"]
-            obs, _ = monitor.reset(
-                options={"initial_condition": InitialCondition(**ic)} if ic else None
-            )
-            model._last_obs = obs[None, :]  # type: ignore[assignment]
-            model._last_episode_starts = np.ones((1,), dtype=bool)
-        np.random.set_state(_tuple_state(state["numpy_rng"]))  # noqa: NPY002 (SB3 uses it)
-        random.setstate(_tuple_state(state["python_rng"]))
+        try:
+            self.next_eval = int(state["next_eval"])
+            self.rows = [
+                r for r in read_eval_table(self.eval_path) if r["step"] <= model.num_timesteps
+            ]
+            actions = [np.asarray(a, dtype=np.int64) for a in state["actions_since_anchor"]]
+            if self.pair_vec is not None:
+                self._resume_pairs(state)
+            else:
+                # Put the env back at the checkpoint's episode start, with its RNG where it
+                # was (through the Monitor wrapper, which must see the reset too).
+                assert isinstance(self.vec_env, DummyVecEnv) and self.env is not None
+                monitor = self.vec_env.envs[0]
+                monitor.reset(seed=self.seed)  # starts SUMO and creates the env RNG
+                self.env.np_random.bit_generator.state = state["env_rng"]
+                ic = state["initial_condition"]
+                obs, _ = monitor.reset(
+                    options={"initial_condition": InitialCondition(**ic)} if ic else None
+                )
+                model._last_obs = obs[None, :]  # type: ignore[assignment]
+                model._last_episode_starts = np.ones((1,), dtype=bool)
+            # The steps taken between the candidate and the checkpoint, replayed: the envs are
+            # then where the killed run's were (SB3 holds their observation).
+            for action in actions:
+                obs, _, dones, _ = self.vec_env.step(action)
+                model._last_obs = obs  # type: ignore[assignment]
+                model._last_episode_starts = dones
+            np.random.set_state(_tuple_state(state["numpy_rng"]))  # noqa: NPY002 (SB3 uses it)
+            random.setstate(_tuple_state(state["python_rng"]))
+            model.action_space.np_random.bit_generator.state = state["action_space_rng"]
+        except (KeyError, TypeError, ValueError) as e:
+            raise CheckpointError(
+                f"{latest / 'state.json'}: inconsistent checkpoint state ({type(e).__name__}: {e})"
+            ) from e
         try:
             th.set_rng_state(th.load(latest / "torch_rng.pt", weights_only=True))
         except Exception as e:
@@ -482,14 +541,20 @@ class _CandidateCallback(BaseCallback):
 
     One env: at the first episode end after it (the env is borrowed and restored there).
     Several pairs: at once (their episodes never end together; they are cut and restarted).
+    The candidate's resume checkpoint follows at the next rollout start
+    (:meth:`Trainer.save_checkpoint`); the steps in between are recorded for its replay.
     """
 
     def __init__(self, trainer: Trainer) -> None:
         super().__init__()
         self.trainer = trainer
 
+    def _on_rollout_start(self) -> None:
+        self.trainer.save_checkpoint()
+
     def _on_step(self) -> bool:
         trainer = self.trainer
+        trainer.record_actions(self.locals["actions"])
         if self.num_timesteps < trainer.next_eval:
             return True
         if trainer.pair_vec is not None:
