@@ -132,3 +132,22 @@ def test_an_unreferenced_env_is_collected_when_a_new_one_starts() -> None:
         other.reset(seed=1)
     finally:
         other.close()
+
+
+def test_vec_env_reseeded_repeats_its_trajectories_with_a_stochastic_vut() -> None:
+    from sumo_ayss.envs.vec_env import PairVecEnv
+
+    vec = PairVecEnv(_noisy_config(), n_envs=3)
+    actions = np.array([10, 3, 18])
+    try:
+        traces = []
+        for _ in range(2):
+            vec.seed(21)
+            trace = [vec.reset()]
+            for _ in range(40):  # beyond the first episodes: auto-resets included
+                obs, _, _, _ = vec.step(actions)
+                trace.append(obs)
+            traces.append(np.array(trace))
+    finally:
+        vec.close()
+    np.testing.assert_array_equal(traces[0], traces[1])
