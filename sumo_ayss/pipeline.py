@@ -296,6 +296,7 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
                 ayss=AyssConfig(n_samples=spec.n_ayss),
                 force=True,
                 progress=False,
+                trust_controller=True,  # the pipeline's own runs, from the user's configs
             )
             atomic_write_json(marker, {"inputs": key})
             stages["evaluate"] = "done"
