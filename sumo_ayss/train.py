@@ -61,6 +61,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor
 from sumo_ayss.agents.dqn import AyssDQN
 from sumo_ayss.agents.greedy import GreedyPolicy
 from sumo_ayss.agents.hparams import DQNHyperParams
+from sumo_ayss.agents.weights import read_policy_state
 from sumo_ayss.atomic import (
     atomic_copy,
     atomic_write_json,
@@ -471,6 +472,14 @@ class Trainer:
             self.rows = [
                 r for r in read_eval_table(self.eval_path) if r["step"] <= model.num_timesteps
             ]
+            for row in self.rows:  # every earlier candidate must still be a readable policy
+                ckpt = Path(str(row["checkpoint"]))
+                if ckpt.is_absolute() or ".." in ckpt.parts or ckpt.parts[:1] != ("checkpoints",):
+                    raise CheckpointError(
+                        f"{self.eval_path}: step {row['step']}: checkpoint must be a path "
+                        f"under checkpoints/, got {str(ckpt)!r}"
+                    )
+                read_policy_state(self.run_dir / ckpt)
             actions = [np.asarray(a, dtype=np.int64) for a in state["actions_since_anchor"]]
             if self.pair_vec is not None:
                 self._resume_pairs(state)

@@ -526,7 +526,13 @@ RESUME_CORRUPTIONS: list[tuple[str, str, Corruption, str]] = [
         "truncated model.zip",
         "checkpoints/LATEST/model.zip",
         _truncate,
-        "model.zip: unreadable checkpoint",
+        "model.zip: not a saved policy",
+    ),
+    (
+        "truncated resume_model.zip",
+        "checkpoints/LATEST/resume_model.zip",
+        _truncate,
+        "resume_model.zip: unreadable checkpoint",
     ),
     (
         "truncated replay.pkl",
