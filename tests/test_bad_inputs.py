@@ -686,3 +686,15 @@ def test_step_after_the_episode_ended_raises() -> None:
             env.step(10)
     finally:
         env.close()
+
+
+def test_report_out_pointing_at_a_file_is_refused(
+    trained_run: tuple[Path, Path], tmp_path: Path
+) -> None:
+    from sumo_ayss.report.__main__ import main
+
+    file = _yaml(tmp_path, "precious\n", "report.txt")
+    with pytest.raises(SystemExit) as info:
+        main([str(trained_run[1]), "--out", str(file)])
+    assert isinstance(info.value.code, str) and "--out: " in info.value.code
+    assert file.read_text() == "precious\n"
