@@ -1,29 +1,109 @@
-"""Atomic file writes: a temporary file in the same folder, then ``os.replace``.
+"""Atomic, durable file writes: a temporary file in the same folder, fsync, ``os.replace``,
+fsync of the folder.
 
 A reader (or a resumed run after a kill) sees either the old file or the new one, never
-half of one. Every result file of sumo_ayss is written through these helpers.
+half of one; after the function returns, the new file survives a power loss too (its data
+and the rename are on disk). Every result file of sumo_ayss is written through these helpers.
+
+Temporary files are named ``.<name>.<pid>.tmp``; :func:`remove_stale_temporaries` deletes
+the ones a killed process left behind.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import shutil
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+#: Suffix of every temporary file written here (``.<name>.<pid>.tmp``).
+TMP_SUFFIX = ".tmp"
 
-def atomic_write_text(path: str | Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same folder + rename."""
+
+def fsync_dir(folder: str | Path) -> None:
+    """Make a rename or a new entry in ``folder`` durable (no-op where folders cannot be opened)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:  # pragma: no cover - e.g. Windows
+        return
+    try:
+        os.fsync(fd)
+    except OSError:  # pragma: no cover - some file systems refuse fsync on folders
+        pass
+    finally:
+        os.close(fd)
+
+
+def _tmp_path(path: Path) -> Path:
+    return path.with_name(f".{path.name}.{os.getpid()}{TMP_SUFFIX}")
+
+
+def atomic_write_with(path: str | Path, write: Callable[[Path], None]) -> None:
+    """Let ``write(tmp)`` create a temporary file, then fsync it and rename it to ``path``.
+
+    For writers that need a path (SB3's ``save``, matplotlib's ``savefig``, ``torch.save``).
+    The temporary file keeps ``path``'s suffix (some writers choose the format by it).
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp = path.with_name(f".{path.stem}.{os.getpid()}{TMP_SUFFIX}{path.suffix}")
     try:
-        tmp.write_text(text, encoding="utf-8")
+        write(tmp)
+        with open(tmp, "rb+") as f:
+            os.fsync(f.fileno())
         os.replace(tmp, path)
+        fsync_dir(path.parent)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` durably through a temporary file in the same folder + rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = _tmp_path(path)
+    try:
+        with open(tmp, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+        fsync_dir(path.parent)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def atomic_write_text(path: str | Path, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically and durably."""
+    atomic_write_bytes(path, text.encode("utf-8"))
 
 
 def atomic_write_json(path: str | Path, data: Any) -> None:
     """Indented, key-sorted JSON, written atomically."""
     atomic_write_text(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
+
+
+def atomic_copy(src: str | Path, dst: str | Path) -> None:
+    """Copy ``src`` to ``dst`` atomically and durably."""
+    atomic_write_with(dst, lambda tmp: shutil.copyfile(src, tmp))
+
+
+def remove_stale_temporaries(folder: str | Path, recursive: bool = True) -> list[Path]:
+    """Delete temporary files (``.*.tmp``, ``.*.tmp.*``) left in ``folder`` by a killed writer.
+
+    Call it only where no other process writes into ``folder`` at the same time (a run folder
+    at the start of its run). Returns the removed paths.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    pattern = "**/.*" if recursive else ".*"
+    removed = []
+    for path in folder.glob(pattern):
+        name = path.name
+        if path.is_file() and (name.endswith(TMP_SUFFIX) or f"{TMP_SUFFIX}." in name):
+            path.unlink(missing_ok=True)
+            removed.append(path)
+    return removed

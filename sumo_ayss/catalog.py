@@ -21,13 +21,15 @@ Decelerations (``decel``, ``emergencyDecel``, ``apparentDecel``) are positive nu
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import difflib
 import hashlib
 import importlib
 import importlib.util
 import math
 import sys
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -531,10 +533,22 @@ class ControllerSpec:
             value = _check_number(f"{where}.{name}", getattr(self, name))
             if value <= 0:
                 raise ConfigError(f"{where}.{name} must be > 0, got {value!r}")
-        self.build(where)
+        if _CONTROLLER_IMPORTS.get():  # untrusted (a run folder): built only when needed
+            self.build(where)
 
     def resolve(self, where: str = "controller") -> Any:
-        """The object ``target`` names (a class or factory), imported."""
+        """The object ``target`` names (a class or factory), imported.
+
+        Raises:
+            ConfigError: The target cannot be imported, or imports are not allowed here
+                (inside ``controller_imports(False)``: a run folder opened untrusted).
+        """
+        if not _CONTROLLER_IMPORTS.get():
+            raise ConfigError(
+                f"{where}.target {self.target!r}: this VUT is a user controller, and importing "
+                "it runs code named by the run folder; pass --trust-controller if you trust "
+                "the folder (see 'Trust model' in the README)"
+            )
         module_part, _, attr_part = self.target.rpartition(":")
         try:
             module = _import(module_part)
@@ -621,6 +635,28 @@ class ControllerSpec:
         )
         spec.validate(where)
         return spec
+
+
+#: Whether user controllers may be imported now (see :func:`controller_imports`).
+_CONTROLLER_IMPORTS: contextvars.ContextVar[bool] = contextvars.ContextVar(
+    "sumo_ayss_controller_imports", default=True
+)
+
+
+@contextlib.contextmanager
+def controller_imports(allowed: bool) -> Iterator[None]:
+    """Allow or forbid importing user controllers inside the ``with`` block.
+
+    Configs a user writes import their controllers (to fail early on a bad target). A run
+    folder's ``config.yaml`` is opened with ``allowed=False`` unless the user passed
+    ``--trust-controller``: its controller targets are checked for form but not imported,
+    and building one (an env whose VUT it drives) raises a :class:`ConfigError` naming the flag.
+    """
+    token = _CONTROLLER_IMPORTS.set(bool(allowed))
+    try:
+        yield
+    finally:
+        _CONTROLLER_IMPORTS.reset(token)
 
 
 def _import(module_part: str) -> Any:

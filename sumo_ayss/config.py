@@ -47,6 +47,21 @@ def _check_range(where: str, value: tuple[float, ...], low: float = -math.inf) -
     _require(value[0] >= low, f"{where} min must be >= {low}, got {value[0]}")
 
 
+#: SUMO options that sumo_ayss sets itself (sim/session.py), and where to change them.
+MANAGED_SUMO_OPTIONS: dict[str, str] = {
+    "net-file": "env.network",
+    "n": "env.network",
+    "additional-files": "env.vuts / env.pov",
+    "a": "env.vuts / env.pov",
+    "step-length": "env.sim.step_length_s",
+    "seed": "the run's seed",
+    "collision.action": "always warn: a collision ends the episode",
+    "collision.mingap-factor": "env.sim.collision_mingap_factor",
+    "lanechange.duration": "env.sim.lanechange_duration_s",
+    "begin": "always 0",
+}
+
+
 @dataclass(frozen=True)
 class SimConfig:
     """How SUMO runs. Section ``env.sim``."""
@@ -81,6 +96,18 @@ class SimConfig:
             0 <= self.collision_mingap_factor <= 1,
             f"{s}.collision_mingap_factor must be in [0, 1], got {self.collision_mingap_factor}",
         )
+        args = self.extra_args
+        _require(
+            not args or str(args[0]).startswith("-"),
+            f"{s}.extra_args must start with a SUMO option ('--name'), got {list(args)}",
+        )
+        for arg in args:
+            name = str(arg).lstrip("-").split("=", 1)[0]
+            if str(arg).startswith("-") and name in MANAGED_SUMO_OPTIONS:
+                raise ConfigError(
+                    f"{s}.extra_args: {arg!r} is set by sumo_ayss itself "
+                    f"({MANAGED_SUMO_OPTIONS[name]}); remove it"
+                )
 
 
 ActuatorMode = Literal["clipped", "highway_env"]
@@ -322,6 +349,13 @@ class EnvConfig:
             path = Path(self.network)
             object.__setattr__(self, "network", path)
             _require(path.is_file(), f"{s}.network: file not found: {path}")
+            check_sumo_network(path, f"{s}.network")
+        top = self.actuator.max_speed_mps
+        _require(
+            self.odd.pov_speed_mps[1] <= top,
+            f"{s}.odd.pov_speed_mps max ({self.odd.pov_speed_mps[1]}) must be <= "
+            f"env.actuator.max_speed_mps ({top}): the POV could not drive its initial speed",
+        )
 
     @property
     def vut_type(self) -> VehicleType:
@@ -386,6 +420,8 @@ def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> A
     if tp is float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ConfigError(f"{where} must be a number, got {value!r}")
+        if not math.isfinite(value):  # YAML's .inf / .nan: no field of ours takes them
+            raise ConfigError(f"{where} must be a finite number, got {value!r}")
         return float(value)
     if tp is str:
         if not isinstance(value, str):
@@ -404,7 +440,9 @@ def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> A
     if origin in (Mapping, dict) or tp is dict:
         if not isinstance(value, Mapping):
             raise ConfigError(f"{where} must be a mapping, got {value!r}")
-        merged = dict(default or {})
+        # A catalog of VUTs extends the built-ins; any other mapping (e.g. the pipeline's
+        # ``experiments``) replaces its default whole, so ``{}`` never falls back silently.
+        merged = dict(default or {}) if args and args[1] is VehicleType else {}
         for k, v in value.items():
             merged[str(k)] = _convert(args[1], v, f"{where}.{k}", base_dir, merged.get(str(k)))
         return merged
@@ -460,12 +498,100 @@ def read_yaml(path: str | Path) -> dict[str, Any]:
     if not path.is_file():
         raise ConfigError(f"config file not found: {path}")
     try:
-        data = yaml.safe_load(path.read_text()) or {}
-    except yaml.YAMLError as e:
-        raise ConfigError(f"{path}: invalid YAML: {e}") from e
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise ConfigError(f"{path}: unreadable ({e})") from e
+    data = safe_load_yaml(text, str(path))
+    if data is None:
+        raise ConfigError(
+            f"{path}: the file is empty; write at least one section (an empty file would "
+            "silently run every default)"
+        )
     if not isinstance(data, Mapping):
         raise ConfigError(f"{path}: top level must be a mapping, got {type(data).__name__}")
     return dict(data)
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing a key given twice in one mapping (PyYAML keeps the last)."""
+
+
+def _construct_unique_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode) -> Any:
+    loader.flatten_mapping(node)
+    seen: dict[Any, Any] = {}
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=True)
+        if key in seen:
+            raise yaml.constructor.ConstructorError(
+                None,
+                None,
+                f"duplicate key {key!r} (first at line {seen[key].line + 1}); each key may "
+                "appear once per mapping",
+                key_node.start_mark,
+            )
+        seen[key] = key_node.start_mark
+    return loader.construct_mapping(node, deep=True)
+
+
+_UniqueKeyLoader.add_constructor(
+    yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_unique_mapping
+)
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
+def safe_load_yaml(text: str, name: str) -> Any:
+    """YAML from ``text`` (safe types only, duplicate keys refused); errors name ``name``."""
+    try:
+        return yaml.load(text, Loader=_UniqueKeyLoader)
+    except yaml.YAMLError as e:
+        raise ConfigError(f"{name}: invalid YAML: {_one_line(str(e))}") from e
+
+
+#: Seeds are passed to SUMO's ``--seed`` (a C int), numpy and torch: the common range.
+SEED_MAX = 2**31 - 1
+
+
+def check_seed(seed: Any, where: str) -> int:
+    """``seed`` as an int in [0, SEED_MAX], else a :class:`ConfigError` naming ``where``."""
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= SEED_MAX:
+        raise ConfigError(f"{where} must be an integer in [0, {SEED_MAX}], got {seed!r}")
+    return int(seed)
+
+
+def check_out_dir(path: Path, where: str) -> None:
+    """Refuse an output folder that is, or lies under, an existing file (before any work)."""
+    for p in (Path(path), *Path(path).parents):
+        if p.exists():
+            if not p.is_dir():
+                raise ConfigError(f"{where}: {p} is a file; give a folder (it may not exist yet)")
+            return
+
+
+def check_sumo_network(path: Path, where: str) -> None:
+    """Refuse a file that is not a SUMO ``.net.xml`` before libsumo loads it.
+
+    libsumo dies with a segmentation fault (no message) on some XML files that are not SUMO
+    networks, so the root element (``<net>``) is checked here, in Python, first.
+    """
+    import xml.etree.ElementTree as ET
+
+    try:
+        for _event, elem in ET.iterparse(path, events=("start",)):
+            tag = elem.tag.rpartition("}")[2]
+            if tag != "net":
+                raise ConfigError(
+                    f"{where}: {path} is not a SUMO network (root element <{tag}>, expected "
+                    "<net>; build one with netconvert)"
+                )
+            return
+    except ET.ParseError as e:
+        raise ConfigError(f"{where}: {path} is not valid XML ({e})") from e
+    except OSError as e:
+        raise ConfigError(f"{where}: cannot read {path} ({e})") from e
+    raise ConfigError(f"{where}: {path} is empty, not a SUMO network")
 
 
 def env_config_from_mapping(data: Mapping[str, Any], base_dir: Path | None = None) -> EnvConfig:

@@ -57,6 +57,7 @@ A worked example is ``examples/acc_controller.py`` (constant time-gap ACC).
 from __future__ import annotations
 
 import math
+import numbers
 from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 from sumo_ayss.catalog import ControllerSpec, VehicleType
@@ -129,12 +130,18 @@ def bound_acceleration(accel_mps2: Any, max_accel_mps2: float, max_decel_mps2: f
     Raises:
         ControllerError: If the command is not a finite real number.
     """
-    try:
-        a = float(accel_mps2)
-    except (TypeError, ValueError) as e:
-        raise ControllerError(f"controller returned {accel_mps2!r}, not a number") from e
-    if not math.isfinite(a) or isinstance(accel_mps2, bool):
-        raise ControllerError(f"controller returned {accel_mps2!r}, not a finite acceleration")
+    # A real number only: float('2.5') would accept a string, float(True) a bool.
+    if isinstance(accel_mps2, bool) or not isinstance(accel_mps2, numbers.Real):
+        raise ControllerError(
+            f"controller returned {accel_mps2!r} ({type(accel_mps2).__name__}); "
+            "acceleration(state) must return a finite real number [m/s²]"
+        )
+    a = float(accel_mps2)
+    if not math.isfinite(a):
+        raise ControllerError(
+            f"controller returned {accel_mps2!r}; acceleration(state) must return a finite "
+            "real number [m/s²]"
+        )
     return min(max(a, -max_decel_mps2), max_accel_mps2)
 
 
@@ -188,7 +195,12 @@ class ControlledVut:
         pair.take_vut_control()
         reset = getattr(self.controller, "reset", None)
         if reset is not None:
-            reset()
+            try:
+                reset()
+            except Exception as e:
+                raise ControllerError(
+                    f"controller {self.spec.target!r}: reset() raised {type(e).__name__}: {e}"
+                ) from e
         self.last_state = None
         self.last_request_mps2 = self.last_command_mps2 = 0.0
 
@@ -204,8 +216,16 @@ class ControlledVut:
         """
         state = self.observe(pair)
         spec = self.spec
-        request = self.controller.acceleration(state)
-        accel = bound_acceleration(request, spec.max_accel_mps2, spec.max_decel_mps2)
+        try:
+            request = self.controller.acceleration(state)
+        except Exception as e:  # user code: stop the run with the controller named
+            raise ControllerError(
+                f"controller {self.spec.target!r} raised {type(e).__name__}: {e} (state {state})"
+            ) from e
+        try:
+            accel = bound_acceleration(request, spec.max_accel_mps2, spec.max_decel_mps2)
+        except ControllerError as e:
+            raise ControllerError(f"{spec.target!r}: {e}") from None
         v_next, realised = commanded_speed(state.speed_mps, accel, self.dt_s, spec.max_speed_mps)
         pair.command_vut_speed(v_next)
         self.last_state = state

@@ -30,10 +30,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
-
-from sumo_ayss.agents.greedy import GreedyPolicy
-from sumo_ayss.config import to_dict
+from sumo_ayss.catalog import controller_imports
+from sumo_ayss.config import check_seed, safe_load_yaml, to_dict
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
@@ -82,8 +80,13 @@ class EvaluationResult:
     ran_ayss: bool
 
 
-def load_run(run_dir: str | Path) -> RunInfo:
+def load_run(run_dir: str | Path, *, trust_controller: bool = False) -> RunInfo:
     """Read ``config.yaml`` (and ``spcp.json`` if present) of a run folder.
+
+    Args:
+        run_dir: The run folder.
+        trust_controller: Import the user controllers its config names (runs their code).
+            Without it their targets are checked for form only (see the README's trust model).
 
     Raises:
         CheckpointError: If the folder or its config is missing or unreadable.
@@ -93,26 +96,36 @@ def load_run(run_dir: str | Path) -> RunInfo:
     if not path.is_file():
         raise CheckpointError(f"{run_dir}: not a run folder (no config.yaml)")
     try:
-        data = yaml.safe_load(path.read_text())
+        data = safe_load_yaml(path.read_text(encoding="utf-8"), str(path))
         data = dict(data)
-        seed, vut = int(data.pop("seed")), data.pop("vut")
-    except (yaml.YAMLError, TypeError, ValueError, KeyError) as exc:
+        seed, vut = check_seed(data.pop("seed"), f"{path}: seed"), data.pop("vut")
+    except (ConfigError, TypeError, ValueError, KeyError, OSError, UnicodeDecodeError) as exc:
         raise CheckpointError(f"{path}: unreadable run configuration ({exc})") from exc
     try:
-        cfg = experiment_from_dict(data, run_dir).with_vut(vut)
+        with controller_imports(trust_controller):
+            cfg = experiment_from_dict(data, run_dir).with_vut(vut)
     except ConfigError as exc:
         raise CheckpointError(f"{path}: invalid run configuration: {exc}") from exc
     spcp_step = None
     if (run_dir / "spcp.json").is_file():
-        spcp_step = read_json(run_dir / "spcp.json").get("step")
+        spcp = read_json(run_dir / "spcp.json")
+        spcp_step = spcp.get("step") if isinstance(spcp, dict) else None
     return RunInfo(run_dir, cfg, seed, spcp_step)
 
 
-def _load_policy(run_dir: Path) -> Policy:
-    path = run_dir / "spcp.zip"
+def load_spcp(run: RunInfo, env: PairEnv) -> Policy:
+    """The run's SPCP as a greedy policy, its weights read without unpickling (trust model)."""
+    from sumo_ayss.agents.weights import load_greedy_policy
+
+    path = run.run_dir / "spcp.zip"
     if not path.is_file():
-        raise CheckpointError(f"{run_dir}: no spcp.zip (was the SPCP selected?)")
-    return GreedyPolicy.load(path)
+        raise CheckpointError(f"{run.run_dir}: no spcp.zip (was the SPCP selected?)")
+    return load_greedy_policy(
+        path,
+        run.config.agent,
+        env.observation_space,  # type: ignore[arg-type]
+        env.action_space,  # type: ignore[arg-type]
+    )
 
 
 def _base_record(run: RunInfo, stage: str) -> dict[str, Any]:
@@ -196,6 +209,7 @@ def evaluate_run(
     force: bool = False,
     progress: bool = True,
     policy: Policy | None = None,
+    trust_controller: bool = False,
 ) -> EvaluationResult:
     """Run the outcome and AYSS stages on a run folder (see the module docstring).
 
@@ -207,6 +221,8 @@ def evaluate_run(
         force: Recompute stages whose outputs exist.
         progress: tqdm progress bars.
         policy: Use this policy instead of ``<run>/spcp.zip`` (e.g. a scripted one).
+        trust_controller: Allow importing the run's user-controller VUT (runs its code); a
+            run whose VUT is a controller cannot be evaluated without it.
 
     Returns:
         The output paths and which stages ran.
@@ -214,7 +230,20 @@ def evaluate_run(
     Raises:
         CheckpointError: If the run folder, its config or its SPCP cannot be read.
     """
-    run = load_run(run_dir)
+    with controller_imports(trust_controller):
+        return _evaluate_run(run_dir, n_outcome, outcome_seed, ayss, force, progress, policy)
+
+
+def _evaluate_run(
+    run_dir: str | Path,
+    n_outcome: int,
+    outcome_seed: int,
+    ayss: AyssConfig | None,
+    force: bool,
+    progress: bool,
+    policy: Policy | None,
+) -> EvaluationResult:
+    run = load_run(run_dir, trust_controller=_trusted())
     ayss_cfg = ayss if ayss is not None else AyssConfig()
     d = run.run_dir
     paths = {n: d / n for n in (OUTCOME_CSV, OUTCOME_JSON, AYSS_CSV, AYSS_JSON)}
@@ -223,9 +252,9 @@ def evaluate_run(
     )
     do_ayss = _should_run(paths[AYSS_CSV], paths[AYSS_JSON], ayss_cfg.to_dict(), force)
     if do_outcome or do_ayss:
-        pol = policy if policy is not None else _load_policy(d)
         env = make_env(run.config.env, sumo_seed=run.seed)
         try:
+            pol = policy if policy is not None else load_spcp(run, env)
             if do_outcome:
                 _outcome_stage(env, pol, run, n_outcome, outcome_seed, progress)
             if do_ayss:
@@ -241,6 +270,12 @@ def evaluate_run(
         do_outcome,
         do_ayss,
     )
+
+
+def _trusted() -> bool:
+    from sumo_ayss.catalog import _CONTROLLER_IMPORTS
+
+    return _CONTROLLER_IMPORTS.get()
 
 
 # --------------------------------------------------------------------------- CLI
@@ -273,6 +308,11 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
         help="sample AYSS speeds in the run's ODD instead of [0, 30] m/s",
     )
     parser.add_argument("--force", action="store_true", help="recompute existing outputs")
+    parser.add_argument(
+        "--trust-controller",
+        action="store_true",
+        help="import the run's user-controller VUT (runs code the run folder names)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     return parser.parse_args(argv)
 
@@ -297,6 +337,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             ayss=ayss,
             force=args.force,
             progress=not args.no_progress,
+            trust_controller=args.trust_controller,
         )
     except AyssError as e:
         sys.exit(f"error: {e}")

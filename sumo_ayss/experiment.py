@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from sumo_ayss.agents.hparams import DQNHyperParams
-from sumo_ayss.config import EnvConfig, _require, build, read_yaml, to_dict
+from sumo_ayss.config import EnvConfig, _require, build, check_seed, read_yaml, to_dict
 from sumo_ayss.selection import CRITERIA
 
 
@@ -64,6 +64,7 @@ class TrainConfig:
         ):
             value = getattr(self, name)
             _require(value >= 1, f"{s}.{name} must be >= 1, got {value}")
+        check_seed(self.eval_seed, f"{s}.eval_seed")
         _require(
             self.eval_every <= self.total_timesteps,
             f"{s}.eval_every ({self.eval_every}) must be <= total_timesteps "
@@ -87,6 +88,14 @@ class ExperimentConfig:
     env: EnvConfig = field(default_factory=EnvConfig)
     agent: DQNHyperParams = field(default_factory=DQNHyperParams)
     train: TrainConfig = field(default_factory=TrainConfig)
+
+    def __post_init__(self) -> None:
+        a, t = self.agent, self.train
+        _require(
+            a.learning_starts < t.total_timesteps,
+            f"agent.learning_starts ({a.learning_starts}) must be < train.total_timesteps "
+            f"({t.total_timesteps}): otherwise the run never learns",
+        )
 
     def with_vut(self, vut: str | None) -> ExperimentConfig:
         if vut is None:

@@ -27,6 +27,7 @@ Pipeline YAML (every key optional)::
 from __future__ import annotations
 
 import argparse
+import collections
 import dataclasses
 import hashlib
 import json
@@ -34,9 +35,11 @@ import logging
 import multiprocessing
 import os
 import sys
+import threading
 import time
 import traceback
 import types
+import typing
 from collections.abc import Mapping, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
@@ -44,8 +47,17 @@ from pathlib import Path
 from typing import Any, ClassVar, Literal
 
 from sumo_ayss.catalog import VehicleType
-from sumo_ayss.config import PROJECT_ROOT, Case, _require, build, read_yaml, to_dict
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.config import (
+    PROJECT_ROOT,
+    Case,
+    _require,
+    build,
+    check_out_dir,
+    check_seed,
+    read_yaml,
+    to_dict,
+)
+from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.report.options import ReportOptions
 
 logger = logging.getLogger(__name__)
@@ -68,6 +80,8 @@ class GridConfig:
             values = getattr(self, name)
             _require(len(values) > 0, f"grid.{name} must not be empty")
             _require(len(set(values)) == len(values), f"grid.{name} has duplicates: {list(values)}")
+        for seed in self.seeds:
+            check_seed(seed, "grid.seeds[]")
 
 
 @dataclass(frozen=True)
@@ -121,6 +135,12 @@ class PipelineConfig:
         object.__setattr__(self, "vuts", types.MappingProxyType(dict(self.vuts)))
         for name, vt in self.vuts.items():
             vt.validate(f"vuts.{name}")
+        known = typing.get_args(Case)
+        for case in self.experiments:
+            _require(
+                case in known,
+                f"experiments.{case}: unknown case; allowed: {list(known)}",
+            )
         for case in self.grid.cases:
             _require(
                 case in self.experiments,
@@ -278,6 +298,7 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
                 ayss=AyssConfig(n_samples=spec.n_ayss),
                 force=True,
                 progress=False,
+                trust_controller=True,  # the pipeline's own runs, from the user's configs
             )
             atomic_write_json(marker, {"inputs": key})
             stages["evaluate"] = "done"
@@ -312,7 +333,14 @@ def _table(statuses: Sequence[JobStatus]) -> Any:
     table = Table(title="sumo_ayss pipeline", expand=False)
     for col in ("job", "state", "progress", "tries", "wall [s]"):
         table.add_column(col)
-    colours = {"done": "green", "failed": "red", "running": "yellow", "retrying": "magenta"}
+    colours = {
+        "done": "green",
+        "failed": "red",
+        "running": "yellow",
+        "retrying": "magenta",
+        "interrupted": "red",
+        "cancelled": "red",
+    }
     for s in statuses:
         colour = colours.get(s.state, "white")
         table.add_row(
@@ -325,72 +353,125 @@ def _table(statuses: Sequence[JobStatus]) -> Any:
     return table
 
 
-def _die_with_parent() -> None:
-    """Worker initializer: on Linux, get SIGKILLed when the pipeline process dies.
+def _worker_init() -> None:
+    """Worker initializer: die with the pipeline, and leave Ctrl-C to it.
 
-    Without it a killed pipeline leaves its workers running, and a rerun would race them
-    for the same run folders.
+    On Linux a worker gets SIGKILLed when the pipeline process dies: without it a killed
+    pipeline leaves its workers running, and a rerun would race them for the same run
+    folders. A Ctrl-C reaches every process of the terminal's group; workers ignore it and
+    the pipeline stops them (:func:`_stop_workers`), so that no job starts afterwards.
+    It also runs before any job imports torch, so that torch's intra-op pool starts with one
+    BLAS/OpenMP thread (``run_job`` then applies ``train.torch_threads``).
     """
+    import signal
+
+    from sumo_ayss.threads import single_thread_env
+
+    single_thread_env()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     if sys.platform.startswith("linux"):
         import ctypes
-        import signal
 
         libc = ctypes.CDLL("libc.so.6", use_errno=True)
         pr_set_pdeathsig = 1
         libc.prctl(pr_set_pdeathsig, signal.SIGKILL)
 
 
-def _init_worker() -> None:
-    """Worker initializer: die with the parent; one BLAS/OpenMP thread unless the user set one.
+def _stop_workers(pool: ProcessPoolExecutor, grace_s: float = 3.0) -> None:
+    """Terminate the pool's worker processes now (SIGTERM, then SIGKILL after ``grace_s``).
 
-    Runs in the fresh (spawned) worker before any job imports torch, so torch's intra-op pool
-    starts with one thread (``run_job`` then applies ``train.torch_threads``).
+    Safe for the run folders: every result is written atomically and a rerun resumes from
+    the last checkpoint (:func:`sumo_ayss.train.train`).
     """
-    _die_with_parent()
-    from sumo_ayss.threads import single_thread_env
+    processes = list(getattr(pool, "_processes", {}).values())  # CPython's worker table
+    for proc in processes:
+        if proc.is_alive():
+            proc.terminate()
+    deadline = time.monotonic() + grace_s
+    for proc in processes:
+        proc.join(max(0.0, deadline - time.monotonic()))
+        if proc.is_alive():
+            proc.kill()
+            proc.join(1.0)
+    pool.shutdown(wait=False, cancel_futures=True)
 
-    single_thread_env()
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, handled as a Ctrl-C."""
+
+
+def _raise_terminated(signum: int, frame: Any) -> None:
+    raise _Terminated
 
 
 def run_grid_local(
     jobs: Sequence[JobSpec], workers: int, retries: int, live: bool
 ) -> list[JobStatus]:
-    """Run ``jobs`` on a local process pool with retries and a live table."""
+    """Run ``jobs`` on a local process pool with retries and a live table.
+
+    At most ``workers`` jobs are handed to the pool at a time; the others wait here, so that
+    a Ctrl-C (SIGINT) or SIGTERM cancels them at once: running jobs are terminated (their
+    state is ``interrupted``, resumable), queued ones never start (``cancelled``), and the
+    KeyboardInterrupt propagates to the caller within seconds.
+    """
+    import signal
+
     statuses = [JobStatus(j) for j in jobs]
+    queue: collections.deque[JobStatus] = collections.deque(statuses)
     ctx = multiprocessing.get_context("spawn")  # fresh interpreters: no inherited libsumo
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker) as pool:
-        pending: dict[Future[dict[str, Any]], JobStatus] = {}
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init)
+    pending: dict[Future[dict[str, Any]], JobStatus] = {}
+    in_main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _raise_terminated) if in_main else None
+    display = None
 
-        def submit(s: JobStatus) -> None:
-            s.attempts += 1
-            s.state = "running" if s.attempts == 1 else "retrying"
-            pending[pool.submit(run_job, s.spec)] = s
+    def submit(s: JobStatus) -> None:
+        s.attempts += 1
+        s.state = "running" if s.attempts == 1 else "retrying"
+        pending[pool.submit(run_job, s.spec)] = s
 
-        for s in statuses:
-            submit(s)
+    try:
         display = _live(statuses) if live else None
-        try:
-            while pending:
-                done = [f for f in list(pending) if f.done()]
-                for fut in done:
-                    s = pending.pop(fut)
-                    try:
-                        result = fut.result()
-                        s.state, s.wall_s = "done", result["wall_s"]
-                    except Exception as e:  # a job's failure is data here
-                        s.error = "".join(traceback.format_exception_only(e)).strip()
-                        if s.attempts <= retries:
-                            logger.warning("job %s failed (%s); retrying", s.spec.name, s.error)
-                            submit(s)
-                        else:
-                            s.state = "failed"
-                if display is not None:
-                    display.update(_table(statuses))
-                time.sleep(0.5)
-        finally:
+        while pending or queue:
+            while queue and len(pending) < workers:
+                submit(queue.popleft())
+            for fut in [f for f in list(pending) if f.done()]:
+                s = pending.pop(fut)
+                try:
+                    result = fut.result()
+                    s.state, s.wall_s = "done", result["wall_s"]
+                except Exception as e:  # a job's failure is data here
+                    s.error = "".join(traceback.format_exception_only(e)).strip()
+                    if s.attempts <= retries:
+                        logger.warning("job %s failed (%s); retrying", s.spec.name, s.error)
+                        s.state = "queued"
+                        queue.append(s)
+                    else:
+                        s.state = "failed"
             if display is not None:
                 display.update(_table(statuses))
-                display.stop()
+            time.sleep(0.2)
+    except KeyboardInterrupt:
+        for s in queue:
+            s.state = "cancelled"
+        for fut, s in pending.items():
+            fut.cancel()
+            s.state = "interrupted"
+        _stop_workers(pool)
+        logger.warning(
+            "interrupted: %d running job(s) stopped, %d queued job(s) cancelled; rerun the "
+            "same command to resume",
+            len(pending),
+            len(queue),
+        )
+        raise
+    finally:
+        if in_main:
+            signal.signal(signal.SIGTERM, previous)
+        if display is not None:
+            display.update(_table(statuses))
+            display.stop()
+        pool.shutdown(wait=False, cancel_futures=True)
     return statuses
 
 
@@ -411,6 +492,7 @@ def run_pipeline(
 ) -> tuple[list[JobStatus], Path | None]:
     """Run the grid, then the report over every finished job; return statuses and report."""
     jobs = plan_jobs(cfg)
+    check_out_dir(cfg.out, "out")
     cfg.out.mkdir(parents=True, exist_ok=True)
     from sumo_ayss.atomic import atomic_write_json
 
@@ -455,7 +537,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
         prog="python -m sumo_ayss.pipeline", description=__doc__.splitlines()[0]
     )
-    parser.add_argument("config", type=Path, nargs="?", default=None, help="pipeline YAML")
+    parser.add_argument(
+        "config", type=Path, help="pipeline YAML (configs/paper.yaml runs the paper's grid)"
+    )
     parser.add_argument("--out", type=Path, default=None)
     parser.add_argument("--workers", type=int, default=None)
     parser.add_argument(
@@ -471,8 +555,11 @@ def main(argv: Sequence[str] | None = None) -> None:
         statuses, report = run_pipeline(
             cfg, backend=args.backend, address=args.address, live=not args.no_live
         )
-    except ConfigError as e:
+    except AyssError as e:
         sys.exit(f"error: {e}")
+    except KeyboardInterrupt:
+        print("interrupted: no job runs any more; rerun the same command to resume", flush=True)
+        sys.exit(130)
     failed = [s for s in statuses if s.state == "failed"]
     for s in failed:
         print(f"FAILED {s.spec.name}: {s.error}  (log: {s.spec.run_dir / 'job.log'})")

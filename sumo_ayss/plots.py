@@ -46,8 +46,9 @@ def plot_reward_shapes(cfg: RewardConfig, path: Path) -> Path:
         "and ends the episode",
         fontsize=10,
     )
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
+    from sumo_ayss.atomic import atomic_write_with
+
+    atomic_write_with(path, lambda tmp: fig.savefig(tmp, dpi=120))
     plt.close(fig)
     return path
 

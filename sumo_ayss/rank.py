@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.analysis.seeds import kendall_tau
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.errors import AyssError, ConfigError
 
 if TYPE_CHECKING:
     from sumo_ayss.report.document import CaseAnalysis, ReportOptions
@@ -247,8 +247,11 @@ def main(argv: Sequence[str] | None = None) -> None:
             done = [s.spec.run_dir for s in statuses if s.state == "done"]
             complete = len(done) == len(statuses)
         analyses = analyse(done, cfg.report)
-    except ConfigError as e:
+    except AyssError as e:
         sys.exit(f"error: {e}")
+    except KeyboardInterrupt:
+        print("interrupted: no job runs any more; rerun the same command to resume", flush=True)
+        sys.exit(130)
     checks = [c for a in analyses if (c := order_check(a, cfg.expected_order)) is not None]
     _, md = write_ranking(ranking_rows(analyses), cfg.out, checks, cfg.expected_order)
     print(md.read_text())

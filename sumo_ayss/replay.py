@@ -47,7 +47,6 @@ import dataclasses
 import json
 import math
 import os
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -58,7 +57,8 @@ from typing import Any, Literal
 
 import numpy as np
 
-from sumo_ayss.catalog import vtypes_xml
+from sumo_ayss.atomic import atomic_copy, atomic_write_text
+from sumo_ayss.catalog import controller_imports, vtypes_xml
 from sumo_ayss.config import EnvConfig, to_dict
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
@@ -163,13 +163,11 @@ def _initial_condition(kind: Kind, row: dict[str, Any]) -> InitialCondition:
     return InitialCondition(row["v_pov0_mps"], row["v_vut0_mps"], row["gap0_m"])
 
 
-def _load_policy(run_dir: Path) -> Policy:
-    from sumo_ayss.agents.greedy import GreedyPolicy  # torch: only when a policy is needed
+def _load_policy(run: Any) -> Policy:
+    """The run's SPCP, weights only (never unpickled: see "Trust model" in the README)."""
+    from sumo_ayss.evaluate import load_spcp  # torch: only when a policy is needed
 
-    path = run_dir / "spcp.zip"
-    if not path.is_file():
-        raise CheckpointError(f"{run_dir}: no spcp.zip (was the SPCP selected?)")
-    return GreedyPolicy.load(path)
+    return load_spcp(run, make_env(run.config.env))
 
 
 def _vehicle_name(vtype: str) -> str:
@@ -193,6 +191,7 @@ def export_scenario(
     outcome_row: int | None = None,
     decisions: int | None = None,
     policy: Policy | None = None,
+    trust_controller: bool = False,
 ) -> ExportResult:
     """Write one scenario of a run as replayable SUMO files (see the module docstring).
 
@@ -205,6 +204,7 @@ def export_scenario(
             ``d = 1`` scenario) and the whole episode for an outcome row. The recording
             always stops when the episode ends (collision or its last decision).
         policy: Use this policy instead of ``<run>/spcp.zip`` (e.g. a scripted one).
+        trust_controller: Allow importing the run's user-controller VUT (runs its code).
 
     Returns:
         The written files and the scenario's information.
@@ -228,10 +228,18 @@ def export_scenario(
     ):
         raise ConfigError(f"decisions must be an integer >= 1, got {decisions!r}")
     run_dir, out = Path(run_dir), Path(out)
-    run = load_run(run_dir)
+    with controller_imports(trust_controller):
+        run = load_run(run_dir, trust_controller=trust_controller)
+        return _export(run, kind, index, out, policy, decisions)
+
+
+def _export(
+    run: Any, kind: Kind, index: int, out: Path, policy: Policy | None, decisions: int | None
+) -> Any:
+    run_dir = run.run_dir
     row = _row(run_dir, kind, index)
     ic = _initial_condition(kind, row)
-    pol = policy if policy is not None else _load_policy(run_dir)
+    pol = policy if policy is not None else _load_policy(run)
     env_cfg = run.config.env
     limit = decisions if decisions is not None else (1 if kind == "ayss" else None)
     out.mkdir(parents=True, exist_ok=True)
@@ -249,9 +257,9 @@ def export_scenario(
     trajectory = [*rec["insertion"], *initial, *_rename(sumo_points, time_of)]
     end_s = round(max(p.time_s for p in trajectory) + dt, 9)
     net_src = env_cfg.network if env_cfg.network is not None else network_path(env_cfg.case)
-    shutil.copyfile(net_src, out / NET_FILE)
+    atomic_copy(net_src, out / NET_FILE)
     vt = env_cfg.vut_type
-    (out / VTYPES_FILE).write_text(vtypes_xml({f"vut_{env_cfg.vut}": vt, "pov": env_cfg.pov}))
+    atomic_write_text(out / VTYPES_FILE, vtypes_xml({f"vut_{env_cfg.vut}": vt, "pov": env_cfg.pov}))
     comment = (
         f"{kind} row {index} of {run_dir.resolve()}; t = 0 inserts the vehicles, the scenario "
         f"(tau = 0) starts at t = {dt:g} s"
@@ -276,8 +284,8 @@ def export_scenario(
         gui_settings=GUI_FILE,
     )
     info = _info(run, kind, index, row, ic, rec, dt, end_s)
-    (out / SCENARIO_FILE).write_text(json.dumps(info, indent=2, allow_nan=False) + "\n")
-    (out / "README.md").write_text(_readme(info))
+    atomic_write_text(out / SCENARIO_FILE, json.dumps(info, indent=2, allow_nan=False) + "\n")
+    atomic_write_text(out / "README.md", _readme(info))
     return ExportResult(out, out / SUMOCFG_FILE, out / TRAJECTORY_FILE, info)
 
 
@@ -516,6 +524,11 @@ def _export_main(argv: Sequence[str]) -> int:
     which.add_argument("--outcome-row", type=int, help="data row of outcome.csv (0-based)")
     parser.add_argument("--out", type=Path, required=True, help="scenario folder to write")
     parser.add_argument(
+        "--trust-controller",
+        action="store_true",
+        help="import the run's user-controller VUT (runs code the run folder names)",
+    )
+    parser.add_argument(
         "--decisions",
         type=int,
         default=None,
@@ -528,6 +541,7 @@ def _export_main(argv: Sequence[str]) -> int:
         ayss_row=args.ayss_row,
         outcome_row=args.outcome_row,
         decisions=args.decisions,
+        trust_controller=args.trust_controller,
     )
     info = result.info
     print(

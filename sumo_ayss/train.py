@@ -41,7 +41,6 @@ import io
 import json
 import logging
 import math
-import os
 import platform
 import random
 import shlex
@@ -62,18 +61,28 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor
 from sumo_ayss.agents.dqn import AyssDQN
 from sumo_ayss.agents.greedy import GreedyPolicy
 from sumo_ayss.agents.hparams import DQNHyperParams
-from sumo_ayss.atomic import atomic_write_json, atomic_write_text
-from sumo_ayss.config import to_dict, write_yaml
+from sumo_ayss.agents.weights import read_policy_state
+from sumo_ayss.atomic import (
+    atomic_copy,
+    atomic_write_json,
+    atomic_write_text,
+    atomic_write_with,
+    remove_stale_temporaries,
+)
+from sumo_ayss.config import check_out_dir, check_seed, safe_load_yaml, to_dict, write_yaml
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.envs.vec_env import EpisodeTrace, PairVecEnv
-from sumo_ayss.errors import CheckpointError, ConfigError
+from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
 from sumo_ayss.experiment import ExperimentConfig, experiment_from_dict, load_experiment
 from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, run_episodes, summarize
 from sumo_ayss.selection import select_spcp
 
 logger = logging.getLogger(__name__)
+
+#: Files of a checkpoint that only the latest keeps (what a resume needs beyond model.zip).
+RESUME_FILES = ("replay.pkl", "resume_model.zip")
 
 EVAL_COLUMNS = [
     "step",
@@ -100,16 +109,39 @@ def write_eval_table(path: Path, rows: Sequence[dict[str, Any]]) -> None:
 
 
 def read_eval_table(path: Path) -> list[dict[str, Any]]:
+    """The rows of ``eval.csv`` (none if it does not exist).
+
+    Raises:
+        CheckpointError: The file is unreadable, lacks a column, or has a bad cell; the
+            message names the file, the line and the column.
+    """
     if not path.is_file():
         return []
-    with path.open() as f:
-        rows = list(csv.DictReader(f))
-    for row in rows:
-        row["step"] = int(row["step"])
-        row["n_episodes"] = int(row["n_episodes"])
+    try:
+        with path.open(encoding="utf-8", newline="") as f:
+            reader = csv.DictReader(f)
+            missing = [c for c in EVAL_COLUMNS if c not in (reader.fieldnames or [])]
+            if missing:
+                raise CheckpointError(f"{path}: not an eval table (missing columns {missing})")
+            rows = list(reader)
+    except (OSError, UnicodeDecodeError, csv.Error) as e:
+        raise CheckpointError(f"{path}: unreadable ({e})") from e
+    for line, row in enumerate(rows, start=2):
         for key in EVAL_COLUMNS:
-            if key not in ("step", "n_episodes", "checkpoint"):
-                row[key] = float(row[key])
+            if key == "checkpoint":
+                continue
+            cell = row[key]
+            try:
+                value = int(cell) if key in ("step", "n_episodes") else float(cell)
+            except (TypeError, ValueError):
+                raise CheckpointError(
+                    f"{path}, line {line}: column {key!r} must be a number, got {cell!r}"
+                ) from None
+            if key not in ("std_return",) and not math.isfinite(value):
+                raise CheckpointError(
+                    f"{path}, line {line}: column {key!r} must be finite, got {cell!r}"
+                )
+            row[key] = value
     return rows
 
 
@@ -165,6 +197,11 @@ class Trainer:
             self.pair_vec = PairVecEnv(cfg.env, self.n_envs, sumo_seed=seed)
             self.vec_env = VecMonitor(self.pair_vec)
         self.model: AyssDQN | None = None
+        #: Between a candidate and its checkpoint: the candidate's folder, the env state
+        #: right after the candidate (episode start(s), RNGs) and the actions taken since.
+        self._pending_dir: Path | None = None
+        self._anchor: dict[str, Any] = {}
+        self._actions_since_anchor: list[list[int]] = []
 
     # -- folder ------------------------------------------------------------------------
 
@@ -216,8 +253,10 @@ class Trainer:
                 tb_log_name="dqn",
                 progress_bar=progress_bar,
             )
+        self.save_checkpoint()  # a candidate of the last rollout
         if model.num_timesteps >= self.next_eval:  # the last candidate, at the very end
             self.candidate(at_episode_boundary=False)
+            self.save_checkpoint()
 
     # -- candidates ----------------------------------------------------------------------
 
@@ -271,20 +310,50 @@ class Trainer:
         while self.next_eval <= step:
             self.next_eval += self.cfg.train.eval_every
 
-        self._save_resume_state(step_dir, env_state)
         write_eval_table(self.eval_path, self.rows)
-        atomic_write_json(self.ckpt_dir / "latest.json", {"step": step, "dir": step_dir.name})
-        self._prune_replays(step_dir)
+        # The resume state is written at the next rollout start (save_checkpoint), once SB3
+        # has stored this step's transitions and trained on them: from here on the actions
+        # are recorded, so that a resume replays them from this episode start.
+        self._anchor = env_state
+        self._actions_since_anchor = []
+        self._pending_dir = step_dir
 
-    def _prune_replays(self, keep: Path) -> None:
-        """Keep the replay buffer of the latest checkpoint only (each is ~6 MB per 100k).
+    def record_actions(self, actions: Any) -> None:
+        """Note a step's actions (between a candidate and its checkpoint, for the replay)."""
+        if self._pending_dir is not None:
+            self._actions_since_anchor.append(np.asarray(actions).reshape(-1).tolist())
+
+    def save_checkpoint(self) -> None:
+        """Write the resume state of the last candidate, if one is pending.
+
+        Called where SB3's state is consistent: at the start of a rollout (the previous
+        step's transitions are stored and trained on, ``num_timesteps`` counts exactly the
+        buffer's transitions, a new ``train_freq`` cycle begins) and at the end of ``learn``.
+        The env state is the candidate's episode start(s) plus the actions taken since,
+        which a resume replays (SUMO is deterministic for a VUT without random parameters).
+        """
+        step_dir = self._pending_dir
+        if step_dir is None:
+            return
+        self._save_resume_state(step_dir)
+        atomic_write_json(
+            self.ckpt_dir / "latest.json",
+            {"step": int(step_dir.name.split("_")[1]), "dir": step_dir.name},
+        )
+        self._pending_dir = None
+        self._prune_resume_files(step_dir)
+
+    def _prune_resume_files(self, keep: Path) -> None:
+        """Keep the replay buffer and full model of the latest checkpoint only (the buffer is
+        ~6 MB per 100k transitions).
 
         Run after ``latest.json`` moves on and again at resume, so a kill between the two
         leaves no orphan behind for good.
         """
-        for path in self.ckpt_dir.glob("step_*/replay.pkl"):
-            if path.parent != keep:
-                path.unlink(missing_ok=True)
+        for name in RESUME_FILES:
+            for path in self.ckpt_dir.glob(f"step_*/{name}"):
+                if path.parent != keep:
+                    path.unlink(missing_ok=True)
 
     def _restart_pairs(self, rollout: dict[str, Any] | None) -> None:
         """After an evaluation on the pairs: a fresh training episode on every pair.
@@ -322,67 +391,128 @@ class Trainer:
             "env_rngs": [env.np_random.bit_generator.state for env in self.pair_vec.envs],
         }
 
-    def _save_resume_state(self, step_dir: Path, env_state: dict[str, Any]) -> None:
+    def _save_resume_state(self, step_dir: Path) -> None:
         model = self.model
         assert model is not None
-        tmp = step_dir / ".replay.pkl.tmp"
-        model.save_replay_buffer(tmp)
-        os.replace(tmp, step_dir / "replay.pkl")
+        _atomic_model_save(model, step_dir / "resume_model.zip")
+        atomic_write_with(step_dir / "replay.pkl", model.save_replay_buffer)
         state = {
             "num_timesteps": model.num_timesteps,
             "next_eval": self.next_eval,
-            **env_state,
+            **self._anchor,
+            "actions_since_anchor": self._actions_since_anchor,
             "numpy_rng": _jsonable(np.random.get_state()),  # noqa: NPY002 (SB3 uses it)
             "python_rng": _jsonable(random.getstate()),
+            # SB3 explores with the model's action space's own RNG; its load reseeds it.
+            "action_space_rng": model.action_space.np_random.bit_generator.state,
         }
-        th.save(th.get_rng_state(), step_dir / ".torch_rng.pt.tmp")
-        os.replace(step_dir / ".torch_rng.pt.tmp", step_dir / "torch_rng.pt")
+        torch_state = th.get_rng_state()
+        atomic_write_with(step_dir / "torch_rng.pt", lambda tmp: th.save(torch_state, tmp))
         atomic_write_json(step_dir / "state.json", state)
 
     def _latest(self) -> Path | None:
         path = self.ckpt_dir / "latest.json"
         if not path.is_file():
             return None
-        return self.ckpt_dir / json.loads(path.read_text())["dir"]
+        data = _read_json(path)
+        name = data.get("dir") if isinstance(data, dict) else None
+        if not isinstance(name, str) or Path(name).name != name or not name.startswith("step_"):
+            raise CheckpointError(f"{path}: 'dir' must name a step_* folder, got {name!r}")
+        latest = self.ckpt_dir / name
+        if not latest.is_dir():
+            raise CheckpointError(f"{path} points at {name}, which does not exist")
+        return latest
 
     # -- resume --------------------------------------------------------------------------
+
+    def clean_leftovers(self) -> None:
+        """Delete what a killed run left half-done: temporary files, and checkpoint folders
+        newer than ``latest.json`` (a kill during a checkpoint; the resumed run redoes them).
+        """
+        for path in remove_stale_temporaries(self.run_dir):
+            logger.info("removed temporary file %s", path)
+        latest = self._latest()
+        for step_dir in sorted(self.ckpt_dir.glob("step_*")):
+            if step_dir.is_dir() and (latest is None or step_dir.name > latest.name):
+                shutil.rmtree(step_dir)
+                logger.info("removed unfinished checkpoint %s", step_dir)
 
     def resume(self) -> None:
         """Continue from the latest complete checkpoint."""
         latest = self._latest()
         if latest is None:
             raise CheckpointError(f"{self.run_dir}: no checkpoint to resume from")
-        state = json.loads((latest / "state.json").read_text())
+        state = _read_json(latest / "state.json")
+        if not isinstance(state, dict) or not {"num_timesteps", "next_eval"} <= set(state):
+            raise CheckpointError(f"{latest / 'state.json'}: not a checkpoint state")
         th.set_num_threads(self.cfg.train.torch_threads)
-        model = AyssDQN.load(
-            str(latest / "model.zip"),
-            env=self.vec_env,
-            device=check_device(self.cfg.train.device),
-            tensorboard_log=str(self.run_dir / "tb"),
-        )
-        model.load_replay_buffer(latest / "replay.pkl")
-        self._prune_replays(latest)
-        self.model = model
-        self.next_eval = int(state["next_eval"])
-        self.rows = [r for r in read_eval_table(self.eval_path) if r["step"] <= model.num_timesteps]
-        if self.pair_vec is not None:
-            self._resume_pairs(state)
-        else:
-            # Put the env back at the checkpoint's episode start, with its RNG where it was
-            # (through the Monitor wrapper, which must see the reset too).
-            assert isinstance(self.vec_env, DummyVecEnv) and self.env is not None
-            monitor = self.vec_env.envs[0]
-            monitor.reset(seed=self.seed)  # starts SUMO and creates the env RNG
-            self.env.np_random.bit_generator.state = state["env_rng"]
-            ic = state["initial_condition"]
-            obs, _ = monitor.reset(
-                options={"initial_condition": InitialCondition(**ic)} if ic else None
+        # Resuming trusts the folder: SB3's loader unpickles parts of model.zip and replay.pkl
+        # (see "Trust model" in the README); evaluating and reporting never do.
+        try:
+            model = AyssDQN.load(
+                str(latest / "resume_model.zip"),
+                env=self.vec_env,
+                device=check_device(self.cfg.train.device),
+                tensorboard_log=str(self.run_dir / "tb"),
             )
-            model._last_obs = obs[None, :]  # type: ignore[assignment]
-            model._last_episode_starts = np.ones((1,), dtype=bool)
-        np.random.set_state(_tuple_state(state["numpy_rng"]))  # noqa: NPY002 (SB3 uses it)
-        random.setstate(_tuple_state(state["python_rng"]))
-        th.set_rng_state(th.load(latest / "torch_rng.pt"))
+        except Exception as e:  # zipfile, pickle, torch: any corruption
+            raise CheckpointError(
+                f"{latest / 'resume_model.zip'}: unreadable checkpoint ({type(e).__name__}: {e})"
+            ) from e
+        try:
+            model.load_replay_buffer(latest / "replay.pkl")
+        except Exception as e:
+            raise CheckpointError(
+                f"{latest / 'replay.pkl'}: unreadable replay buffer ({type(e).__name__}: {e})"
+            ) from e
+        self._prune_resume_files(latest)
+        self.model = model
+        try:
+            self.next_eval = int(state["next_eval"])
+            self.rows = [
+                r for r in read_eval_table(self.eval_path) if r["step"] <= model.num_timesteps
+            ]
+            for row in self.rows:  # every earlier candidate must still be a readable policy
+                ckpt = Path(str(row["checkpoint"]))
+                if ckpt.is_absolute() or ".." in ckpt.parts or ckpt.parts[:1] != ("checkpoints",):
+                    raise CheckpointError(
+                        f"{self.eval_path}: step {row['step']}: checkpoint must be a path "
+                        f"under checkpoints/, got {str(ckpt)!r}"
+                    )
+                read_policy_state(self.run_dir / ckpt)
+            actions = [np.asarray(a, dtype=np.int64) for a in state["actions_since_anchor"]]
+            if self.pair_vec is not None:
+                self._resume_pairs(state)
+            else:
+                # Put the env back at the checkpoint's episode start, with its RNG where it
+                # was (through the Monitor wrapper, which must see the reset too).
+                assert isinstance(self.vec_env, DummyVecEnv) and self.env is not None
+                monitor = self.vec_env.envs[0]
+                monitor.reset(seed=self.seed)  # starts SUMO and creates the env RNG
+                self.env.np_random.bit_generator.state = state["env_rng"]
+                ic = state["initial_condition"]
+                obs, _ = monitor.reset(
+                    options={"initial_condition": InitialCondition(**ic)} if ic else None
+                )
+                model._last_obs = obs[None, :]  # type: ignore[assignment]
+                model._last_episode_starts = np.ones((1,), dtype=bool)
+            # The steps taken between the candidate and the checkpoint, replayed: the envs are
+            # then where the killed run's were (SB3 holds their observation).
+            for action in actions:
+                obs, _, dones, _ = self.vec_env.step(action)
+                model._last_obs = obs  # type: ignore[assignment]
+                model._last_episode_starts = dones
+            np.random.set_state(_tuple_state(state["numpy_rng"]))  # noqa: NPY002 (SB3 uses it)
+            random.setstate(_tuple_state(state["python_rng"]))
+            model.action_space.np_random.bit_generator.state = state["action_space_rng"]
+        except (KeyError, TypeError, ValueError) as e:
+            raise CheckpointError(
+                f"{latest / 'state.json'}: inconsistent checkpoint state ({type(e).__name__}: {e})"
+            ) from e
+        try:
+            th.set_rng_state(th.load(latest / "torch_rng.pt", weights_only=True))
+        except Exception as e:
+            raise CheckpointError(f"{latest / 'torch_rng.pt'}: unreadable ({e})") from e
         logger.info("resumed %s at step %d", self.run_dir, model.num_timesteps)
 
     def _resume_pairs(self, state: dict[str, Any]) -> None:
@@ -404,8 +534,7 @@ class Trainer:
     def select(self) -> dict[str, Any]:
         choice = select_spcp(self.rows, self.cfg.train.selection)
         row = self.rows[choice.index]
-        shutil.copyfile(self.run_dir / row["checkpoint"], self.run_dir / ".spcp.zip.tmp")
-        os.replace(self.run_dir / ".spcp.zip.tmp", self.run_dir / "spcp.zip")
+        atomic_copy(self.run_dir / row["checkpoint"], self.run_dir / "spcp.zip")
         record = {**dataclasses.asdict(choice), "checkpoint": row["checkpoint"], "row": row}
         atomic_write_json(self.run_dir / "spcp.json", record)
         return record
@@ -421,14 +550,20 @@ class _CandidateCallback(BaseCallback):
 
     One env: at the first episode end after it (the env is borrowed and restored there).
     Several pairs: at once (their episodes never end together; they are cut and restarted).
+    The candidate's resume checkpoint follows at the next rollout start
+    (:meth:`Trainer.save_checkpoint`); the steps in between are recorded for its replay.
     """
 
     def __init__(self, trainer: Trainer) -> None:
         super().__init__()
         self.trainer = trainer
 
+    def _on_rollout_start(self) -> None:
+        self.trainer.save_checkpoint()
+
     def _on_step(self) -> bool:
         trainer = self.trainer
+        trainer.record_actions(self.locals["actions"])
         if self.num_timesteps < trainer.next_eval:
             return True
         if trainer.pair_vec is not None:
@@ -509,10 +644,16 @@ def _episode_result(trace: EpisodeTrace) -> EpisodeResult:
     )
 
 
+def _read_json(path: Path) -> Any:
+    """JSON from a run-folder file; a missing, unreadable or malformed file -> CheckpointError."""
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        raise CheckpointError(f"{path}: unreadable JSON ({e})") from e
+
+
 def _atomic_model_save(model: AyssDQN, path: Path) -> None:
-    tmp = path.with_name(f".{path.stem}.tmp.zip")
-    model.save(tmp)
-    os.replace(tmp, path)
+    atomic_write_with(path, model.save)
 
 
 def _jsonable(obj: Any) -> Any:
@@ -544,6 +685,8 @@ def train(
 ) -> Path:
     """Train one (case, VUT, seed) into its run folder; return the folder."""
     check_device(cfg.train.device)  # before the run folder exists
+    seed = check_seed(seed, "--seed")
+    check_out_dir(Path(out), "--out")
     run_dir = run_dir_for(out, cfg, seed)
     config_file = run_dir / "config.yaml"
     if resume:
@@ -556,6 +699,8 @@ def train(
         )
     trainer = Trainer(cfg, seed, run_dir)
     try:
+        if resume:
+            trainer.clean_leftovers()
         if resume and trainer._latest() is not None:
             trainer.resume()
         else:
@@ -570,12 +715,16 @@ def train(
 
 
 def _check_same_config(run_dir: Path, cfg: ExperimentConfig, seed: int) -> None:
-    import yaml
-
-    stored = yaml.safe_load((run_dir / "config.yaml").read_text())
-    stored_seed = stored.pop("seed")
-    stored.pop("vut")
-    stored_cfg = experiment_from_dict(stored, run_dir)
+    path = run_dir / "config.yaml"
+    try:
+        stored = safe_load_yaml(path.read_text(encoding="utf-8"), str(path))
+        if not isinstance(stored, dict):
+            raise CheckpointError(f"{path}: not a run configuration (top level is not a mapping)")
+        stored_seed = stored.pop("seed")
+        stored.pop("vut")
+        stored_cfg = experiment_from_dict(stored, run_dir)
+    except (ConfigError, KeyError, OSError, UnicodeDecodeError) as e:
+        raise CheckpointError(f"{path}: unreadable run configuration ({e})") from e
     if stored_seed != seed or to_dict(stored_cfg) != to_dict(cfg):
         raise CheckpointError(
             f"--resume: {run_dir}/config.yaml differs from the requested configuration; "
@@ -620,7 +769,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             overrides["device"] = args.device
         cfg = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, **overrides))
         run_dir = train(cfg, args.seed, args.out, resume=args.resume, argv=argv)
-    except (ConfigError, CheckpointError) as e:
+    except AyssError as e:
         sys.exit(f"error: {e}")
     print(run_dir)
 

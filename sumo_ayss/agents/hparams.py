@@ -156,6 +156,11 @@ class DQNHyperParams:
         _check_int(p, "buffer_size", self.buffer_size, low=1)
         _check_int(p, "batch_size", self.batch_size, low=1)
         _check_int(p, "learning_starts", self.learning_starts, low=0)
+        if self.buffer_size < self.batch_size:
+            raise ConfigError(
+                f"{p}.buffer_size ({self.buffer_size}) must be >= {p}.batch_size "
+                f"({self.batch_size}): a minibatch is drawn from the buffer"
+            )
         _check_int(p, "train_freq", self.train_freq, low=1)
         _check_int(p, "gradient_steps", self.gradient_steps, low=1)
         _check_int(p, "target_update_interval", self.target_update_interval, low=1)

@@ -171,6 +171,7 @@ class CutInEnv(PairEnv):
     OBS_LOW: ClassVar[tuple[float, ...]] = (0.0, 0.0, HEADWAY_LOW_M, 0.0)
     OBS_HIGH: ClassVar[tuple[float, ...]] = (SPEED_HIGH_MPS, SPEED_HIGH_MPS, HEADWAY_HIGH_M, 1.0)
     N_ACTIONS: ClassVar[int] = N_ACTIONS
+    IC_GAP_MIN_M: ClassVar[float] = HEADWAY_LOW_M  # side by side: the POV's rear behind
 
     def __init__(
         self,

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import weakref
 from abc import abstractmethod
 from typing import Any, ClassVar, NamedTuple, SupportsFloat, SupportsInt
 
@@ -64,6 +65,19 @@ def session_vtypes(cfg: EnvConfig) -> dict[str, VehicleType]:
     return vtypes
 
 
+#: Largest gap [m] a given initial condition may ask for (the POV must stay on the road).
+IC_GAP_MAX_M = HEADWAY_HIGH_M
+
+
+def sumo_seed_of(seed: int) -> int:
+    """SUMO's ``--seed`` for an env reset with ``seed``: ``seed`` itself when it fits SUMO's
+    range [0, 2**31 - 1] (as :class:`~sumo_ayss.envs.vec_env.PairVecEnv` does), else a hash."""
+    if 0 <= seed <= 2**31 - 1:
+        return seed
+    state = np.random.SeedSequence(seed).generate_state(1, np.uint32)
+    return int(state[0]) >> 1
+
+
 class PairKinematics(NamedTuple):
     """What a step reads back from SUMO (front-bumper positions, m; speeds, m/s).
 
@@ -93,6 +107,8 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
     OBS_LOW: ClassVar[tuple[float, ...]]
     OBS_HIGH: ClassVar[tuple[float, ...]]
     N_ACTIONS: ClassVar[int]
+    #: Smallest gap [m] a given initial condition may ask for (cut-in: side by side, < 0).
+    IC_GAP_MIN_M: ClassVar[float] = 0.0
 
     def __init__(
         self,
@@ -116,7 +132,10 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         )
         self.action_space = spaces.Discrete(self.N_ACTIONS)
         self.sumo_seed = sumo_seed
+        self._fixed_sumo_seed = sumo_seed is not None
         self._session: SumoSession | None = None
+        self._finalizer: weakref.finalize | None = None
+        self._done = False  # the episode ended (terminated or truncated): step() refuses
         self._pair: VehiclePair | None = None
         # Per-step constants, looked up once (config properties compute on each access).
         self._pov_length_m = config.pov.length_m
@@ -216,9 +235,20 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
     def step(
         self, action: SupportsInt
     ) -> tuple[npt.NDArray[np.float32], SupportsFloat, bool, bool, dict[str, Any]]:
+        """One decision (``decision_period_s``).
+
+        Raises:
+            ActionError: Before the first reset, after the episode ended (a collision or the
+                last decision: call ``reset``), or for an action outside the action space.
+        """
         pair = self._pair
         if pair is None or self._k is None or self._shared:
             raise self._step_error()
+        if self._done:
+            raise ActionError(
+                "step() after the episode ended (terminated at a collision or truncated at "
+                f"env.episode_s = {self.config.episode_s} s); call reset() first"
+            )
         self._begin_decision(action)
         session = pair.session
         collided = False
@@ -233,11 +263,20 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
 
     def close(self) -> None:
         """Close SUMO; safe to call twice. A vec-env member leaves the shared SUMO running."""
-        if self._session is not None:
-            self._session.close()
-        self._session = None
+        self._close_sim()
         self._pair = None
         super().close()
+
+    def _close_sim(self) -> None:
+        """Close this env's own simulation (if it owns one)."""
+        if self._finalizer is not None:
+            self._finalizer.detach()
+            self._finalizer = None
+        if self._session is not None:
+            self._session.close()
+            self._session = None
+            self._pair = None
+            self._k = None
 
     # ------------------------------------------------------------------ episode phases
     #
@@ -247,8 +286,26 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
     # reward, termination and the POV's actuator are this code in both.
 
     def _begin_reset(self, seed: int | None, options: dict[str, Any] | None) -> InitialCondition:
-        """Seed the RNG (``seed``) and choose the episode's initial condition (no SUMO call)."""
+        """Seed the RNG (``seed``) and choose the episode's initial condition.
+
+        A ``seed`` also reseeds SUMO: an env that owns its simulation restarts it with SUMO
+        seed ``sumo_seed`` (the constructor's, else :func:`sumo_seed_of` ``(seed)``), so that
+        the same seed and actions give the same trajectories on a fresh or a used env, for
+        stochastic VUTs too (SUMO's own random state starts over). The SUMO seed never draws
+        from the env's RNG, which is for initial conditions only.
+        """
+        if options is not None and not isinstance(options, dict):
+            raise ConfigError(f"reset options must be a dict or None, got {options!r}")
+        unknown = set(options or {}) - {"initial_condition"}
+        if unknown:
+            raise ConfigError(
+                f"reset options: unknown keys {sorted(unknown)}; allowed: ['initial_condition']"
+            )
         super().reset(seed=seed)
+        if seed is not None and not self._shared:
+            if not self._fixed_sumo_seed:
+                self.sumo_seed = sumo_seed_of(int(seed))
+            self._close_sim()  # restarted by the reset's _ensure_sim, with a fresh SUMO state
         ic = (options or {}).get("initial_condition")
         if ic is None:
             ic = sample_initial_condition(self.config.odd, self.np_random)
@@ -256,7 +313,25 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             raise ConfigError(
                 f"reset options['initial_condition'] must be an InitialCondition, got {ic!r}"
             )
+        else:
+            self._check_initial_condition(ic)
         return ic
+
+    def _check_initial_condition(self, ic: InitialCondition) -> None:
+        """Refuse a given initial condition the road and the actuator cannot realise."""
+        v_max = min(SPEED_HIGH_MPS, self._actuator.max_speed_mps)
+        checks = (
+            ("pov_speed_mps", ic.pov_speed_mps, 0.0, v_max),
+            ("vut_speed_mps", ic.vut_speed_mps, 0.0, SPEED_HIGH_MPS),
+            ("gap_m", ic.gap_m, self.IC_GAP_MIN_M, IC_GAP_MAX_M),
+        )
+        for name, value, low, high in checks:
+            ok = isinstance(value, int | float) and not isinstance(value, bool)
+            if not ok or not math.isfinite(value) or not low <= value <= high:
+                raise ConfigError(
+                    f"reset options['initial_condition'].{name} must be a finite number in "
+                    f"[{low:g}, {high:g}], got {value!r}"
+                )
 
     def _start_episode(self, ic: InitialCondition) -> tuple[tuple[float, ...], dict[str, Any]]:
         """Place the pair's fresh vehicles at ``ic``: the reset's observation values and info.
@@ -271,6 +346,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         if self._hw:
             self._start_hwenv(pair, ic)
         self.initial_condition = ic
+        self._done = False
         self._decisions = 0
         self._v_pov = ic.pov_speed_mps
         k = self._k = self._kinematics()
@@ -328,6 +404,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         reward = total_reward(r_a, collided, self._reward_cfg)
         terminated = collided
         truncated = not terminated and self._decisions >= self._max_decisions
+        self._done = terminated or truncated
         info = {
             "headway_m": k.headway_m,
             "ttc_s": time_to_collision_s(k.headway_m, k.vut_speed_mps, k.pov_speed_mps),
@@ -489,8 +566,8 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         if self._pair is not None:
             return self._pair
         cfg = self.config
-        if self.sumo_seed is None:
-            self.sumo_seed = int(self.np_random.integers(0, 2**31 - 1))
+        if self.sumo_seed is None:  # never seeded: fresh entropy, not the env's RNG
+            self.sumo_seed = sumo_seed_of(int(np.random.SeedSequence().entropy))  # type: ignore[arg-type]
         vtypes = session_vtypes(cfg)
         network = cfg.network if cfg.network is not None else network_path(cfg.case)  # type: ignore[arg-type]
         session = SumoSession(
@@ -498,6 +575,8 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         )
         session.start()
         self._session = session
+        # An env dropped without close() must not hold the process's one simulation forever.
+        self._finalizer = weakref.finalize(self, session.close)
         self._pair = VehiclePair(session, vut_type=f"vut_{cfg.vut}", pov_type="pov", edge=ROAD_EDGE)
         return self._pair
 

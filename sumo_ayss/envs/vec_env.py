@@ -72,7 +72,7 @@ from stable_baselines3.common.vec_env.base_vec_env import (
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
-from sumo_ayss.envs.pair_env import PairEnv, session_vtypes
+from sumo_ayss.envs.pair_env import PairEnv, session_vtypes, sumo_seed_of
 from sumo_ayss.errors import ActionError, ConfigError
 from sumo_ayss.sim.network import LANES_OF_CASE, build_parallel_network, parallel_road_edge
 from sumo_ayss.sim.pair import VehiclePair
@@ -136,6 +136,7 @@ class PairVecEnv(VecEnv):
             )
         self.config = config
         self.sumo_seed = sumo_seed
+        self._fixed_sumo_seed = sumo_seed is not None
         #: The pairs' envs (``envs[i]`` drives road i); step them through the vec env only.
         self.envs: list[PairEnv] = [make_env(config) for _ in range(n_envs)]
         first = self.envs[0]
@@ -154,8 +155,14 @@ class PairVecEnv(VecEnv):
         """Start a fresh episode on every pair (no SUMO step); their observations.
 
         Uses and then forgets the seeds of :meth:`seed` and the options of
-        :meth:`set_options` (``{"initial_condition": InitialCondition}`` per pair).
+        :meth:`set_options` (``{"initial_condition": InitialCondition}`` per pair). Seeds
+        given to a running vec env restart SUMO (with ``sumo_seed``, else the first seed),
+        so that its own random state starts over as for a fresh vec env.
         """
+        if self._session is not None and any(s is not None for s in self._seeds):
+            self._close_sim()
+            if not self._fixed_sumo_seed:
+                self.sumo_seed = None  # _ensure_sim takes the first seed
         ics = [
             env._begin_reset(self._seeds[i], self._options[i] or None)
             for i, env in enumerate(self.envs)
@@ -212,6 +219,9 @@ class PairVecEnv(VecEnv):
 
     def close(self) -> None:
         """Close SUMO and the pairs; safe to call twice."""
+        self._close_sim()
+
+    def _close_sim(self) -> None:
         for env in self.envs:
             env.close()
         if self._session is not None:
@@ -325,7 +335,9 @@ class PairVecEnv(VecEnv):
         if self.sumo_seed is None:
             seed = self._seeds[0]
             self.sumo_seed = (
-                int(seed) if seed is not None else int(np.random.default_rng().integers(2**31 - 1))
+                sumo_seed_of(int(seed))
+                if seed is not None
+                else int(np.random.default_rng().integers(2**31 - 1))
             )
         self._tmp = tempfile.TemporaryDirectory(prefix="sumo_ayss_vec_")
         try:

@@ -14,7 +14,8 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.config import check_out_dir
+from sumo_ayss.errors import AyssError
 from sumo_ayss.report.document import DEFAULT_TITLE, ReportOptions, write_report
 
 
@@ -64,9 +65,13 @@ def main(argv: Sequence[str] | None = None) -> None:
             n_boot=args.n_boot,
             rng_seed=args.seed,
         )
+        if args.out is not None:
+            check_out_dir(args.out, "--out")
         path = write_report(args.paths, args.out, title=args.title, options=options)
-    except ConfigError as exc:
+    except AyssError as exc:
         sys.exit(f"error: {exc}")
+    except OSError as exc:  # e.g. a folder that cannot be written
+        sys.exit(f"error: cannot write the report: {exc}")
     print(path)
 
 

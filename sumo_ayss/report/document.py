@@ -1212,8 +1212,10 @@ def write_report(
     runs = [load_run(d) for d in run_dirs]
     report = build_report(runs, target, title=title, options=options)
     html_path = target / HTML_NAME
-    html_path.write_text(render_html(report), encoding="utf-8")
-    (target / MARKDOWN_NAME).write_text(render_markdown(report, target), encoding="utf-8")
+    from sumo_ayss.atomic import atomic_write_text
+
+    atomic_write_text(html_path, render_html(report))
+    atomic_write_text(target / MARKDOWN_NAME, render_markdown(report, target))
     logger.info("report written to %s", html_path)
     return html_path
 

@@ -174,8 +174,10 @@ def _style() -> Iterator[None]:
 
 
 def _save(fig: Figure, path: Path) -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=DPI)  # a bare Figure renders PNG with Agg; no pyplot state
+    from sumo_ayss.atomic import atomic_write_with
+
+    # a bare Figure renders PNG with Agg; no pyplot state. Atomic: a reader never sees half.
+    atomic_write_with(path, lambda tmp: fig.savefig(tmp, dpi=DPI))
     return path
 
 

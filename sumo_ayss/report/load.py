@@ -29,7 +29,7 @@ import numpy as np
 import yaml
 from numpy.typing import NDArray
 
-from sumo_ayss.config import RewardConfig, build
+from sumo_ayss.config import RewardConfig, build, safe_load_yaml
 from sumo_ayss.errors import ConfigError
 
 __all__ = [
@@ -240,6 +240,8 @@ class EvalCurve:
     crash_rate: NDArray[np.float64] = field(default_factory=_empty_f)
     lane_change_rate: NDArray[np.float64] = field(default_factory=_empty_f)
     mean_final_headway_m: NDArray[np.float64] = field(default_factory=_empty_f)
+    n_dropped: int = 0
+    """Rows skipped because ``step`` or ``mean_return`` was not a finite number."""
 
     def __len__(self) -> int:
         return int(self.step.size)
@@ -498,6 +500,7 @@ def read_eval_curve(path: Path) -> EvalCurve:
         if missing:
             raise ValueError(f"missing column(s) {missing}")
         rows = [{c: _number(row.get(c)) for c in EVAL_COLUMNS_USED} for row in reader]
+    n_read = len(rows)
     rows = [r for r in rows if math.isfinite(r["step"]) and math.isfinite(r["mean_return"])]
     rows.sort(key=lambda r: r["step"])
 
@@ -510,6 +513,7 @@ def read_eval_curve(path: Path) -> EvalCurve:
         crash_rate=col("crash_rate"),
         lane_change_rate=col("lane_change_rate"),
         mean_final_headway_m=col("mean_final_headway_m"),
+        n_dropped=n_read - len(rows),
     )
 
 
@@ -619,6 +623,11 @@ def load_run(path: str | Path) -> Run:
             logger.warning("%s: %s unreadable: %s", run_dir, name, exc)
 
     attempt(RUN_FILES.eval_table, read_eval_curve, "eval_curve")
+    if run.eval_curve is not None and run.eval_curve.n_dropped:
+        run.problems.append(
+            f"{RUN_FILES.eval_table}: {run.eval_curve.n_dropped} candidate row(s) without a "
+            "finite step or mean_return dropped"
+        )
     attempt(RUN_FILES.spcp, _read_spcp, "spcp")
     attempt(RUN_FILES.outcome, read_outcome, "outcome")
     attempt(RUN_FILES.ayss, read_ayss, "ayss")
@@ -641,13 +650,13 @@ def _load_config(run: Run) -> None:
         )
         return
     try:
-        data = yaml.safe_load(file.read_text()) or {}
+        data = safe_load_yaml(file.read_text(encoding="utf-8"), str(file)) or {}
         if not isinstance(data, Mapping):
             raise ValueError("top level is not a mapping")
         env = data.get("env") or {}
         if not isinstance(env, Mapping):
             raise ValueError("env is not a mapping")
-    except (OSError, ValueError, yaml.YAMLError) as exc:
+    except (OSError, ValueError, yaml.YAMLError) as exc:  # ConfigError is a ValueError
         run.problems.append(f"{RUN_FILES.config} unreadable ({exc})")
         return
     run.case = str(env.get("case", run.case))

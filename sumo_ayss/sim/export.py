@@ -34,6 +34,7 @@ from xml.sax.saxutils import quoteattr
 
 import libsumo
 
+from sumo_ayss.atomic import atomic_write_text
 from sumo_ayss.config import SimConfig
 from sumo_ayss.errors import SimulationError
 from sumo_ayss.sim.network import sumo_binary, sumo_home
@@ -187,7 +188,7 @@ def write_fcd(path: Path, points: Iterable[FcdPoint], comment: str = "") -> Path
             )
         lines.append("    </timestep>")
     lines.append("</fcd-export>")
-    path.write_text("\n".join(lines) + "\n")
+    atomic_write_text(path, "\n".join(lines) + "\n")
     return path
 
 
@@ -242,11 +243,12 @@ def write_gui_settings(
     """
     zoom = min(max(100.0 * 1000.0 / max(span_m, 1.0), 100.0), 5000.0)
     x, y = centre_xy
-    path.write_text(
+    atomic_write_text(
+        path,
         "<viewsettings>\n"
         f'    <viewport zoom="{zoom:.1f}" x="{x:.2f}" y="{y:.2f}" angle="0.00"/>\n'
         f'    <delay value="{int(delay_ms)}"/>\n'
-        "</viewsettings>\n"
+        "</viewsettings>\n",
     )
     return path
 
@@ -294,7 +296,7 @@ def write_sumocfg(
         lines += [f"        <{k} value={quoteattr(v)}/>" for k, v in values.items()]
         lines.append(f"    </{section}>")
     lines.append("</configuration>")
-    path.write_text("\n".join(lines) + "\n")
+    atomic_write_text(path, "\n".join(lines) + "\n")
     return path
 
 

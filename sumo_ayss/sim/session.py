@@ -114,6 +114,13 @@ class SumoSession:
             return
         live = SumoSession._live
         if live is not None:
+            # The owner may be an env dropped without close(): collecting it runs its
+            # finalizer, which closes the simulation (see PairEnv._ensure_sim).
+            import gc
+
+            gc.collect()
+            live = SumoSession._live
+        if live is not None:
             raise SimulationError(
                 f"a libsumo simulation is already running in this process (owner: "
                 f"{live.owner}); libsumo holds one simulation per process. Close it first "

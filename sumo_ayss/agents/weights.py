@@ -1,0 +1,97 @@
+"""Load a saved policy's weights without unpickling anything (the run-folder trust model).
+
+SB3's ``DQN.load`` unpickles parts of a ``.zip`` (its ``data`` entry holds cloudpickled
+objects), so opening someone else's ``spcp.zip`` with it could run their code. Here only the
+zip's ``policy.pth`` is read, with ``torch.load(weights_only=True)`` (tensors and plain
+containers only), and the Q-network is rebuilt from the run's own ``config.yaml`` settings
+(:class:`~sumo_ayss.agents.hparams.DQNHyperParams`) and the case's spaces.
+"""
+
+from __future__ import annotations
+
+import io
+import zipfile
+from pathlib import Path
+from types import SimpleNamespace
+
+import torch as th
+from gymnasium import spaces
+from stable_baselines3.common.torch_layers import FlattenExtractor
+
+from sumo_ayss.agents.greedy import GreedyPolicy
+from sumo_ayss.agents.hparams import DQNHyperParams
+from sumo_ayss.agents.policies import DuelingQNetwork
+from sumo_ayss.errors import CheckpointError
+
+#: The state dict entry of SB3's saved zip, and the online network's prefix in it.
+POLICY_ENTRY = "policy.pth"
+_ONLINE_PREFIX = "q_net."
+
+
+def read_policy_state(path: str | Path) -> dict[str, th.Tensor]:
+    """The policy's state dict from an SB3 ``.zip`` (``policy.pth``), tensors only.
+
+    Raises:
+        CheckpointError: The file is missing, not a zip, has no ``policy.pth``, or that
+            entry is not a plain state dict of tensors.
+    """
+    path = Path(path)
+    try:
+        with zipfile.ZipFile(path) as archive:
+            raw = archive.read(POLICY_ENTRY)
+    except FileNotFoundError:
+        raise CheckpointError(f"{path}: file not found") from None
+    except (zipfile.BadZipFile, KeyError, OSError, EOFError) as e:
+        raise CheckpointError(
+            f"{path}: not a saved policy (an SB3 .zip with {POLICY_ENTRY}): {e}"
+        ) from e
+    try:
+        state = th.load(io.BytesIO(raw), map_location="cpu", weights_only=True)
+    except Exception as e:  # torch raises several types on corrupt or unsafe data
+        raise CheckpointError(
+            f"{path}: {POLICY_ENTRY} is not a plain tensor state dict ({type(e).__name__}: "
+            f"{str(e).splitlines()[0] if str(e) else ''})"
+        ) from e
+    if not isinstance(state, dict) or not all(isinstance(v, th.Tensor) for v in state.values()):
+        raise CheckpointError(f"{path}: {POLICY_ENTRY} is not a state dict of tensors")
+    return state
+
+
+def load_greedy_policy(
+    path: str | Path,
+    hparams: DQNHyperParams,
+    observation_space: spaces.Box,
+    action_space: spaces.Discrete,
+) -> GreedyPolicy:
+    """The greedy policy of the online Q-network saved in ``path``, without unpickling.
+
+    Args:
+        path: An ``spcp.zip`` or candidate ``model.zip`` written by training.
+        hparams: The run's learner settings (network layout: arch widths, dueling).
+        observation_space: The case's observation space (its size sets the input layer).
+        action_space: The case's action space.
+
+    Raises:
+        CheckpointError: The file cannot be read or its weights do not fit the layout.
+    """
+    state = read_policy_state(path)
+    online = {k[len(_ONLINE_PREFIX) :]: v for k, v in state.items() if k.startswith(_ONLINE_PREFIX)}
+    extractor = FlattenExtractor(observation_space)
+    net = DuelingQNetwork(
+        observation_space,
+        action_space,
+        features_extractor=extractor,
+        features_dim=extractor.features_dim,
+        feature_net_arch=hparams.feature_net_arch,
+        value_net_arch=hparams.value_net_arch,
+        advantage_net_arch=hparams.advantage_net_arch,
+        dueling=hparams.dueling,
+    )
+    try:
+        net.load_state_dict(online, strict=True)
+    except RuntimeError as e:
+        raise CheckpointError(
+            f"{path}: weights do not fit the run's network (agent.*_net_arch, agent.dueling "
+            f"in config.yaml): {str(e).splitlines()[0]}"
+        ) from e
+    return GreedyPolicy(SimpleNamespace(q_net=net))  # type: ignore[arg-type]

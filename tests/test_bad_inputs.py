@@ -1,0 +1,700 @@
+"""The bad-input corpus: every misuse a new user tried gives a clear one-line error.
+
+Each case names the field, file or argument and what is allowed, exits non-zero from the
+command line, and loses nothing already written. Cases that need SUMO use the real one (a
+reset or a few steps); the run-folder cases share one tiny real training run.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import shutil
+import zipfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from sumo_ayss.config import EnvConfig, SimConfig, read_yaml
+from sumo_ayss.controllers import ControllerError, bound_acceleration
+from sumo_ayss.errors import ActionError, AyssError, CheckpointError, ConfigError
+from sumo_ayss.experiment import load_experiment
+from tests.helpers import TINY_AGENT
+
+# ------------------------------------------------------------------------------ helpers
+
+
+def _yaml(tmp_path: Path, text: str, name: str = "exp.yaml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def _one_line(err: BaseException) -> str:
+    message = str(err)
+    assert "\n" not in message.strip(), f"not one line: {message!r}"
+    assert "Traceback" not in message
+    return message
+
+
+# ------------------------------------------------------------------ experiment files
+
+EXPERIMENT_CASES: list[tuple[str, str, str]] = [
+    # (id, YAML text, expected part of the message)
+    (
+        "inf time constant",
+        "env: {actuator: {time_constant_s: .inf}}",
+        "time_constant_s must be a finite",
+    ),
+    (
+        "nan time constant",
+        "env: {actuator: {time_constant_s: .nan}}",
+        "time_constant_s must be a finite",
+    ),
+    ("inf alpha", "env: {reward: {alpha_adversarial: .inf}}", "alpha_adversarial must be a finite"),
+    (
+        "inf zero_m",
+        "env: {reward: {same_lane: {zero_m: .inf}}}",
+        "same_lane.zero_m must be a finite",
+    ),
+    ("-inf episode", "env: {episode_s: -.inf}", "env.episode_s must be a finite"),
+    ("inf in a range", "env: {odd: {gap_m: [2, .inf]}}", "env.odd.gap_m[1] must be a finite"),
+    (
+        "odd above actuator top speed",
+        "env: {odd: {pov_speed_mps: [10, 45]}}",
+        "env.odd.pov_speed_mps max (45.0) must be <= env.actuator.max_speed_mps",
+    ),
+    (
+        "buffer below batch",
+        "agent: {buffer_size: 10, batch_size: 64}",
+        "agent.buffer_size (10) must be >=",
+    ),
+    (
+        "learning never starts",
+        "agent: {learning_starts: 5000}\ntrain: {total_timesteps: 1000, eval_every: 500}",
+        "agent.learning_starts (5000) must be < train.total_timesteps (1000)",
+    ),
+    ("duplicate key", "env:\n  case: car_following\n  case: cut_in\n", "duplicate key 'case'"),
+    (
+        "duplicate section",
+        "train: {eval_every: 10}\ntrain: {eval_every: 20}\n",
+        "duplicate key 'train'",
+    ),
+    ("empty file", "", "the file is empty"),
+    ("only a comment", "# nothing\n", "the file is empty"),
+    (
+        "negative eval seed",
+        "train: {eval_seed: -1}",
+        "train.eval_seed must be an integer in [0, 2147483647]",
+    ),
+    ("huge eval seed", "train: {eval_seed: 99999999999}", "train.eval_seed must be an integer in"),
+    (
+        "extra_args not an option",
+        "env: {sim: {extra_args: [foo]}}",
+        "env.sim.extra_args must start",
+    ),
+    (
+        "extra_args managed option",
+        "env: {sim: {extra_args: ['--seed', '3']}}",
+        "'--seed' is set by sumo_ayss",
+    ),
+    (
+        "extra_args step length",
+        "env: {sim: {extra_args: ['--step-length=0.1']}}",
+        "env.sim.step_length_s",
+    ),
+    ("top level a list", "- 1\n- 2\n", "top level must be a mapping"),
+    ("invalid YAML", "env: {case: [\n", "invalid YAML"),
+]
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"), [c[1:] for c in EXPERIMENT_CASES], ids=[c[0] for c in EXPERIMENT_CASES]
+)
+def test_bad_experiment_file_is_refused_by_name(tmp_path: Path, text: str, expected: str) -> None:
+    with pytest.raises(ConfigError) as info:
+        load_experiment(_yaml(tmp_path, text))
+    assert expected in _one_line(info.value)
+
+
+def test_network_that_is_not_a_sumo_network_is_refused_before_libsumo(tmp_path: Path) -> None:
+    """libsumo segfaults on some XML files; they are refused in Python first."""
+    routes = _yaml(tmp_path, '<routes><vType id="a"/></routes>\n', "routes.xml")
+    with pytest.raises(
+        ConfigError, match=r"env.network: .* is not a SUMO network \(root element <routes>"
+    ):
+        load_experiment(_yaml(tmp_path, f"env: {{network: {routes}}}"))
+    garbage = _yaml(tmp_path, "this is not xml <", "garbage.net.xml")
+    with pytest.raises(ConfigError, match=r"env.network: .* is not valid XML"):
+        EnvConfig(network=garbage)
+    empty = _yaml(tmp_path, "", "empty.net.xml")
+    with pytest.raises(ConfigError, match=r"env.network: .* is not valid XML"):
+        EnvConfig(network=empty)
+    with pytest.raises(ConfigError, match=r"env\.network: file not found"):
+        EnvConfig(network=tmp_path / "missing.net.xml")
+
+
+def test_yaml_reader_names_the_file_and_line_of_a_duplicate(tmp_path: Path) -> None:
+    path = _yaml(tmp_path, "a: 1\nb: 2\na: 3\n")
+    with pytest.raises(ConfigError) as info:
+        read_yaml(path)
+    message = _one_line(info.value)
+    assert str(path) in message and "first at line 1" in message and "line 3" in message
+
+
+# ------------------------------------------------------------------ pipeline files
+
+PIPELINE_CASES: list[tuple[str, str, str]] = [
+    ("empty pipeline", "", "the file is empty"),
+    ("no experiments", "experiments: {}", "experiments has no file for case 'car_following'"),
+    (
+        "unknown case in experiments",
+        "grid: {cases: [car_following]}\nexperiments: {car_following: EXP, car_follow: EXP}",
+        "experiments.car_follow: unknown case; allowed: ['car_following', 'cut_in']",
+    ),
+    (
+        "negative seed",
+        "grid: {seeds: [0, -1]}",
+        "grid.seeds[] must be an integer in [0, 2147483647], got -1",
+    ),
+    ("huge seed", "grid: {seeds: [4294967296]}", "grid.seeds[] must be an integer in"),
+    ("duplicate grid", "grid: {seeds: [0]}\ngrid: {seeds: [1]}", "duplicate key 'grid'"),
+    ("inf override", "total_timesteps: .inf", "total_timesteps must be an integer"),
+]
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"), [c[1:] for c in PIPELINE_CASES], ids=[c[0] for c in PIPELINE_CASES]
+)
+def test_bad_pipeline_file_is_refused_at_plan_time(
+    tmp_path: Path, text: str, expected: str
+) -> None:
+    from sumo_ayss.pipeline import load_pipeline, plan_jobs
+
+    exp = _yaml(tmp_path, yaml.safe_dump({"env": {"case": "car_following"}}), "cf.yaml")
+    path = _yaml(tmp_path, text.replace("EXP", str(exp)), "pipeline.yaml")
+    with pytest.raises(ConfigError) as info:
+        plan_jobs(load_pipeline(path))
+    assert expected in _one_line(info.value)
+
+
+def test_pipeline_seed_override_out_of_range_is_refused(tmp_path: Path) -> None:
+    from sumo_ayss.pipeline import load_pipeline
+
+    path = _yaml(tmp_path, "grid: {seeds: [0]}", "pipeline.yaml")
+    with pytest.raises(ConfigError, match=r"grid.seeds\[\] must be an integer in .*got -3"):
+        load_pipeline(path, seeds=[1, -3])
+
+
+def test_pipeline_without_a_config_argument_refuses_to_start(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from sumo_ayss.pipeline import main
+
+    with pytest.raises(SystemExit) as info:
+        main([])
+    assert info.value.code == 2
+    assert "the following arguments are required: config" in capsys.readouterr().err
+
+
+def test_pipeline_out_pointing_at_a_file_is_refused_before_any_job(tmp_path: Path) -> None:
+    from sumo_ayss.pipeline import main
+
+    exp = _yaml(tmp_path, yaml.safe_dump({"env": {"case": "car_following"}}), "cf.yaml")
+    file = _yaml(tmp_path, "precious\n", "results.txt")
+    pipe = _yaml(
+        tmp_path,
+        yaml.safe_dump(
+            {
+                "grid": {"cases": ["car_following"], "vuts": ["pi1"], "seeds": [0]},
+                "experiments": {"car_following": str(exp)},
+                "out": str(file),
+            }
+        ),
+        "pipeline.yaml",
+    )
+    with pytest.raises(SystemExit) as info:
+        main([str(pipe), "--no-live"])
+    assert isinstance(info.value.code, str) and "out: " in info.value.code
+    assert "is a file" in info.value.code
+    assert file.read_text() == "precious\n"  # nothing lost
+
+
+# ------------------------------------------------------------------ train command line
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (["--seed", "-1"], "--seed must be an integer in [0, 2147483647], got -1"),
+        (["--seed", "99999999999"], "--seed must be an integer in [0, 2147483647]"),
+        (
+            ["--total-timesteps", "500", "--eval-every", "500"],
+            "agent.learning_starts (1000) must be < train.total_timesteps (500)",
+        ),
+        (["--vut", "pi9"], "env.vut must be one of"),
+    ],
+    ids=["negative seed", "huge seed", "learning never starts", "unknown vut"],
+)
+def test_bad_train_arguments_exit_with_one_line(
+    tmp_path: Path, args: list[str], expected: str
+) -> None:
+    from sumo_ayss.train import main
+
+    with pytest.raises(SystemExit) as info:
+        main([*args, "--out", str(tmp_path / "runs"), "--no-progress"])
+    code = info.value.code
+    assert isinstance(code, str) and code.startswith("error: ") and expected in code
+    assert "\n" not in code
+    assert not (tmp_path / "runs" / "car_following").exists()
+
+
+def test_train_out_pointing_at_a_file_is_refused(tmp_path: Path) -> None:
+    from sumo_ayss.train import main
+
+    file = _yaml(tmp_path, "precious\n", "out.txt")
+    for out in (file, file / "below"):
+        with pytest.raises(SystemExit) as info:
+            main(["--out", str(out), "--no-progress"])
+        assert isinstance(info.value.code, str) and "--out: " in info.value.code
+        assert "is a file" in info.value.code
+    assert file.read_text() == "precious\n"
+
+
+def test_empty_experiment_file_refuses_to_train(tmp_path: Path) -> None:
+    from sumo_ayss.train import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["--config", str(_yaml(tmp_path, "")), "--out", str(tmp_path / "runs")])
+    assert isinstance(info.value.code, str) and "the file is empty" in info.value.code
+
+
+# ------------------------------------------------------------------ controllers
+
+
+@pytest.mark.parametrize(
+    "value",
+    [math.nan, math.inf, -math.inf, None, "2.5", True, [1.0], {"a": 1}],
+    ids=["nan", "inf", "-inf", "None", "str", "bool", "list", "dict"],
+)
+def test_controller_output_that_is_not_a_finite_number_is_refused(value: Any) -> None:
+    with pytest.raises(ControllerError, match="must return a finite real number"):
+        bound_acceleration(value, 3.0, 6.0)
+
+
+def test_controller_numbers_of_numpy_and_int_types_are_accepted() -> None:
+    import numpy as np
+
+    assert bound_acceleration(np.float32(1.5), 3.0, 6.0) == 1.5
+    assert bound_acceleration(np.int64(-9), 3.0, 6.0) == -6.0
+    assert bound_acceleration(2, 3.0, 6.0) == 2.0
+
+
+class ReturnsNan:
+    def acceleration(self, state: Any) -> float:
+        return math.nan
+
+
+class ReturnsString:
+    def acceleration(self, state: Any) -> Any:
+        return "2.5"
+
+
+class Raises:
+    def acceleration(self, state: Any) -> float:
+        raise ZeroDivisionError("division by zero in my ACC")
+
+
+def _controller_env(target: str) -> Any:
+    from sumo_ayss.catalog import ControllerSpec, VehicleType
+    from sumo_ayss.envs.car_following import CarFollowingEnv
+
+    spec = ControllerSpec(target=target, max_accel_mps2=3.0, max_decel_mps2=6.0)
+    vt = VehicleType(controller=spec)
+    return CarFollowingEnv(EnvConfig(vuts={"mine": vt}, vut="mine"))
+
+
+@pytest.mark.sumo
+@pytest.mark.parametrize(
+    ("target", "expected"),
+    [
+        ("tests.test_bad_inputs:ReturnsNan", "returned nan"),
+        ("tests.test_bad_inputs:ReturnsString", "returned '2.5' (str)"),
+        ("tests.test_bad_inputs:Raises", "raised ZeroDivisionError: division by zero in my ACC"),
+    ],
+    ids=["nan", "str", "raises"],
+)
+def test_a_misbehaving_controller_stops_the_episode_with_its_name(
+    target: str, expected: str
+) -> None:
+    env = _controller_env(target)
+    try:
+        env.reset(seed=0)
+        with pytest.raises(ControllerError) as info:
+            env.step(0)
+        message = _one_line(info.value)
+        assert expected in message and target in message
+    finally:
+        env.close()
+
+
+# ------------------------------------------------------------------ env contract
+
+
+@pytest.mark.sumo
+@pytest.mark.parametrize(
+    ("ic", "expected"),
+    [
+        ((math.nan, 20.0, 10.0), "pov_speed_mps must be a finite number"),
+        ((20.0, -1.0, 10.0), "vut_speed_mps must be a finite number in [0, 50]"),
+        ((20.0, 20.0, 1e6), "gap_m must be a finite number in [0, 500]"),
+        ((20.0, 20.0, -3.0), "gap_m must be a finite number in [0, 500]"),
+        ((45.0, 20.0, 10.0), "pov_speed_mps must be a finite number in [0, 40]"),
+        ((20.0, math.inf, 10.0), "vut_speed_mps"),
+    ],
+    ids=["nan speed", "negative speed", "absurd gap", "overlap", "above actuator", "inf"],
+)
+def test_reset_refuses_an_unrealisable_initial_condition(
+    ic: tuple[float, ...], expected: str
+) -> None:
+    from sumo_ayss.envs.car_following import CarFollowingEnv
+    from sumo_ayss.envs.odd import InitialCondition
+
+    env = CarFollowingEnv()
+    try:
+        with pytest.raises(ConfigError) as info:
+            env.reset(options={"initial_condition": InitialCondition(*ic)})
+        assert expected in _one_line(info.value)
+        with pytest.raises(ConfigError, match="unknown keys"):
+            env.reset(options={"initial_conditions": None})
+    finally:
+        env.close()
+
+
+def test_bad_sumo_arguments_fail_with_a_simulation_error() -> None:
+    from sumo_ayss.envs.car_following import CarFollowingEnv
+
+    env = CarFollowingEnv(EnvConfig(sim=SimConfig(extra_args=("--no-such-option", "1"))))
+    try:
+        with pytest.raises(AyssError, match="SUMO failed to start"):
+            env.reset(seed=0)
+    finally:
+        env.close()
+    env = CarFollowingEnv()  # the failed start left no simulation behind
+    try:
+        env.reset(seed=0)
+    finally:
+        env.close()
+
+
+# ------------------------------------------------------------------ run folders
+
+
+@pytest.fixture(scope="module")
+def trained_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """A real, tiny training run: (its experiment file, its run folder)."""
+    from sumo_ayss.train import train
+
+    root = tmp_path_factory.mktemp("bad_inputs_run")
+    agent = {**TINY_AGENT, "learning_starts": 50}
+    train_cfg = {
+        "total_timesteps": 200,
+        "eval_every": 100,
+        "n_eval_scenarios": 2,
+        "progress_bar": False,
+    }
+    exp = root / "tiny.yaml"
+    exp.write_text(yaml.safe_dump({"agent": agent, "train": train_cfg}))
+    run = train(load_experiment(exp), seed=0, out=root / "runs")
+    return exp, run
+
+
+def _copy_run(trained_run: tuple[Path, Path], tmp_path: Path) -> tuple[Path, Path]:
+    _, run = trained_run
+    out = tmp_path / "runs"
+    copy = out / run.relative_to(run.parents[2])
+    shutil.copytree(run, copy)
+    return out, copy
+
+
+def _truncate(path: Path) -> None:
+    path.write_bytes(path.read_bytes()[: max(1, path.stat().st_size // 3)])
+
+
+def _garbage(path: Path) -> None:
+    path.write_bytes(b"\x00\xffnot what you expected\n" * 7)
+
+
+Corruption = Callable[[Path], None]
+RUN_CORRUPTIONS: list[tuple[str, str, Corruption, str]] = [
+    # (id, file in the run folder, corruption, expected part of the message)
+    ("truncated spcp.zip", "spcp.zip", _truncate, "spcp.zip: not a saved policy"),
+    ("random spcp.zip", "spcp.zip", _garbage, "spcp.zip: not a saved policy"),
+    ("garbage config.yaml", "config.yaml", _garbage, "config.yaml: unreadable run configuration"),
+    (
+        "config.yaml a list",
+        "config.yaml",
+        lambda p: p.write_text("- 1\n"),
+        "config.yaml: unreadable",
+    ),
+    (
+        "config.yaml bad value",
+        "config.yaml",
+        lambda p: p.write_text(p.read_text().replace("gamma: 0.8", "gamma: .inf")),
+        "agent.gamma",
+    ),
+]
+
+
+@pytest.mark.sumo
+@pytest.mark.parametrize(
+    ("name", "corrupt", "expected"),
+    [c[1:] for c in RUN_CORRUPTIONS],
+    ids=[c[0] for c in RUN_CORRUPTIONS],
+)
+def test_evaluate_on_a_corrupt_run_folder_gives_one_line(
+    trained_run: tuple[Path, Path], tmp_path: Path, name: str, corrupt: Corruption, expected: str
+) -> None:
+    from sumo_ayss.evaluate import main
+
+    _, run = _copy_run(trained_run, tmp_path)
+    corrupt(run / name)
+    with pytest.raises(SystemExit) as info:
+        main([str(run), "--n-outcome", "2", "--n-ayss", "10", "--no-progress"])
+    code = info.value.code
+    assert isinstance(code, str) and expected in code and "\n" not in code
+    assert not (run / "outcome.csv").exists()
+
+
+@pytest.mark.sumo
+@pytest.mark.parametrize(
+    ("name", "corrupt", "expected"),
+    [c[1:] for c in RUN_CORRUPTIONS[:3]],
+    ids=[c[0] for c in RUN_CORRUPTIONS[:3]],
+)
+def test_replay_export_on_a_corrupt_run_folder_gives_one_line(
+    trained_run: tuple[Path, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    name: str,
+    corrupt: Corruption,
+    expected: str,
+) -> None:
+    from sumo_ayss.replay import main
+
+    _, run = _copy_run(trained_run, tmp_path)
+    _write_outcome_table(run)
+    corrupt(run / name)
+    code = main(["export", str(run), "--outcome-row", "0", "--out", str(tmp_path / "scn")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and expected in err and len(err.splitlines()) == 1
+
+
+def _write_outcome_table(run: Path) -> None:
+    """Evaluate a copy of the run (tiny) so that outcome.csv exists for export."""
+    from sumo_ayss.evaluate import evaluate_run
+    from sumo_ayss.scenarios.ayss import AyssConfig
+
+    evaluate_run(run, n_outcome=2, ayss=AyssConfig(n_samples=10), progress=False)
+
+
+RESUME_CORRUPTIONS: list[tuple[str, str, Corruption, str]] = [
+    ("garbage latest.json", "checkpoints/latest.json", _garbage, "latest.json: unreadable JSON"),
+    (
+        "latest.json escapes",
+        "checkpoints/latest.json",
+        lambda p: p.write_text('{"dir": "../../x"}'),
+        "must name a step_* folder",
+    ),
+    (
+        "garbage state.json",
+        "checkpoints/LATEST/state.json",
+        _garbage,
+        "state.json: unreadable JSON",
+    ),
+    (
+        "state.json not a state",
+        "checkpoints/LATEST/state.json",
+        lambda p: p.write_text("[]"),
+        "not a checkpoint state",
+    ),
+    (
+        "truncated model.zip",
+        "checkpoints/LATEST/model.zip",
+        _truncate,
+        "model.zip: not a saved policy",
+    ),
+    (
+        "truncated resume_model.zip",
+        "checkpoints/LATEST/resume_model.zip",
+        _truncate,
+        "resume_model.zip: unreadable checkpoint",
+    ),
+    (
+        "truncated replay.pkl",
+        "checkpoints/LATEST/replay.pkl",
+        _truncate,
+        "replay.pkl: unreadable replay buffer",
+    ),
+    ("garbage config.yaml", "config.yaml", _garbage, "config.yaml: unreadable run configuration"),
+    (
+        "text in eval.csv",
+        "eval.csv",
+        lambda p: p.write_text(p.read_text().replace(",2,", ",two,", 1)),
+        "column 'n_episodes' must be a number, got 'two'",
+    ),
+    ("eval.csv not a table", "eval.csv", lambda p: p.write_text("hello\n1\n"), "not an eval table"),
+]
+
+
+@pytest.mark.sumo
+@pytest.mark.parametrize(
+    ("name", "corrupt", "expected"),
+    [c[1:] for c in RESUME_CORRUPTIONS],
+    ids=[c[0] for c in RESUME_CORRUPTIONS],
+)
+def test_resume_of_a_corrupt_run_folder_gives_one_line(
+    trained_run: tuple[Path, Path], tmp_path: Path, name: str, corrupt: Corruption, expected: str
+) -> None:
+    from sumo_ayss.train import main
+
+    exp, _ = trained_run
+    out, run = _copy_run(trained_run, tmp_path)
+    (run / "spcp.json").unlink()  # an unfinished run: --resume continues it
+    latest = json.loads((run / "checkpoints" / "latest.json").read_text())["dir"]
+    target = run / name.replace("LATEST", latest)
+    corrupt(target)
+    before = {p: p.read_bytes() for p in run.rglob("*") if p.is_file() and p != target}
+    with pytest.raises(SystemExit) as info:
+        main(["--config", str(exp), "--out", str(out), "--resume", "--no-progress"])
+    code = info.value.code
+    assert isinstance(code, str) and expected in code and "\n" not in code
+    for path, data in before.items():  # nothing already written is lost or changed
+        assert path.is_file() and path.read_bytes() == data, path
+
+
+# ------------------------------------------------------------------ trust model
+
+
+class _Boom:
+    """Unpickling this runs code: it creates the file named in the class attribute."""
+
+    marker = ""
+
+    def __reduce__(self) -> Any:
+        return (Path.touch, (Path(self.marker),))
+
+
+def test_spcp_weights_are_never_unpickled(trained_run: tuple[Path, Path], tmp_path: Path) -> None:
+    from sumo_ayss.agents.weights import read_policy_state
+
+    _, run = _copy_run(trained_run, tmp_path)
+    marker = tmp_path / "pwned"
+    boom = _Boom()
+    boom.marker = str(marker)
+    evil = run / "spcp.zip"
+    with zipfile.ZipFile(trained_run[1] / "spcp.zip") as src, zipfile.ZipFile(evil, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            if item.filename == "policy.pth":
+                buf = io.BytesIO()
+                import torch as th
+
+                th.save({"q_net.x": boom}, buf)
+                data = buf.getvalue()
+            dst.writestr(item, data)
+    with pytest.raises(CheckpointError, match=r"policy\.pth is not a plain tensor state dict"):
+        read_policy_state(evil)
+    assert not marker.exists()
+
+
+@pytest.mark.sumo
+def test_a_run_folder_controller_is_imported_only_when_trusted(
+    trained_run: tuple[Path, Path], tmp_path: Path
+) -> None:
+    from sumo_ayss.evaluate import load_run, main
+
+    _, run = _copy_run(trained_run, tmp_path)
+    marker = tmp_path / "imported"
+    module = tmp_path / "evil_controller.py"
+    module.write_text(
+        f"import pathlib\npathlib.Path({str(marker)!r}).touch()\n"
+        "class C:\n    def acceleration(self, state):\n        return 0.0\n"
+    )
+    data = yaml.safe_load((run / "config.yaml").read_text())
+    data["vut"] = "evil"
+    data["env"]["vut"] = "evil"
+    data["env"]["vuts"]["evil"] = {
+        "model": "IDM",
+        "params": {},
+        "description": "",
+        "controller": {"target": f"{module}:C", "max_accel_mps2": 3.0, "max_decel_mps2": 6.0},
+    }
+    (run / "config.yaml").write_text(yaml.safe_dump(data))
+    info = load_run(run)  # the config is read and checked, its controller not imported
+    assert info.config.env.vut == "evil" and not marker.exists()
+    with pytest.raises(SystemExit) as exit_info:
+        main([str(run), "--n-outcome", "2", "--n-ayss", "10", "--no-progress"])
+    assert isinstance(exit_info.value.code, str) and "--trust-controller" in exit_info.value.code
+    assert not marker.exists()
+    # Trusted: imported, and the evaluation runs.
+    main([str(run), "--n-outcome", "2", "--n-ayss", "10", "--no-progress", "--trust-controller"])
+    assert marker.exists() and (run / "outcome.csv").is_file()
+
+
+# ------------------------------------------------------------------ report
+
+
+def test_report_says_which_candidate_rows_it_dropped(
+    trained_run: tuple[Path, Path], tmp_path: Path
+) -> None:
+    from sumo_ayss.report.load import load_run
+
+    _, run = _copy_run(trained_run, tmp_path)
+    table = run / "eval.csv"
+    lines = table.read_text().splitlines()
+    head, first, *rest = lines
+    cells = first.split(",")
+    cells[1] = "oops"
+    table.write_text("\n".join([head, ",".join(cells), *rest]) + "\n")
+    loaded = load_run(run)
+    assert loaded.eval_curve is not None and loaded.eval_curve.n_dropped == 1
+    assert any("1 candidate row(s)" in p for p in loaded.problems)
+
+
+def test_step_after_the_episode_ended_raises() -> None:
+    from sumo_ayss.envs.car_following import CarFollowingEnv
+    from sumo_ayss.envs.odd import InitialCondition
+
+    env = CarFollowingEnv()
+    try:
+        env.reset(seed=0, options={"initial_condition": InitialCondition(0.0, 30.0, 0.5)})
+        terminated = truncated = False
+        while not (terminated or truncated):
+            _, reward, terminated, truncated, _ = env.step(0)
+        assert terminated and float(reward) < 0  # the collision
+        with pytest.raises(ActionError, match="after the episode ended"):
+            env.step(0)
+        env.reset(seed=1)  # a reset makes it steppable again
+        for _ in range(env.config.max_decisions):
+            env.step(10)
+        with pytest.raises(ActionError, match="call reset"):
+            env.step(10)
+    finally:
+        env.close()
+
+
+def test_report_out_pointing_at_a_file_is_refused(
+    trained_run: tuple[Path, Path], tmp_path: Path
+) -> None:
+    from sumo_ayss.report.__main__ import main
+
+    file = _yaml(tmp_path, "precious\n", "report.txt")
+    with pytest.raises(SystemExit) as info:
+        main([str(trained_run[1]), "--out", str(file)])
+    assert isinstance(info.value.code, str) and "--out: " in info.value.code
+    assert file.read_text() == "precious\n"
