@@ -94,4 +94,4 @@ def load_greedy_policy(
             f"{path}: weights do not fit the run's network (agent.*_net_arch, agent.dueling "
             f"in config.yaml): {str(e).splitlines()[0]}"
         ) from e
-    return GreedyPolicy(SimpleNamespace(q_net=net))  # type: ignore[arg-type]
+    return GreedyPolicy(SimpleNamespace(q_net=net, device=th.device("cpu")))  # type: ignore[arg-type]
