@@ -440,7 +440,7 @@ def premise_sentence(premise: Premise | None, options: ReportOptions) -> str:
         return "Premise check: needs outcome summaries of at least two VUTs."
     parts = []
     for m in premise.metrics:
-        unit = f" {m.spec.unit}" if m.spec.unit and m.spec.unit != "%" else m.spec.unit
+        unit = f" {m.spec.unit}" if m.spec.unit else ""
         parts.append(
             f"{m.spec.name} spread {_num(m.spread * m.spec.scale)}{unit} "
             f"(tolerance {_num(m.tolerance * m.spec.scale)}{unit}"
