@@ -11,6 +11,9 @@ STAMP  := $(VENV)/.installed
 # torch first, pinned: that CPU build is on this machine's disk; an unpinned torch pulls a
 # multi-GB CUDA build from PyPI.
 TORCH  := torch==2.13.0
+# Extra pip arguments for torch. Off this machine, take the CPU build from PyTorch's index:
+#   make demo TORCH_PIP_ARGS="--index-url https://download.pytorch.org/whl/cpu"
+TORCH_PIP_ARGS ?=
 
 .PHONY: all demo test test-slow lint format typecheck bench networks clean
 
@@ -19,7 +22,7 @@ all: test
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet $(TORCH)
+	$(BIN)/python -m pip install --quiet $(TORCH) $(TORCH_PIP_ARGS)
 	$(BIN)/python -m pip install --quiet -e '.[dev,ray,hwenv]'
 	@touch $(STAMP)
 

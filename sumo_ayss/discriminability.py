@@ -43,6 +43,7 @@ from sumo_ayss.analysis.discriminability import (
     compare_responses,
 )
 from sumo_ayss.atomic import atomic_write_json, atomic_write_text
+from sumo_ayss.cli import prog
 from sumo_ayss.config import Case, EnvConfig, read_yaml, to_dict
 from sumo_ayss.errors import AyssError, ConfigError
 
@@ -292,7 +293,7 @@ def ensure(
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(
-        prog="python -m sumo_ayss.discriminability",
+        prog=prog("python -m sumo_ayss.discriminability"),
         description=(__doc__ or "").splitlines()[0],
     )
     p.add_argument("config", type=Path, help="experiment YAML or pipeline YAML")

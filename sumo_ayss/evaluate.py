@@ -31,11 +31,13 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.catalog import controller_imports
+from sumo_ayss.cli import prog
 from sumo_ayss.config import check_seed, safe_load_yaml, to_dict
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
 from sumo_ayss.experiment import ExperimentConfig, experiment_from_dict
+from sumo_ayss.paths import portable_path
 from sumo_ayss.scenarios.ayss import DEFAULT_AYSS_SEED, AyssConfig, run_ayss
 from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_N, DEFAULT_OUTCOME_SEED, run_outcome
 from sumo_ayss.scenarios.rollout import Policy
@@ -132,7 +134,7 @@ def _base_record(run: RunInfo, stage: str) -> dict[str, Any]:
     env = run.config.env
     return {
         "stage": stage,
-        "run_dir": str(run.run_dir.resolve()),
+        "run_dir": portable_path(run.run_dir),
         "case": env.case,
         "vut": env.vut,
         "train_seed": run.seed,
@@ -283,7 +285,7 @@ def _trusted() -> bool:
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(
-        prog="python -m sumo_ayss.evaluate", description=(__doc__ or "").splitlines()[0]
+        prog=prog("python -m sumo_ayss.evaluate"), description=(__doc__ or "").splitlines()[0]
     )
     parser.add_argument("run_dir", type=Path, help="run folder (holds config.yaml, spcp.zip)")
     parser.add_argument(

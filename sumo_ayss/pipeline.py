@@ -2,6 +2,11 @@
 
     python -m sumo_ayss.pipeline configs/paper.yaml [--workers N] [--backend local|ray]
 
+Progress: on a terminal, a live table of every job (queued / running / done / failed,
+training steps, rate in steps/s, wall time in s) with the grid's ETA; with ``--no-live`` or
+when the output is not a terminal, one log line per job event (started, each SPCP
+candidate, training finished, done, failed) with the grid's counts and ETA.
+
 Each job (case, VUT, seed) trains (or resumes) its SPCP candidates, selects the SPCP, runs
 the outcome episodes and the Monte Carlo AYSS; then one report covers the whole grid. Jobs
 run in parallel processes (one SUMO per process: libsumo holds one simulation each), or as
@@ -47,6 +52,7 @@ from pathlib import Path
 from typing import Any, ClassVar, Literal
 
 from sumo_ayss.catalog import VehicleType
+from sumo_ayss.cli import prog
 from sumo_ayss.config import (
     PROJECT_ROOT,
     Case,
@@ -58,9 +64,10 @@ from sumo_ayss.config import (
     to_dict,
 )
 from sumo_ayss.errors import AyssError, ConfigError
+from sumo_ayss.progress import GridProgress, JobStatus, format_duration
 from sumo_ayss.report.options import ReportOptions
 
-logger = logging.getLogger(__name__)
+logger = logging.getLogger("sumo_ayss.pipeline")  # also when run as __main__
 
 Backend = Literal["local", "ray"]
 
@@ -174,15 +181,6 @@ class JobSpec:
         return Path(self.out) / self.case / self.vut / f"seed_{self.seed}"
 
 
-@dataclass
-class JobStatus:
-    spec: JobSpec
-    state: str = "queued"
-    attempts: int = 0
-    error: str = ""
-    wall_s: float = 0.0
-
-
 # ---------------------------------------------------------------------- loading
 
 
@@ -262,7 +260,7 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
     from sumo_ayss.experiment import experiment_from_dict
     from sumo_ayss.scenarios.ayss import AyssConfig
     from sumo_ayss.threads import set_torch_threads
-    from sumo_ayss.train import train
+    from sumo_ayss.train import train, write_progress
 
     run_dir = spec.run_dir
     run_dir.mkdir(parents=True, exist_ok=True)
@@ -273,6 +271,7 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
     root.setLevel(logging.INFO)
     t0 = time.perf_counter()
     stages: dict[str, str] = {}
+    times: dict[str, float] = {}
     try:
         cfg = experiment_from_dict(spec.experiment, run_dir)
         set_torch_threads(cfg.train.torch_threads)  # for evaluate too, when training is skipped
@@ -285,7 +284,10 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
             resume = (run_dir / "config.yaml").is_file()
             train(cfg, spec.seed, Path(spec.out), resume=resume, argv=["--pipeline", spec.name])
             stages["train"] = "resumed" if resume else "done"
+        times["train_s"] = time.perf_counter() - t0
 
+        write_progress(run_dir, "evaluate")
+        t1 = time.perf_counter()
         marker = run_dir / "evaluate.done.json"
         key = _fingerprint(run_dir / "spcp.zip", spec.n_outcome, spec.n_ayss)
         done = json.loads(marker.read_text()) if marker.is_file() else {}
@@ -302,55 +304,18 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
             )
             atomic_write_json(marker, {"inputs": key})
             stages["evaluate"] = "done"
+        times["evaluate_s"] = time.perf_counter() - t1
+        write_progress(run_dir, "done")
     except BaseException:
         logger.exception("job %s failed", spec.name)
         raise
     finally:
         root.removeHandler(handler)
         handler.close()
-    return {"job": spec.name, "stages": stages, "wall_s": time.perf_counter() - t0}
+    return {"job": spec.name, "stages": stages, "wall_s": time.perf_counter() - t0, **times}
 
 
 # ---------------------------------------------------------------------- the grid
-
-
-def _progress(status: JobStatus) -> str:
-    latest = status.spec.run_dir / "checkpoints" / "latest.json"
-    total = status.spec.experiment["train"]["total_timesteps"]
-    if (status.spec.run_dir / "evaluate.done.json").is_file():
-        return "evaluated"
-    if (status.spec.run_dir / "spcp.json").is_file():
-        return "trained; evaluating" if status.state == "running" else "trained"
-    if latest.is_file():
-        step = json.loads(latest.read_text())["step"]
-        return f"train {step:,}/{total:,}"
-    return "train 0" if status.state == "running" else ""
-
-
-def _table(statuses: Sequence[JobStatus]) -> Any:
-    from rich.table import Table
-
-    table = Table(title="sumo_ayss pipeline", expand=False)
-    for col in ("job", "state", "progress", "tries", "wall [s]"):
-        table.add_column(col)
-    colours = {
-        "done": "green",
-        "failed": "red",
-        "running": "yellow",
-        "retrying": "magenta",
-        "interrupted": "red",
-        "cancelled": "red",
-    }
-    for s in statuses:
-        colour = colours.get(s.state, "white")
-        table.add_row(
-            s.spec.name,
-            f"[{colour}]{s.state}[/{colour}]",
-            _progress(s),
-            str(s.attempts),
-            f"{s.wall_s:.0f}" if s.wall_s else "",
-        )
-    return table
 
 
 def _worker_init() -> None:
@@ -405,20 +370,29 @@ def _raise_terminated(signum: int, frame: Any) -> None:
 
 
 def run_grid_local(
-    jobs: Sequence[JobSpec], workers: int, retries: int, live: bool
+    jobs: Sequence[JobSpec], workers: int, retries: int, live: Any = None
 ) -> list[JobStatus]:
-    """Run ``jobs`` on a local process pool with retries and a live table.
+    """Run ``jobs`` on a local process pool with retries; report progress as it goes.
 
-    At most ``workers`` jobs are handed to the pool at a time; the others wait here, so that
-    a Ctrl-C (SIGINT) or SIGTERM cancels them at once: running jobs are terminated (their
-    state is ``interrupted``, resumable), queued ones never start (``cancelled``), and the
-    KeyboardInterrupt propagates to the caller within seconds.
+    At most ``workers`` jobs are handed to the pool at a time; the others wait here, so the
+    jobs shown as running are the ones a worker holds, and a Ctrl-C (SIGINT) or SIGTERM
+    cancels them at once: running jobs are terminated (their state is ``interrupted``,
+    resumable), queued ones never start (``cancelled``), and the KeyboardInterrupt
+    propagates to the caller within seconds. Every job event is logged (one line each, with
+    the grid's counts and ETA); ``live`` (a :class:`rich.console.Console`, or None for
+    none) also shows a table of every job that refreshes twice a second.
     """
     import signal
 
     statuses = [JobStatus(j) for j in jobs]
+    progress = GridProgress(statuses, workers)
     queue: collections.deque[JobStatus] = collections.deque(statuses)
     ctx = multiprocessing.get_context("spawn")  # fresh interpreters: no inherited libsumo
+    logger.info(
+        "%d jobs on %d worker processes; each job logs to <run folder>/job.log",
+        len(jobs),
+        workers,
+    )
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init)
     pending: dict[Future[dict[str, Any]], JobStatus] = {}
     in_main = threading.current_thread() is threading.main_thread()
@@ -426,30 +400,37 @@ def run_grid_local(
     display = None
 
     def submit(s: JobStatus) -> None:
-        s.attempts += 1
-        s.state = "running" if s.attempts == 1 else "retrying"
+        s.start()
         pending[pool.submit(run_job, s.spec)] = s
+        logger.info(progress.line(s, f"started (try {s.attempts})"))
 
     try:
-        display = _live(statuses) if live else None
+        display = _live(progress, live) if live is not None else None
         while pending or queue:
             while queue and len(pending) < workers:
                 submit(queue.popleft())
-            for fut in [f for f in list(pending) if f.done()]:
+            finished = [f for f in list(pending) if f.done()]
+            for event in progress.poll():  # also the last events of the finished jobs
+                logger.info(event)
+            for fut in finished:
                 s = pending.pop(fut)
                 try:
                     result = fut.result()
-                    s.state, s.wall_s = "done", result["wall_s"]
                 except Exception as e:  # a job's failure is data here
                     s.error = "".join(traceback.format_exception_only(e)).strip()
+                    s.stage = ""
                     if s.attempts <= retries:
-                        logger.warning("job %s failed (%s); retrying", s.spec.name, s.error)
                         s.state = "queued"
-                        queue.append(s)
+                        queue.appendleft(s)
+                        logger.warning(progress.line(s, f"failed ({s.error}); will retry"))
                     else:
                         s.state = "failed"
+                        log = s.spec.run_dir / "job.log"
+                        logger.error(progress.line(s, f"FAILED: {s.error} (log: {log})"))
+                    continue
+                logger.info(progress.finished(s, result))
             if display is not None:
-                display.update(_table(statuses))
+                display.update(progress.table())
             time.sleep(0.2)
     except KeyboardInterrupt:
         for s in queue:
@@ -469,18 +450,72 @@ def run_grid_local(
         if in_main:
             signal.signal(signal.SIGTERM, previous)
         if display is not None:
-            display.update(_table(statuses))
+            display.update(progress.table())
             display.stop()
         pool.shutdown(wait=False, cancel_futures=True)
+    c = progress.counts()
+    logger.info(
+        "grid finished: %d done, %d failed, %s wall",
+        c["done"],
+        c["failed"],
+        format_duration(time.time() - progress.t0),
+    )
     return statuses
 
 
-def _live(statuses: Sequence[JobStatus]) -> Any:
+def _live(progress: GridProgress, console: Any) -> Any:
     from rich.live import Live
 
-    live = Live(_table(statuses), refresh_per_second=2, transient=False)
+    live = Live(progress.table(), console=console, refresh_per_second=2, transient=False)
     live.start()
     return live
+
+
+def _relative_paths(data: Any, base: Path) -> Any:
+    """``data`` with absolute path strings made relative to ``base`` (no machine paths)."""
+    if isinstance(data, dict):
+        return {k: _relative_paths(v, base) for k, v in data.items()}
+    if isinstance(data, list):
+        return [_relative_paths(v, base) for v in data]
+    if isinstance(data, str) and os.path.isabs(data):
+        return Path(os.path.relpath(data, base.resolve())).as_posix()
+    return data
+
+
+def configure_logging(live: bool) -> Any:
+    """CLI logging; returns the live display's console (None: not live or not a terminal).
+
+    With a live table, log lines go through the table's console so that they print above
+    it instead of being glued onto its border.
+    """
+    if live and sys.stdout.isatty():
+        from rich.console import Console
+        from rich.logging import RichHandler
+
+        console = Console()
+        handler = RichHandler(console=console, show_path=False, markup=False)
+        logging.basicConfig(level=logging.INFO, format="%(message)s", handlers=[handler])
+        return console
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    return None
+
+
+def final_messages(statuses: Sequence[JobStatus], report: Path | None) -> list[str]:
+    """What the CLI prints at the end: failures, the report and its trust warnings."""
+    lines = [
+        f"FAILED {s.spec.name}: {s.error}  (log: {s.spec.run_dir / 'job.log'})"
+        for s in statuses
+        if s.state == "failed"
+    ]
+    done = [s for s in statuses if s.state == "done"]
+    if done:
+        from sumo_ayss.report.checks import read_training, trust_warnings
+
+        runs = [(s.spec.name, read_training(s.spec.run_dir)) for s in done]
+        lines += [f"WARNING: {w}" for w in trust_warnings(runs)]
+    if report is not None:
+        lines.append(f"report: {report}")
+    return lines
 
 
 def run_pipeline(
@@ -489,20 +524,32 @@ def run_pipeline(
     backend: Backend = "local",
     address: str | None = None,
     live: bool = True,
+    console: Any = None,
 ) -> tuple[list[JobStatus], Path | None]:
-    """Run the grid, then the report over every finished job; return statuses and report."""
+    """Run the grid, then the report over every finished job; return statuses and report.
+
+    ``live``: show a live table when standard output is a terminal (``console``: the
+    :class:`rich.console.Console` to draw it on, default a new one); job events are logged
+    either way.
+    """
     jobs = plan_jobs(cfg)
     check_out_dir(cfg.out, "out")
     cfg.out.mkdir(parents=True, exist_ok=True)
     from sumo_ayss.atomic import atomic_write_json
 
-    atomic_write_json(cfg.out / "pipeline.json", to_dict(cfg))
+    atomic_write_json(cfg.out / "pipeline.json", _relative_paths(to_dict(cfg), cfg.out))
     if backend == "ray":
         from sumo_ayss.ray_backend import run_grid_ray
 
         statuses = run_grid_ray(jobs, cfg.retries, address)
     else:
-        statuses = run_grid_local(jobs, min(cfg.n_workers, len(jobs)), cfg.retries, live)
+        if live and console is None and sys.stdout.isatty():
+            from rich.console import Console
+
+            console = Console()
+        statuses = run_grid_local(
+            jobs, min(cfg.n_workers, len(jobs)), cfg.retries, console if live else None
+        )
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
     report = None
     if finished:
@@ -535,7 +582,7 @@ def write_discriminability(cfg: PipelineConfig) -> None:
 
 def main(argv: Sequence[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
-        prog="python -m sumo_ayss.pipeline", description=__doc__.splitlines()[0]
+        prog=prog("python -m sumo_ayss.pipeline"), description=__doc__.splitlines()[0]
     )
     parser.add_argument(
         "config", type=Path, help="pipeline YAML (configs/paper.yaml runs the paper's grid)"
@@ -547,25 +594,31 @@ def main(argv: Sequence[str] | None = None) -> None:
     )
     parser.add_argument("--backend", choices=["local", "ray"], default="local")
     parser.add_argument("--address", default=None, help="Ray cluster address (ray backend)")
-    parser.add_argument("--no-live", action="store_true", help="no live table (logs only)")
+    parser.add_argument(
+        "--no-live",
+        action="store_true",
+        help="no live table: one log line per job event (the default when stdout is not a "
+        "terminal)",
+    )
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    console = configure_logging(not args.no_live)
     try:
         cfg = load_pipeline(args.config, out=args.out, workers=args.workers, seeds=args.seeds)
         statuses, report = run_pipeline(
-            cfg, backend=args.backend, address=args.address, live=not args.no_live
+            cfg,
+            backend=args.backend,
+            address=args.address,
+            live=console is not None,
+            console=console,
         )
     except AyssError as e:
         sys.exit(f"error: {e}")
     except KeyboardInterrupt:
         print("interrupted: no job runs any more; rerun the same command to resume", flush=True)
         sys.exit(130)
-    failed = [s for s in statuses if s.state == "failed"]
-    for s in failed:
-        print(f"FAILED {s.spec.name}: {s.error}  (log: {s.spec.run_dir / 'job.log'})")
-    if report is not None:
-        print(f"report: {report}")
-    sys.exit(1 if failed else 0)
+    for line in final_messages(statuses, report):
+        print(line)
+    sys.exit(1 if any(s.state == "failed" for s in statuses) else 0)
 
 
 if __name__ == "__main__":

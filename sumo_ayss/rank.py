@@ -22,7 +22,6 @@ from __future__ import annotations
 import argparse
 import csv
 import io
-import logging
 import math
 import sys
 from collections.abc import Sequence
@@ -208,11 +207,18 @@ def write_ranking(
 def main(argv: Sequence[str] | None = None) -> None:
     import dataclasses
 
-    from sumo_ayss.pipeline import load_pipeline, plan_jobs, run_pipeline
+    from sumo_ayss.cli import prog
+    from sumo_ayss.pipeline import (
+        configure_logging,
+        final_messages,
+        load_pipeline,
+        plan_jobs,
+        run_pipeline,
+    )
     from sumo_ayss.report.options import MODES
 
     parser = argparse.ArgumentParser(
-        prog="python -m sumo_ayss.rank", description=__doc__.splitlines()[0]
+        prog=prog("python -m sumo_ayss.rank"), description=__doc__.splitlines()[0]
     )
     parser.add_argument("config", type=Path, help="pipeline YAML listing the VUTs to rank")
     parser.add_argument("--workers", type=int, default=None)
@@ -228,10 +234,11 @@ def main(argv: Sequence[str] | None = None) -> None:
         action="store_true",
         help="rank the grid's existing run folders (with outcome.json) without running jobs",
     )
-    parser.add_argument("--no-live", action="store_true")
+    parser.add_argument("--no-live", action="store_true", help="no live table (log lines)")
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    console = configure_logging(not args.no_live)
     report = None
+    statuses: list[Any] = []
     try:
         cfg = load_pipeline(args.config, workers=args.workers, out=args.out, seeds=args.seeds)
         if args.mode is not None:
@@ -243,7 +250,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             if not done:
                 raise ConfigError(f"--no-run: no finished run folder under {cfg.out}")
         else:
-            statuses, report = run_pipeline(cfg, live=not args.no_live)
+            statuses, report = run_pipeline(cfg, live=console is not None, console=console)
             done = [s.spec.run_dir for s in statuses if s.state == "done"]
             complete = len(done) == len(statuses)
         analyses = analyse(done, cfg.report)
@@ -255,8 +262,14 @@ def main(argv: Sequence[str] | None = None) -> None:
     checks = [c for a in analyses if (c := order_check(a, cfg.expected_order)) is not None]
     _, md = write_ranking(ranking_rows(analyses), cfg.out, checks, cfg.expected_order)
     print(md.read_text())
-    if report is not None:
-        print(f"report: {report}")
+    if args.no_run:
+        from sumo_ayss.report.checks import read_training, trust_warnings
+
+        runs = [(str(d), read_training(d)) for d in done]
+        for warning in trust_warnings(runs):
+            print(f"WARNING: {warning}")
+    for line in final_messages(statuses, report):
+        print(line)
     sys.exit(0 if complete else 1)
 
 

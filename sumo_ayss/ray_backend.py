@@ -1,6 +1,10 @@
 """Ray backend of the pipeline: one Ray task per (case, VUT, seed) on an existing cluster.
 
-``python -m sumo_ayss.pipeline configs/paper.yaml --backend ray [--address ray://host:10001]``
+``python -m sumo_ayss.pipeline configs/paper.yaml --backend ray [--address auto]``
+
+Without ``--address`` Ray starts a private instance on this machine for the pipeline;
+``--address auto`` (or ``ray://host:10001``) joins a cluster that is already running
+(``ray start --head`` on the head machine, ``ray start --address <head>:6379`` on workers).
 
 Workers need not share a file system with the driver: a task receives the job's run
 folder as it stands on the driver (empty, half-trained or finished), works on a private
@@ -75,7 +79,15 @@ def run_grid_ray(jobs: Sequence[JobSpec], retries: int, address: str | None) -> 
         ) from e
     started_here = not ray.is_initialized()
     if started_here:
-        ray.init(address=address, include_dashboard=False, log_to_driver=False)
+        try:
+            ray.init(address=address, include_dashboard=False, log_to_driver=False)
+        except ConnectionError as e:
+            raise ConfigError(
+                f"--address {address}: no Ray cluster reachable ({e}). Start one first: "
+                "`ray start --head` on this machine (then `ray start --address <head-ip>:6379` "
+                "on each worker machine), or leave out --address to run on a Ray instance "
+                "started just for this pipeline on this machine"
+            ) from e
     task = ray.remote(num_cpus=1, max_retries=0)(remote_job)
     statuses = [JobStatus(j) for j in jobs]
     pending: dict[Any, JobStatus] = {}

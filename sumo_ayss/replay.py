@@ -59,11 +59,13 @@ import numpy as np
 
 from sumo_ayss.atomic import atomic_copy, atomic_write_text
 from sumo_ayss.catalog import controller_imports, vtypes_xml
+from sumo_ayss.cli import prog
 from sumo_ayss.config import EnvConfig, to_dict
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.errors import AyssError, CheckpointError, ConfigError, SimulationError
+from sumo_ayss.paths import portable_path
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.scenarios.tables import AYSS_SCHEMA, OUTCOME_SCHEMA, read_table
 from sumo_ayss.sim import export
@@ -381,7 +383,7 @@ def _info(
         }
     return {
         "source": {
-            "run_dir": str(run.run_dir.resolve()),
+            "run_dir": portable_path(run.run_dir),
             "table": "ayss.csv" if kind == "ayss" else "outcome.csv",
             "row": index,
             "values": {k: _json_value(v) for k, v in row.items()},
@@ -515,7 +517,7 @@ def replay_in_gui(scenario_dir: str | Path, delay_ms: int = 200) -> int:
 
 def _export_main(argv: Sequence[str]) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m sumo_ayss.replay export",
+        prog=prog("python -m sumo_ayss.replay") + " export",
         description="Write an AYSS sample or an outcome episode of a run as SUMO files.",
     )
     parser.add_argument("run_dir", type=Path, help="run folder (config.yaml, spcp.zip, tables)")
@@ -554,7 +556,7 @@ def _export_main(argv: Sequence[str]) -> int:
 
 def _replay_main(argv: Sequence[str]) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m sumo_ayss.replay",
+        prog=prog("python -m sumo_ayss.replay"),
         description="Replay a scenario folder in sumo-gui, or headless with sumo. "
         "`python -m sumo_ayss.replay export ...` writes one.",
     )

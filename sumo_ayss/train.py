@@ -26,6 +26,8 @@ Run folder ``<out>/<case>/<vut>/seed_<k>/``:
     checkpoints/       step_XXXXXXXX/model.zip per candidate; the latest also holds the
                        replay buffer and RNG state; latest.json points at it
     spcp.json, spcp.zip  the selected candidate and why
+    progress.json      training progress for watchers (stage, step, total, rate), rewritten
+                       atomically every few seconds
     tb/                TensorBoard logs
 
 Every file is written atomically (temporary file + rename), and ``latest.json`` is written
@@ -69,6 +71,7 @@ from sumo_ayss.atomic import (
     atomic_write_with,
     remove_stale_temporaries,
 )
+from sumo_ayss.cli import prog
 from sumo_ayss.config import check_out_dir, check_seed, safe_load_yaml, to_dict, write_yaml
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
@@ -76,6 +79,7 @@ from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.envs.vec_env import EpisodeTrace, PairVecEnv
 from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
 from sumo_ayss.experiment import ExperimentConfig, experiment_from_dict, load_experiment
+from sumo_ayss.paths import portable_python
 from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, run_episodes, summarize
 from sumo_ayss.selection import select_spcp
 
@@ -214,7 +218,7 @@ class Trainer:
         self.ckpt_dir.mkdir(exist_ok=True)
         atomic_write_text(
             self.run_dir / "command.txt",
-            shlex.join([sys.executable, "-m", __spec__.name, *argv])
+            shlex.join([portable_python(), "-m", __spec__.name, *argv])
             if __spec__
             else shlex.join(argv),
         )
@@ -545,6 +549,21 @@ class Trainer:
             self.env.close()
 
 
+PROGRESS_FILE = "progress.json"
+PROGRESS_EVERY_S = 2.0
+"""Seconds between two rewrites of a run's ``progress.json`` during training."""
+
+
+def write_progress(run_dir: Path, stage: str, **fields: Any) -> None:
+    """Atomically (re)write ``run_dir/progress.json``: ``stage`` plus ``fields``.
+
+    Stages: ``train`` (with ``step``, ``total`` in transitions and ``rate_steps_per_s``,
+    transitions per second of wall time since this process started training), ``evaluate``,
+    ``done``. Only watchers (the pipeline's progress display) read it; nothing depends on it.
+    """
+    atomic_write_json(run_dir / PROGRESS_FILE, {"stage": stage, "time": time.time(), **fields})
+
+
 class _CandidateCallback(BaseCallback):
     """Calls :meth:`Trainer.candidate` once ``eval_every`` is reached.
 
@@ -552,16 +571,45 @@ class _CandidateCallback(BaseCallback):
     Several pairs: at once (their episodes never end together; they are cut and restarted).
     The candidate's resume checkpoint follows at the next rollout start
     (:meth:`Trainer.save_checkpoint`); the steps in between are recorded for its replay.
+    Every :data:`PROGRESS_EVERY_S` seconds it also rewrites ``progress.json``.
     """
 
     def __init__(self, trainer: Trainer) -> None:
         super().__init__()
         self.trainer = trainer
+        self._t0 = time.monotonic()
+        self._step0: int | None = None
+        self._next_progress = 0.0
+
+    def _write_progress(self) -> None:
+        now = time.monotonic()
+        if self._step0 is None:
+            self._step0 = self.num_timesteps
+        elapsed = now - self._t0
+        rate = (self.num_timesteps - self._step0) / elapsed if elapsed > 0 else 0.0
+        write_progress(
+            self.trainer.run_dir,
+            "train",
+            step=int(self.num_timesteps),
+            total=int(self.trainer.cfg.train.total_timesteps),
+            rate_steps_per_s=round(rate, 2),
+        )
+        self._next_progress = now + PROGRESS_EVERY_S
+
+    def _on_training_start(self) -> None:
+        self._t0 = time.monotonic()
+        self._step0 = self.num_timesteps
+        self._write_progress()
+
+    def _on_training_end(self) -> None:
+        self._write_progress()
 
     def _on_rollout_start(self) -> None:
         self.trainer.save_checkpoint()
 
     def _on_step(self) -> bool:
+        if time.monotonic() >= self._next_progress:
+            self._write_progress()
         trainer = self.trainer
         trainer.record_actions(self.locals["actions"])
         if self.num_timesteps < trainer.next_eval:
@@ -734,7 +782,7 @@ def _check_same_config(run_dir: Path, cfg: ExperimentConfig, seed: int) -> None:
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(
-        prog="python -m sumo_ayss.train", description=__doc__.splitlines()[0]
+        prog=prog("python -m sumo_ayss.train"), description=__doc__.splitlines()[0]
     )
     parser.add_argument("--config", type=Path, default=None, help="experiment YAML")
     parser.add_argument("--vut", default=None, help="VUT name (overrides env.vut)")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 import os
 import signal
 import subprocess
@@ -146,3 +147,29 @@ def test_pipeline_vuts_report_and_known_order_sections(tmp_path: Path) -> None:
 def test_bad_pipeline_sections_are_refused(tmp_path: Path, extra: dict, match: str) -> None:
     with pytest.raises(ConfigError, match=match):
         load_pipeline(write_configs(tmp_path, [0], **extra))
+
+
+@pytest.mark.sumo
+def test_progress_is_logged_per_job_event_and_small_budget_is_flagged(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    from sumo_ayss.pipeline import final_messages
+
+    cfg = load_pipeline(write_configs(tmp_path, [0]))  # 2 jobs, 1 worker
+    with caplog.at_level(logging.INFO, logger="sumo_ayss.pipeline"):
+        statuses, report = run_pipeline(cfg, live=True)  # not a terminal: log lines only
+    lines = [r.getMessage() for r in caplog.records if r.name == "sumo_ayss.pipeline"]
+    first = statuses[0].spec.name
+    assert any(
+        "0/2 done, 1 running, 1 queued, 0 failed" in x and f"{first}: started" in x for x in lines
+    )  # only the job a worker holds is running
+    candidates = [x for x in lines if f"{first}: SPCP candidate at step" in x]
+    assert len(candidates) == 2  # 600 steps, a candidate every 300: both, each once
+    done = [x for x in lines if ": done in " in x]
+    assert len(done) == 2 and "1/2 done, 0 running, 1 queued" in done[0]
+    assert "training" in done[0] and " s, evaluation " in done[0]
+    messages = final_messages(statuses, report)
+    assert messages[0].startswith("WARNING: Small training budget: 600 transitions per run")
+    assert messages[-1] == f"report: {report}"
+    for written in (cfg.out / "pipeline.json", report, report.with_name("summary.md")):
+        assert str(tmp_path) not in written.read_text(), written  # no machine paths

@@ -14,6 +14,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from sumo_ayss.cli import prog
 from sumo_ayss.config import check_out_dir
 from sumo_ayss.errors import AyssError
 from sumo_ayss.report.document import DEFAULT_TITLE, ReportOptions, write_report
@@ -23,7 +24,7 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     """Parses the command line."""
     defaults = ReportOptions()
     parser = argparse.ArgumentParser(
-        prog="python -m sumo_ayss.report",
+        prog=prog("python -m sumo_ayss.report"),
         description="Write the AYSS safety report (HTML + Markdown + PNGs) from run folders.",
     )
     parser.add_argument(

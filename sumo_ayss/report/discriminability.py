@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -120,8 +121,17 @@ def _pct(x: float | None) -> str:
     return "—" if x is None or not math.isfinite(x) else f"{100 * x:.1f}"
 
 
-def _command(config: Path | str, vuts: Sequence[str], case_dir: Path) -> str:
-    return f"python -m sumo_ayss.discriminability {config} --vuts {' '.join(vuts)} --out {case_dir}"
+def _rel(path: Path, base: Path) -> str:
+    """``path`` relative to ``base`` (the report folder): reports carry no machine paths."""
+    return Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()
+
+
+def _command(config: Path | str, vuts: Sequence[str], case_dir: Path, out_dir: Path) -> str:
+    config = _rel(config, out_dir) if isinstance(config, Path) else config
+    return (
+        f"python -m sumo_ayss.discriminability {config} --vuts {' '.join(vuts)} "
+        f"--out {_rel(case_dir, out_dir)}"
+    )
 
 
 def discriminability_blocks(
@@ -157,7 +167,7 @@ def discriminability_blocks(
             and len(set(rec["vuts"]) & set(vuts)) >= 2
             and rec.get("case", case) == case
         ):
-            record, where = rec, d / RECORD_NAME
+            record, where = rec, _rel(d / RECORD_NAME, out_dir)
             break
     if record is None:
         target = case_dirs[0] if case_dirs else Path(f"<out>/{case}")
@@ -167,8 +177,8 @@ def discriminability_blocks(
             heading,
             Paragraph(
                 "Not computed for these VUTs (no discriminability.json beside the runs; "
-                "the pipeline writes one). Make it with: "
-                f"{_command(config, vuts, target)}"
+                "the pipeline writes one). Make it with (paths relative to this report's "
+                f"folder): {_command(config, vuts, target, out_dir)}"
             ),
         ]
     missing = sorted(set(vuts) - set(record["vuts"]))

@@ -28,6 +28,7 @@ import html
 import itertools
 import logging
 import math
+import os
 import zlib
 from collections import Counter
 from collections.abc import Mapping, Sequence
@@ -56,6 +57,7 @@ from sumo_ayss.analysis.seeds import (
 )
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.report import figures
+from sumo_ayss.report.checks import NOISE_SE, TRUSTED_TIMESTEPS, mixing_problems, trust_warnings
 from sumo_ayss.report.discriminability import discriminability_blocks
 from sumo_ayss.report.figures import CaseInfo, case_info
 from sumo_ayss.report.load import (
@@ -826,12 +828,23 @@ def _learning_blocks(a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path) 
             step = f"{run.spcp.step:,}" if run.spcp is not None else "—"
             score = _num(run.spcp.score, 3) if run.spcp is not None else "—"
             crit = run.spcp.criterion if run.spcp is not None and run.spcp.criterion else "—"
-            rows.append((vut, str(run.seed), n_cand, step, score, crit, str(run.path)))
+            rows.append(
+                (
+                    vut,
+                    str(run.seed),
+                    n_cand,
+                    step,
+                    score,
+                    crit,
+                    run.training.status,
+                    _display_path(run.path, out_dir),
+                )
+            )
     table = Table(
         "SPCP selection: the candidate with the best score on the fixed evaluation scenarios",
-        ("VUT", "seed", "candidates", "SPCP step", "score", "criterion", "run folder"),
+        ("VUT", "seed", "candidates", "SPCP step", "score", "criterion", "SPCP", "run folder"),
         tuple(rows),
-        (False, True, True, True, True, False, False),
+        (False, True, True, True, True, False, False, False),
     )
     caption = (
         "Mean evaluation episode reward of every SPCP candidate vs training steps; one colour "
@@ -1085,8 +1098,54 @@ def _ranking_blocks(
 # --------------------------------------------------------------------------- whole report
 
 
+def _display_path(path: Path, base: Path) -> str:
+    """``path`` relative to ``base`` (the report folder), so reports carry no machine paths."""
+    return Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()
+
+
+def _training_table(runs: Sequence[Run]) -> Table:
+    rows = []
+    for r in runs:
+        t = r.training
+        rows.append(
+            (
+                r.case,
+                r.label,
+                "?" if t.total_timesteps is None else f"{t.total_timesteps:,}",
+                "?" if t.eval_every is None else f"{t.eval_every:,}",
+                str(t.n_candidates),
+                "?" if t.spcp_step is None else f"{t.spcp_step:,}",
+                "?" if t.last_step is None else f"{t.last_step:,}",
+                t.status,
+            )
+        )
+    return Table(
+        "Training budget and SPCP per run",
+        (
+            "case",
+            "run",
+            "total_timesteps",
+            "eval_every",
+            "candidates",
+            "SPCP step",
+            "last candidate step",
+            "SPCP",
+        ),
+        tuple(rows),
+        (False, False, True, True, True, True, True, False),
+        note=(
+            "Budgets in training transitions. SPCP: 'may still improve' when it is the last "
+            "candidate; 'plateau' when the last candidate's mean evaluation reward is within "
+            f"{NOISE_SE:g} standard errors (SE, the SPCP's std / sqrt(episodes)) of the "
+            "SPCP's; 'peaked' when it is further below. Below "
+            f"{TRUSTED_TIMESTEPS:,} transitions (the shipped experiments' budget) verdicts "
+            "are not to be trusted."
+        ),
+    )
+
+
 def _inputs_blocks(
-    runs: Sequence[Run], groups: Mapping[str, Mapping[str, list[Run]]]
+    runs: Sequence[Run], groups: Mapping[str, Mapping[str, list[Run]]], out_dir: Path
 ) -> list[Block]:
     blocks: list[Block] = [Heading("Inputs", 2, "inputs")]
     rows = []
@@ -1105,7 +1164,13 @@ def _inputs_blocks(
             (False, False, False, True, False, True),
         )
     )
-    blocks.append(BulletList(tuple(str(r.path) for r in runs), f"Run folders used ({len(runs)})"))
+    blocks.append(_training_table(runs))
+    blocks.append(
+        BulletList(
+            tuple(_display_path(r.path, out_dir) for r in runs),
+            f"Run folders used ({len(runs)}, relative to this report's folder)",
+        )
+    )
     versions: dict[str, Counter[str]] = {}
     for run in runs:
         for key, value in run.versions.items():
@@ -1156,8 +1221,17 @@ def build_report(
         f"{case}: " + ", ".join(f"{vut} × {len(m)}" for vut, m in by_vut.items())
         for case, by_vut in groups.items()
     )
-    subtitle = f"Generated {now} from {len(runs)} run folders ({n_seeds or 'none'})."
-    blocks: list[Block] = [Heading("Verdicts", 2, "verdicts")]
+    budgets = sorted({r.training.total_timesteps or 0 for r in runs})
+    budget = ", ".join(f"{b:,}" if b else "unknown" for b in budgets)
+    subtitle = (
+        f"Generated {now} from {len(runs)} run folders ({n_seeds or 'none'}); training budget "
+        f"{budget or 'none'} transitions per run."
+    )
+    blocks: list[Block] = []
+    warnings = trust_warnings([(f"{r.case} {r.label}", r.training) for r in runs])
+    if warnings:
+        blocks.append(Callout("Read the verdicts with care", tuple(warnings), "warning"))
+    blocks.append(Heading("Verdicts", 2, "verdicts"))
     if not analyses:
         blocks.append(Callout("No runs", ("No run folder was found.",), "warning"))
     for a in analyses:
@@ -1175,7 +1249,7 @@ def build_report(
             "SPCP: harder braking (car-following) or a smaller Δv̄ (cut-in) at the same headway."
         )
     )
-    blocks += _inputs_blocks(runs, groups)
+    blocks += _inputs_blocks(runs, groups, out_dir)
     for a in analyses:
         blocks += _case_blocks(a, colors, out_dir, options)
     return Report(title, subtitle, tuple(blocks))
@@ -1210,6 +1284,16 @@ def write_report(
         raise ConfigError(f"no run folder (with {RUN_FILES.config}) under {list(map(str, paths))}")
     target = Path(out_dir) if out_dir is not None else Path(paths[0]) / "report"
     runs = [load_run(d) for d in run_dirs]
+    problems = mixing_problems(
+        [(r.case, r.vut, r.seed, _display_path(r.path, Path.cwd()), r.training) for r in runs]
+    )
+    if problems:
+        raise ConfigError(
+            "these runs must not be pooled into one report (report each group separately, "
+            "e.g. one pipeline output folder at a time):\n  " + "\n  ".join(problems)
+        )
+    for warning in trust_warnings([(f"{r.case} {r.label}", r.training) for r in runs]):
+        logger.warning("%s", warning)
     report = build_report(runs, target, title=title, options=options)
     html_path = target / HTML_NAME
     from sumo_ayss.atomic import atomic_write_text

@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 
 from sumo_ayss.config import RewardConfig, build, safe_load_yaml
 from sumo_ayss.errors import ConfigError
+from sumo_ayss.report.checks import Training, read_training
 
 __all__ = [
     "AYSS_COLUMNS",
@@ -301,6 +302,7 @@ class Run:
         outcome: The outcome summary, or None.
         ayss: The AYSS samples, or None.
         versions: Package versions the run used (``versions.json``), or empty.
+        training: Training budget and SPCP state (:func:`~sumo_ayss.report.checks.read_training`).
         problems: One sentence per missing or unreadable file.
     """
 
@@ -315,6 +317,7 @@ class Run:
     outcome: Outcome | None = None
     ayss: AyssSamples | None = None
     versions: dict[str, str] = field(default_factory=dict)
+    training: Training = field(default_factory=Training)
     problems: list[str] = field(default_factory=list)
 
     @property
@@ -638,6 +641,7 @@ def load_run(path: str | Path) -> Run:
         except (OSError, ValueError) as exc:
             run.problems.append(f"{RUN_FILES.versions} unreadable ({exc})")
     _check_ayss(run)
+    run.training = read_training(run_dir)
     return run
 
 

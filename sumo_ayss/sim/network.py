@@ -131,7 +131,11 @@ def build_parallel_network(n_roads: int, lanes: int, out_dir: Path) -> Path:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    from sumo_ayss.cli import prog
+
+    parser = argparse.ArgumentParser(
+        prog=prog("python -m sumo_ayss.sim.network"), description=__doc__.splitlines()[0]
+    )
     parser.add_argument("--out-dir", type=Path, default=None, help="default: networks/")
     args = parser.parse_args(argv)
     for stem in sorted(set(NETWORK_OF_CASE.values())):

@@ -1,0 +1,316 @@
+"""Progress of a pipeline grid that a person can follow: per-job state, steps, rate, ETA.
+
+The main process never talks to its workers about progress: it reads what each job writes
+into its run folder. The trainer rewrites ``progress.json`` atomically every few seconds
+(:func:`sumo_ayss.train.write_progress`: stage, step, total, rate); ``checkpoints/
+latest.json`` names the last candidate; ``spcp.json`` and ``evaluate.done.json`` mark the
+finished stages. From these :class:`GridProgress` makes
+
+- one log line per job event (started, each new SPCP candidate, training finished,
+  evaluation finished, failed, retried), each prefixed with the grid's counts and ETA, for
+  ``--no-live`` runs and logs;
+- a table for a live terminal display (jobs queued / running / done / failed, stage, steps,
+  rate in steps/s, tries, wall time in s) with the grid's ETA in its title.
+
+Imports neither SUMO nor torch.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import statistics
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+PROGRESS_FILE = "progress.json"
+"""Written by :func:`sumo_ayss.train.write_progress` (same name; not imported: torch)."""
+
+STATES = ("queued", "running", "done", "failed", "interrupted", "cancelled")
+
+
+class _Spec(Protocol):
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def run_dir(self) -> Path: ...
+
+    experiment: dict[str, Any]
+
+
+@dataclass
+class JobStatus:
+    """What the pipeline knows about one job.
+
+    Attributes:
+        spec: The job (:class:`sumo_ayss.pipeline.JobSpec`).
+        state: One of :data:`STATES`; ``running`` only while a worker holds the job;
+            ``interrupted`` / ``cancelled`` after a Ctrl-C (running / still queued then).
+        attempts: Tries started so far.
+        error: The last failure, one line.
+        wall_s: Wall time of the finished try, s.
+        started_at: ``time.time()`` when the current try was handed to a worker, s.
+        stage: ``train``, ``evaluate`` or ``done`` while running / when done; "" before.
+        step: Training transitions done (last seen).
+        total: Training transitions asked for (``train.total_timesteps``).
+        rate_steps_per_s: Last training rate seen, transitions per s of wall time.
+        candidate_step: Step of the last SPCP candidate seen (``latest.json``), for events.
+        train_s: Wall time of the training stage of the finished try, s (None: unknown).
+        evaluate_s: Wall time of the evaluation stage of the finished try, s.
+        stages: What the finished try did per stage (``done``, ``resumed``, ``skipped``).
+        step_at_start: Training transitions already done when the current try began.
+    """
+
+    spec: Any
+    state: str = "queued"
+    attempts: int = 0
+    error: str = ""
+    wall_s: float = 0.0
+    started_at: float | None = None
+    stage: str = ""
+    step: int = 0
+    total: int = 0
+    rate_steps_per_s: float | None = None
+    candidate_step: int | None = None
+    train_s: float | None = None
+    evaluate_s: float | None = None
+    stages: dict[str, str] = field(default_factory=dict)
+    step_at_start: int = 0
+
+    def __post_init__(self) -> None:
+        self.total = int(self.spec.experiment["train"]["total_timesteps"])
+        self.step = _finished_steps(self.spec.run_dir, self.total)
+
+    def start(self) -> None:
+        """A worker takes the job: a new try begins (candidates found now are not events)."""
+        self.attempts += 1
+        self.state, self.stage, self.started_at = "running", "", time.time()
+        self.step_at_start = self.step = _finished_steps(self.spec.run_dir, self.total)
+        found = _candidates(self.spec.run_dir)
+        self.candidate_step = found[-1][0] if found else None
+
+
+def _read_json(path: Path) -> dict[str, Any] | None:
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
+
+
+def _finished_steps(run_dir: Path, total: int) -> int:
+    """Training transitions already in ``run_dir`` from an earlier invocation."""
+    if (run_dir / "spcp.json").is_file():
+        return total
+    latest = _read_json(run_dir / "checkpoints" / "latest.json")
+    return int(latest["step"]) if latest and "step" in latest else 0
+
+
+def _candidates(run_dir: Path) -> list[tuple[int, str]]:
+    """(step, mean evaluation reward as written) of each SPCP candidate in ``eval.csv``."""
+    try:
+        with (run_dir / "eval.csv").open(newline="") as f:
+            rows = list(csv.DictReader(f))
+    except (OSError, csv.Error):
+        return []
+    out = []
+    for row in rows:
+        try:
+            out.append((int(row["step"]), f"{float(row['mean_return']):.2f}"))
+        except (KeyError, TypeError, ValueError):
+            continue
+    return out
+
+
+def format_duration(seconds: float) -> str:
+    """``"45 s"``, ``"12 min"``, ``"1 h 05 min"``."""
+    if not math.isfinite(seconds):
+        return "?"
+    seconds = max(0.0, seconds)
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    minutes = round(seconds / 60)
+    if minutes < 60:
+        return f"{minutes} min"
+    return f"{minutes // 60} h {minutes % 60:02d} min"
+
+
+class GridProgress:
+    """Watches the run folders of a grid's jobs; see the module docstring.
+
+    Args:
+        statuses: The grid's jobs (the pipeline updates ``state``, ``attempts``,
+            ``started_at``, ``wall_s`` and the stage times; :meth:`poll` the rest).
+        workers: Worker processes, for the ETA.
+    """
+
+    def __init__(self, statuses: Sequence[JobStatus], workers: int) -> None:
+        self.statuses = list(statuses)
+        self.workers = max(1, workers)
+        self.t0 = time.time()
+
+    def finished(self, s: JobStatus, result: dict[str, Any]) -> str:
+        """Record a finished try (``result``: :func:`sumo_ayss.pipeline.run_job`'s); event."""
+        s.state, s.stage = "done", "done"
+        s.wall_s, s.stages = float(result["wall_s"]), dict(result["stages"])
+        s.train_s, s.evaluate_s = result.get("train_s"), result.get("evaluate_s")
+        trained = s.total - s.step_at_start
+        if s.stages.get("train") != "skipped" and s.train_s and trained > 0:
+            s.rate_steps_per_s = trained / s.train_s
+        s.step = s.total
+        what = ", ".join(f"{k} {v}" for k, v in s.stages.items())
+        times = ""
+        if s.train_s is not None and s.evaluate_s is not None:
+            times = f"; training {s.train_s:.0f} s, evaluation {s.evaluate_s:.0f} s"
+        return self.line(s, f"done in {s.wall_s:.0f} s ({what}{times})")
+
+    # -- reading the run folders ------------------------------------------------------
+
+    def poll(self) -> list[str]:
+        """Refresh the running jobs from their run folders; return new event lines."""
+        events = []
+        for s in self.statuses:
+            if s.state != "running":
+                continue
+            run_dir = s.spec.run_dir
+            progress = _read_json(run_dir / PROGRESS_FILE)
+            if progress and float(progress.get("time", 0)) < (s.started_at or 0) - 1:
+                progress = None  # left by an earlier invocation
+            rate = progress.get("rate_steps_per_s") if progress else None
+            at = f" ({rate:.0f} steps/s)" if isinstance(rate, int | float) and rate > 0 else ""
+            for step, reward in _candidates(run_dir):
+                if s.candidate_step is None or step > s.candidate_step:
+                    text = f"SPCP candidate at step {step:,}/{s.total:,}{at}"
+                    events.append(self.line(s, f"{text}: mean evaluation reward {reward}"))
+                    s.candidate_step = step
+            if progress:
+                stage = str(progress.get("stage", ""))
+                if stage == "train":
+                    s.step = int(progress.get("step", s.step))
+                    rate = progress.get("rate_steps_per_s")
+                    if isinstance(rate, int | float) and rate > 0:
+                        s.rate_steps_per_s = float(rate)
+                if stage and stage != s.stage:
+                    if stage == "evaluate":
+                        s.step = s.total if (run_dir / "spcp.json").is_file() else s.step
+                        events.append(self.line(s, "training finished; evaluating"))
+                    s.stage = stage
+        return events
+
+    # -- numbers ----------------------------------------------------------------------
+
+    def counts(self) -> dict[str, int]:
+        out = dict.fromkeys(STATES, 0)
+        for s in self.statuses:
+            out[s.state] = out.get(s.state, 0) + 1
+        return out
+
+    def job_rate(self) -> float | None:
+        """Typical training rate of one job, transitions/s (median of those seen)."""
+        rates = [s.rate_steps_per_s for s in self.statuses if s.rate_steps_per_s]
+        return statistics.median(rates) if rates else None
+
+    def eta_s(self) -> tuple[float | None, bool]:
+        """Seconds until the grid is done, and whether evaluation time is included.
+
+        Remaining training transitions of unfinished jobs at the typical per-job rate, plus
+        one evaluation per job that has not finished (the mean of the finished ones' when
+        known), spread over ``min(workers, unfinished jobs)`` workers. None before any rate
+        is known. A rough estimate: jobs of different cases train at different rates.
+        """
+        todo = [s for s in self.statuses if s.state in ("queued", "running")]
+        if not todo:
+            return 0.0, True
+        steps = sum(max(0, s.total - s.step) for s in todo)
+        rate = self.job_rate()
+        if rate is None and steps > 0:
+            return None, False
+        train = steps / rate if steps > 0 and rate else 0.0
+        evals = [s.evaluate_s for s in self.statuses if s.evaluate_s is not None]
+        with_eval = bool(evals)
+        work = train + (statistics.mean(evals) * len(todo) if evals else 0.0)
+        return work / min(self.workers, len(todo)), with_eval
+
+    def eta_text(self) -> str:
+        eta, with_eval = self.eta_s()
+        if eta is None:
+            return "ETA: after the first rate is measured"
+        text = f"ETA ≈ {format_duration(eta)}"
+        return text if with_eval else text + " + evaluation"
+
+    def header(self) -> str:
+        """``"2/8 done, 2 running, 4 queued, 0 failed; 3 min elapsed; ETA ≈ 9 min"``."""
+        c = self.counts()
+        elapsed = format_duration(time.time() - self.t0)
+        return (
+            f"{c['done']}/{len(self.statuses)} done, {c['running']} running, "
+            f"{c['queued']} queued, {c['failed']} failed; {elapsed} elapsed; {self.eta_text()}"
+        )
+
+    def line(self, s: JobStatus, event: str) -> str:
+        """One log line for an event of job ``s``."""
+        return f"[{self.header()}] {s.spec.name}: {event}"
+
+    def progress_text(self, s: JobStatus) -> str:
+        if s.state == "done":
+            return f"{s.total:,}/{s.total:,}"
+        if s.total and (s.step or s.state == "running"):
+            return f"{s.step:,}/{s.total:,} ({100 * s.step / s.total:.0f} %)"
+        return ""
+
+    # -- live table -------------------------------------------------------------------
+
+    def table(self) -> Any:
+        """A rich table of every job (headers escaped: rich reads ``[s]`` as markup)."""
+        from rich.markup import escape
+        from rich.table import Table
+
+        table = Table(title=escape(f"sumo_ayss pipeline: {self.header()}"), expand=False)
+        for col, right in (
+            ("job", False),
+            ("state", False),
+            ("stage", False),
+            ("training steps", True),
+            ("rate [steps/s]", True),
+            ("tries", True),
+            ("wall [s]", True),
+        ):
+            table.add_column(
+                escape(col),
+                justify="right" if right else "left",
+                no_wrap=col == "job",
+                min_width=max((len(s.spec.name) for s in self.statuses), default=0)
+                if col == "job"
+                else None,
+            )
+        colours = {
+            "done": "green",
+            "failed": "red",
+            "running": "yellow",
+            "queued": "white",
+            "interrupted": "red",
+            "cancelled": "red",
+        }
+        now = time.time()
+        for s in self.statuses:
+            colour = colours.get(s.state, "white")
+            if s.state == "running" and s.started_at is not None:
+                wall = f"{now - s.started_at:.0f}"
+            else:
+                wall = f"{s.wall_s:.0f}" if s.wall_s else ""
+            rate = f"{s.rate_steps_per_s:.0f}" if s.rate_steps_per_s else ""
+            table.add_row(
+                escape(s.spec.name),
+                f"[{colour}]{s.state}[/{colour}]",
+                escape(s.stage if s.state == "running" else ""),
+                self.progress_text(s),
+                rate if s.state in ("running", "done") else "",
+                str(s.attempts),
+                wall,
+            )
+        return table

@@ -1,0 +1,225 @@
+"""Checks that keep a report from misleading: training budget, SPCP still improving, mixed runs.
+
+Read from the light files of a run folder only (``config.yaml``, ``eval.csv``,
+``spcp.json``), so the pipeline can print the same warnings as the report without loading
+the AYSS tables.
+
+- :func:`read_training` — a run's budget (``train.total_timesteps``, ``train.eval_every``)
+  and the state of its learning curve at the end: the SPCP is the last candidate (the curve
+  was still at its best when training stopped: it may still be improving), the last
+  candidate's mean evaluation reward is within :data:`NOISE_SE` standard errors of the
+  SPCP's (a plateau: the SPCP is one of several candidates equal within noise), or it is
+  clearly below (the curve peaked earlier).
+- :func:`trust_warnings` — sentences for the top of a report (and the terminal) when the
+  budget is below :data:`TRUSTED_TIMESTEPS` or SPCPs may still be improving.
+- :func:`mixing_problems` — runs that must not be pooled: the same (case, VUT, seed) twice,
+  or runs of one case whose configurations differ other than by VUT and seed.
+
+Imports neither SUMO nor torch.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import hashlib
+import json
+import math
+from collections import defaultdict
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+TRUSTED_TIMESTEPS = 100_000
+"""Training transitions per run below which verdicts are flagged as not to be trusted: the
+budget of the shipped experiments (``configs/car_following.yaml``, ``configs/cut_in.yaml``),
+by which car-following SPCPs mostly plateau (README, learning curves)."""
+
+NOISE_SE = 2.0
+"""The last candidate counts as "within noise" of the SPCP when its mean evaluation reward
+is less than this many standard errors (SPCP's ``std_return / sqrt(n_episodes)``) lower."""
+
+_IGNORED_KEYS = (("seed",), ("vut",), ("env", "vut"), ("env", "vuts"), ("train", "progress_bar"))
+"""Config entries that may differ between runs pooled in one report: the run's own VUT and
+seed, the VUT catalog (a leaderboard adds VUTs), and display-only settings."""
+
+
+@dataclass(frozen=True)
+class Training:
+    """A run's training budget and the state of its SPCP.
+
+    Attributes:
+        total_timesteps: ``train.total_timesteps`` (transitions), None if unknown.
+        eval_every: ``train.eval_every`` (transitions between candidates), None if unknown.
+        config_key: Hash of the configuration without :data:`_IGNORED_KEYS`, "" if unknown.
+        n_candidates: Rows of ``eval.csv``.
+        spcp_step: The SPCP's training step, None if unknown.
+        last_step: The last candidate's training step, None if no candidate.
+        gap_se: (SPCP reward − last candidate's reward) / SPCP's standard error; NaN if
+            unknown.
+        still_improving: True when the SPCP is the last candidate; None when unknown.
+    """
+
+    total_timesteps: int | None = None
+    eval_every: int | None = None
+    config_key: str = ""
+    n_candidates: int = 0
+    spcp_step: int | None = None
+    last_step: int | None = None
+    gap_se: float = math.nan
+    still_improving: bool | None = None
+
+    @property
+    def status(self) -> str:
+        """One phrase for a table cell."""
+        if self.still_improving is None:
+            return "unknown"
+        if self.still_improving:
+            return "may still improve: SPCP is the last candidate"
+        if self.gap_se < NOISE_SE:
+            return f"plateau: last candidate within {self.gap_se:.1f} SE of the SPCP"
+        return f"peaked: last candidate {self.gap_se:.1f} SE below the SPCP"
+
+
+def _drop(data: dict[str, Any], key: tuple[str, ...]) -> None:
+    node: Any = data
+    for part in key[:-1]:
+        node = node.get(part) if isinstance(node, Mapping) else None
+    if isinstance(node, dict):
+        node.pop(key[-1], None)
+
+
+def config_key(config: Mapping[str, Any]) -> str:
+    """A short hash of a resolved ``config.yaml`` without the VUT, seed and catalog."""
+    data = json.loads(json.dumps(config, default=str))
+    for key in _IGNORED_KEYS:
+        _drop(data, key)
+    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:12]
+
+
+def _int_or_none(value: Any) -> int | None:
+    return int(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
+
+
+def read_training(run_dir: Path) -> Training:
+    """The :class:`Training` of ``run_dir``; unreadable files leave fields unknown."""
+    total = every = None
+    key = ""
+    try:
+        config = yaml.safe_load((run_dir / "config.yaml").read_text()) or {}
+        train = config.get("train") or {}
+        total, every = (
+            _int_or_none(train.get("total_timesteps")),
+            _int_or_none(train.get("eval_every")),
+        )
+        key = config_key(config)
+    except (OSError, ValueError, AttributeError, yaml.YAMLError):
+        pass
+    rows: list[dict[str, float]] = []
+    try:
+        with (run_dir / "eval.csv").open(newline="") as f:
+            for row in csv.DictReader(f):
+                try:
+                    rows.append(
+                        {
+                            k: float(row.get(k) or "nan")
+                            for k in ("step", "mean_return", "std_return", "n_episodes")
+                        }
+                    )
+                except ValueError:
+                    continue
+    except OSError:
+        pass
+    rows.sort(key=lambda r: r["step"])
+    spcp_step = None
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        spcp_step = _int_or_none(json.loads((run_dir / "spcp.json").read_text()).get("step"))
+    if not rows or spcp_step is None:
+        return Training(total, every, key, len(rows), spcp_step)
+    last = rows[-1]
+    spcp = next((r for r in rows if int(r["step"]) == spcp_step), None)
+    gap = math.nan
+    if spcp is not None:
+        se = spcp["std_return"] / math.sqrt(spcp["n_episodes"]) if spcp["n_episodes"] > 0 else 0
+        diff = spcp["mean_return"] - last["mean_return"]
+        gap = diff / se if se > 0 else (0.0 if diff == 0 else math.inf)
+    improving = int(last["step"]) == spcp_step
+    return Training(total, every, key, len(rows), spcp_step, int(last["step"]), gap, improving)
+
+
+def trust_warnings(runs: Sequence[tuple[str, Training]]) -> list[str]:
+    """Sentences that say why verdicts built on ``runs`` (``(label, training)``) are weak.
+
+    Empty when every run trained at least :data:`TRUSTED_TIMESTEPS` transitions and every
+    SPCP has peaked.
+    """
+    out = []
+    budgets_known = {t.total_timesteps for _, t in runs if t.total_timesteps is not None}
+    small = sorted(b for b in budgets_known if b < TRUSTED_TIMESTEPS)
+    if small:
+        budgets = ", ".join(f"{b:,}" for b in small)
+        out.append(
+            f"Small training budget: {budgets} transitions per run, below the "
+            f"{TRUSTED_TIMESTEPS:,} of the shipped experiments. The SPCPs are undertrained; "
+            "the verdicts and rankings below are NOT to be trusted (a demonstration of the "
+            "machinery, not a result)."
+        )
+    unknown = [label for label, t in runs if t.total_timesteps is None]
+    if unknown:
+        out.append(
+            f"Training budget unknown (no readable train.total_timesteps in config.yaml) for "
+            f"{len(unknown)} of {len(runs)} runs: " + ", ".join(unknown) + "."
+        )
+    improving = [label for label, t in runs if t.still_improving]
+    if improving:
+        out.append(
+            f"{len(improving)} of {len(runs)} SPCPs may still be improving (the SPCP is the "
+            "last candidate: the learning curve was at its best when training stopped); more "
+            "training could change them and the verdicts. Runs: " + ", ".join(improving) + "."
+        )
+    return out
+
+
+def mixing_problems(
+    runs: Sequence[tuple[str, str, int | None, str | Path, Training]],
+) -> list[str]:
+    """Sentences naming runs that must not be pooled into one report.
+
+    Args:
+        runs: ``(case, vut, seed, path, training)`` per run.
+
+    Returns:
+        One sentence per duplicate (case, VUT, seed) and per case whose runs have different
+        budgets or configurations (besides VUT and seed); empty when the runs can be pooled.
+    """
+    out = []
+    by_key: dict[tuple[str, str, int | None], list[str | Path]] = defaultdict(list)
+    for case, vut, seed, path, _ in runs:
+        by_key[(case, vut, seed)].append(path)
+    for (case, vut, seed), paths in by_key.items():
+        if len(paths) > 1:
+            out.append(
+                f"{case} {vut} seed {seed} appears {len(paths)} times: "
+                + ", ".join(str(p) for p in paths)
+            )
+    by_case: dict[str, dict[tuple[int | None, int | None, str], list[str | Path]]] = defaultdict(
+        lambda: defaultdict(list)
+    )
+    for case, _, _, path, t in runs:
+        by_case[case][(t.total_timesteps, t.eval_every, t.config_key)].append(path)
+    for case, groups in by_case.items():
+        if len(groups) < 2:
+            continue
+        parts = []
+        for (total, every, key), paths in groups.items():
+            parts.append(
+                f"total_timesteps={total}, eval_every={every}, config {key or '?'}: "
+                + ", ".join(str(p) for p in paths)
+            )
+        out.append(
+            f"{case}: runs with different training budgets or configurations — " + "; ".join(parts)
+        )
+    return out

@@ -1,0 +1,142 @@
+"""Grid progress read from run folders: events, rates, ETA and a table whose units survive."""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from sumo_ayss.progress import PROGRESS_FILE, GridProgress, JobStatus, format_duration
+
+
+@dataclass(frozen=True)
+class Spec:
+    name: str
+    run_dir: Path
+    experiment: dict[str, Any] = field(
+        default_factory=lambda: {"train": {"total_timesteps": 10_000}}
+    )
+
+
+def _write(path: Path, data: dict[str, Any]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(data))
+
+
+def _grid(tmp_path: Path, n: int) -> list[JobStatus]:
+    return [
+        JobStatus(Spec(f"car_following/pi1/seed_{k}", tmp_path / f"seed_{k}")) for k in range(n)
+    ]
+
+
+def test_events_from_run_folder_files(tmp_path: Path) -> None:
+    statuses = _grid(tmp_path, 3)
+    progress = GridProgress(statuses, workers=2)
+    job = statuses[0]
+    job.start()
+    assert progress.poll() == []
+    job.spec.run_dir.mkdir(parents=True)
+    (job.spec.run_dir / "eval.csv").write_text("step,mean_return\n5000,11.8312\n")
+    _write(
+        job.spec.run_dir / PROGRESS_FILE,
+        {
+            "stage": "train",
+            "time": time.time(),
+            "step": 5200,
+            "total": 10_000,
+            "rate_steps_per_s": 100.0,
+        },
+    )
+    events = progress.poll()
+    assert len(events) == 1 and events[0].endswith(
+        "seed_0: SPCP candidate at step 5,000/10,000 (100 steps/s): mean evaluation reward 11.83"
+    )
+    assert "0/3 done, 1 running, 2 queued, 0 failed" in events[0]
+    assert (job.step, job.rate_steps_per_s) == (5200, 100.0)
+    _write(job.spec.run_dir / PROGRESS_FILE, {"stage": "evaluate", "time": time.time()})
+    (job.spec.run_dir / "spcp.json").write_text("{}")
+    assert progress.poll()[0].endswith("training finished; evaluating")
+    assert progress.poll() == []  # each event once
+
+
+def test_stale_progress_file_of_an_earlier_invocation_is_ignored(tmp_path: Path) -> None:
+    [job] = _grid(tmp_path, 1)
+    _write(
+        job.spec.run_dir / PROGRESS_FILE,
+        {"stage": "train", "time": 0.0, "step": 9000, "rate_steps_per_s": 1.0},
+    )
+    job.start()
+    GridProgress([job], 1).poll()
+    assert job.step == 0 and job.rate_steps_per_s is None
+
+
+def test_eta_spreads_remaining_steps_and_evaluations_over_workers(tmp_path: Path) -> None:
+    statuses = _grid(tmp_path, 4)
+    progress = GridProgress(statuses, workers=2)
+    assert progress.eta_s() == (None, False)
+    done = statuses[0]
+    done.start()
+    msg = progress.finished(
+        done,
+        {
+            "wall_s": 120.0,
+            "stages": {"train": "done", "evaluate": "done"},
+            "train_s": 100.0,
+            "evaluate_s": 20.0,
+        },
+    )
+    assert "done in 120 s (train done, evaluate done; training 100 s, evaluation 20 s)" in msg
+    assert done.rate_steps_per_s == pytest.approx(100.0)  # 10,000 steps in 100 s
+    running = statuses[1]
+    running.start()
+    running.step = 5000
+    # remaining: 5,000 + 2 × 10,000 steps at 100 steps/s = 250 s, + 3 evaluations × 20 s,
+    # over 2 workers
+    eta, with_eval = progress.eta_s()
+    assert with_eval and eta == pytest.approx((250 + 60) / 2)
+    assert progress.eta_text() == "ETA ≈ 3 min"  # 155 s
+
+
+def test_only_started_jobs_are_running_and_table_keeps_units(tmp_path: Path) -> None:
+    from rich.console import Console
+
+    statuses = _grid(tmp_path, 3)
+    statuses[0].start()
+    progress = GridProgress(statuses, workers=1)
+    counts = progress.counts()
+    assert counts == {
+        "queued": 2,
+        "running": 1,
+        "done": 0,
+        "failed": 0,
+        "interrupted": 0,
+        "cancelled": 0,
+    }
+    console = Console(width=200, record=True)
+    console.print(progress.table())
+    text = console.export_text()
+    assert "wall [s]" in text and "rate [steps/s]" in text
+    assert text.count("running") == 2  # the title's count and one row
+    assert text.count("queued") == 3
+
+
+def test_format_duration() -> None:
+    assert [format_duration(s) for s in (5, 89, 600, 3900)] == [
+        "5 s",
+        "89 s",
+        "10 min",
+        "1 h 05 min",
+    ]
+
+
+def test_eta_without_training_left_needs_no_rate(tmp_path: Path) -> None:
+    [job] = _grid(tmp_path, 1)
+    (job.spec.run_dir).mkdir()
+    (job.spec.run_dir / "spcp.json").write_text("{}")  # trained by an earlier invocation
+    job.start()
+    assert job.step == job.total
+    assert GridProgress([job], 1).eta_s() == (0.0, False)

@@ -1,0 +1,120 @@
+"""The README's commands work as written (at a tiny budget) from a fresh folder.
+
+The quick-start block (after ``<!-- quick-start ...-->`` in README.md) is run line by line in
+a temporary folder that links ``configs/``, with the training budget and the evaluation sizes
+shrunk by appended options; ``make demo``'s pipeline runs on a tiny copy of
+``configs/demo.yaml`` (slow).
+"""
+
+from __future__ import annotations
+
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from sumo_ayss.config import PROJECT_ROOT
+
+README = (PROJECT_ROOT / "README.md").read_text()
+
+TINY = {
+    "sumo_ayss.train": ["--total-timesteps", "600", "--eval-every", "300", "--no-progress"],
+    "sumo_ayss.evaluate": ["--n-outcome", "10", "--n-ayss", "2000"],
+    "sumo_ayss.report": ["--n-boot", "200"],
+}
+
+
+def quick_start_commands() -> list[list[str]]:
+    block = re.search(r"<!-- quick-start.*?-->\s*```bash\n(.*?)```", README, re.S)
+    assert block, "README.md has no quick-start block"
+    commands = []
+    for line in block.group(1).splitlines():
+        argv = shlex.split(line, comments=True)
+        if argv:
+            commands.append(argv)
+    return commands
+
+
+def _run(argv: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
+    assert argv[:2] == [".venv/bin/python", "-m"], argv
+    module = argv[2]
+    cmd = [sys.executable, "-m", module, *argv[3:], *TINY.get(module, [])]
+    return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=600)
+
+
+def test_quick_start_block_is_train_evaluate_report() -> None:
+    modules = [argv[2] for argv in quick_start_commands()]
+    assert modules == ["sumo_ayss.train", "sumo_ayss.evaluate", "sumo_ayss.report"]
+
+
+@pytest.mark.sumo
+def test_quick_start_commands_run_as_written(tmp_path: Path) -> None:
+    (tmp_path / "configs").symlink_to(PROJECT_ROOT / "configs")
+    outputs = []
+    for argv in quick_start_commands():
+        done = _run(argv, tmp_path)
+        assert done.returncode == 0, (
+            f"{shlex.join(argv)}\n{done.stdout[-2000:]}{done.stderr[-3000:]}"
+        )
+        outputs.append(done.stdout.strip().splitlines()[-1])
+    run_dir = tmp_path / "runs" / "single" / "car_following" / "pi2" / "seed_0"
+    assert (run_dir / "spcp.json").is_file() and (run_dir / "ayss.csv").is_file()
+    report = Path(outputs[-1])
+    report = report if report.is_absolute() else tmp_path / report
+    assert report.is_file() and "NOT to be trusted" in report.read_text()
+
+
+@pytest.mark.sumo
+@pytest.mark.slow
+def test_make_demo_pipeline_at_a_tiny_budget(tmp_path: Path) -> None:
+    assert (
+        "$(BIN)/python -m sumo_ayss.pipeline configs/demo.yaml"
+        in (PROJECT_ROOT / "Makefile").read_text()
+    )
+    demo = yaml.safe_load((PROJECT_ROOT / "configs" / "demo.yaml").read_text())
+    demo["experiments"] = {
+        k: str(PROJECT_ROOT / "configs" / v) for k, v in demo["experiments"].items()
+    }
+    demo.update(out="runs/demo", total_timesteps=600, eval_every=300)
+    demo["grid"]["seeds"] = [0]
+    demo["evaluate"] = {"n_outcome": 10, "n_ayss": 2000}
+    (tmp_path / "demo.yaml").write_text(yaml.safe_dump(demo))
+    done = subprocess.run(
+        [sys.executable, "-m", "sumo_ayss.pipeline", "demo.yaml"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-3000:]
+    lines = done.stdout.strip().splitlines()
+    assert lines[-1].startswith("report: ")
+    assert any(x.startswith("WARNING: Small training budget: 600") for x in lines)
+    assert "car_following/pi1/seed_0: started" in done.stderr  # one line per job event
+
+
+DOCS = {name: (PROJECT_ROOT / name).read_text() for name in ("README.md", "docker/README.md")}
+
+
+@pytest.mark.parametrize("doc", sorted(DOCS))
+def test_named_modules_commands_and_files_exist(doc: str) -> None:
+    import importlib
+
+    from sumo_ayss.cli import COMMANDS
+
+    text = DOCS[doc]
+    for module in set(re.findall(r"python -m (sumo_ayss[\w.]*)", text)):
+        loaded = importlib.import_module(module)
+        if hasattr(loaded, "__path__"):  # a package: `python -m` runs its __main__
+            loaded = importlib.import_module(f"{module}.__main__")
+        assert callable(loaded.main), module
+    for command in set(re.findall(r"sumo-ayss (\w+)", text)) | set(
+        re.findall(r"sumo-ayss \\\n\s+(\w+)", text)
+    ):
+        assert command in COMMANDS, f"{doc}: sumo-ayss {command}"
+    for path in set(re.findall(r"\b((?:configs|examples|docker)/[\w./-]+\.(?:yaml|py|sh))", text)):
+        assert (PROJECT_ROOT / path).is_file(), f"{doc}: {path}"
