@@ -22,7 +22,7 @@ from sumo_ayss.config import PROJECT_ROOT
 README = (PROJECT_ROOT / "README.md").read_text()
 
 TINY = {
-    "sumo_ayss.train": ["--total-timesteps", "600", "--eval-every", "300", "--no-progress"],
+    "sumo_ayss.train": ["--total-timesteps", "1200", "--eval-every", "600", "--no-progress"],
     "sumo_ayss.evaluate": ["--n-outcome", "10", "--n-ayss", "2000"],
     "sumo_ayss.report": ["--n-boot", "200"],
 }
@@ -79,7 +79,7 @@ def test_make_demo_pipeline_at_a_tiny_budget(tmp_path: Path) -> None:
     demo["experiments"] = {
         k: str(PROJECT_ROOT / "configs" / v) for k, v in demo["experiments"].items()
     }
-    demo.update(out="runs/demo", total_timesteps=600, eval_every=300)
+    demo.update(out="runs/demo", total_timesteps=1200, eval_every=600)
     demo["grid"]["seeds"] = [0]
     demo["evaluate"] = {"n_outcome": 10, "n_ayss": 2000}
     (tmp_path / "demo.yaml").write_text(yaml.safe_dump(demo))
@@ -93,7 +93,7 @@ def test_make_demo_pipeline_at_a_tiny_budget(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-3000:]
     lines = done.stdout.strip().splitlines()
     assert lines[-1].startswith("report: ")
-    assert any(x.startswith("WARNING: Small training budget: 600") for x in lines)
+    assert any(x.startswith("WARNING: Small training budget: 1,200") for x in lines)
     assert "car_following/pi1/seed_0: started" in done.stderr  # one line per job event
 
 
