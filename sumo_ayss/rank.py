@@ -57,7 +57,8 @@ def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> l
 
     options = options or ReportOptions()
     groups = group_runs([load_run(d) for d in run_dirs])
-    return [analyse_case(case, runs, options) for case, runs in groups.items()]
+    paper = options.mode == "paper"  # the AYSS bootstrap is only needed in paper mode
+    return [analyse_case(case, runs, options, paper=paper) for case, runs in groups.items()]
 
 
 def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:

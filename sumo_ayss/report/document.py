@@ -461,13 +461,17 @@ def premise_sentence(premise: Premise | None, options: ReportOptions) -> str:
     )
 
 
-def analyse_case(case: str, runs: dict[str, list[Run]], options: ReportOptions) -> CaseAnalysis:
+def analyse_case(
+    case: str, runs: dict[str, list[Run]], options: ReportOptions, *, paper: bool = True
+) -> CaseAnalysis:
     """Safety index per VUT, ranking, pairwise verdicts and the headline of one case.
 
     Args:
         case: Case name.
         runs: ``{vut: runs}``.
         options: Statistical settings.
+        paper: Compute the paper mode (AYSS safety indices and their bootstrap, the slow
+            part); the report always does, a ranking in exposure mode need not.
 
     Returns:
         The :class:`CaseAnalysis`.
@@ -477,7 +481,7 @@ def analyse_case(case: str, runs: dict[str, list[Run]], options: ReportOptions) 
     for members in runs.values():
         for run in members:
             out.problems += [f"{_rel_label(run)}: {p}" for p in run.problems]
-    for vut, members in runs.items():
+    for vut, members in runs.items() if paper else ():
         idx = vut_safety_index(members, options, _vut_rng(options, case, vut))
         if idx is not None:
             out.indices[vut] = idx
