@@ -44,7 +44,9 @@ BoolArray = npt.NDArray[np.bool_]
 DEFAULT_THRESHOLD_MPS2 = 0.1
 
 
-def _range(where: str, value: Sequence[float], low: float) -> tuple[float, float]:
+def check_range(where: str, value: Sequence[float], low: float = -math.inf) -> tuple[float, float]:
+    """``value`` as a finite ``(min, max)`` with ``low <= min <= max``; ConfigError naming
+    ``where`` otherwise."""
     try:
         lo, hi = (float(v) for v in value)
     except (TypeError, ValueError):
@@ -115,7 +117,7 @@ class BoxGrid:
 
     def __post_init__(self) -> None:
         for name, low in (("v_pov_mps", 0.0), ("v_vut_mps", 0.0), ("h_m", -math.inf)):
-            object.__setattr__(self, name, _range(name, getattr(self, name), low))
+            object.__setattr__(self, name, check_range(name, getattr(self, name), low))
         for name in ("speed_step_mps", "headway_step_m", "max_headway_m"):
             object.__setattr__(self, name, _positive(name, getattr(self, name)))
         if not (math.isfinite(self.min_ttc_s) and self.min_ttc_s >= 0):

@@ -50,6 +50,7 @@ import numpy as np
 import numpy.typing as npt
 from tqdm import tqdm
 
+from sumo_ayss.analysis.discriminability import check_range
 from sumo_ayss.analysis.metrics import ttc_longitudinal
 from sumo_ayss.config import ActuatorConfig, OddConfig
 from sumo_ayss.envs.car_following import target_speed_mps as cf_target_speed_mps
@@ -98,16 +99,6 @@ BoolArray = npt.NDArray[np.bool_]
 # --------------------------------------------------------------------------- configuration
 
 
-def _range(where: str, value: tuple[float, float], low: float = -math.inf) -> tuple[float, float]:
-    try:
-        lo, hi = (float(v) for v in value)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{where} must be [min, max], got {value!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and low <= lo <= hi):
-        raise ConfigError(f"{where} must be finite with {low} <= min <= max, got [{lo}, {hi}]")
-    return lo, hi
-
-
 def _positive_int(where: str, value: object) -> None:
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         raise ConfigError(f"{where} must be an integer >= 1, got {value!r}")
@@ -152,7 +143,7 @@ class AyssConfig:
         _positive_int(f"{s}.n_samples", self.n_samples)
         _positive_int(f"{s}.batch_size", self.batch_size)
         for name, low in (("v_pov_mps", 0.0), ("v_vut_mps", 0.0), ("h_m", -math.inf)):
-            object.__setattr__(self, name, _range(f"{s}.{name}", getattr(self, name), low))
+            object.__setattr__(self, name, check_range(f"{s}.{name}", getattr(self, name), low))
         if not (math.isfinite(self.max_headway_m) and self.max_headway_m > 0):
             raise ConfigError(f"{s}.max_headway_m must be > 0, got {self.max_headway_m}")
         if not (math.isfinite(self.min_ttc_s) and self.min_ttc_s >= 0):
