@@ -371,6 +371,7 @@ class CaseAnalysis:
         mode: The analysis mode of ``headline``, ``ranking_line`` and :attr:`ranked`.
         exposure_rows: Exposure-mode ranking, safest first.
         exposure_pairs: Exposure-mode comparisons of every pair (A ranked above B).
+        exposure_scores: ``{vut: {seed: E}}``, the per-seed exposures behind the ranking.
         premise: Whether the SPCPs reached the same overall outcome, or None.
         paper_headline: The paper-mode headline (also when ``mode`` is exposure).
         paper_ranking_line: The paper-mode ranking line.
@@ -389,6 +390,7 @@ class CaseAnalysis:
     mode: str = "exposure"
     exposure_rows: list[SeedRankRow] = field(default_factory=list)
     exposure_pairs: list[SeedComparison] = field(default_factory=list)
+    exposure_scores: dict[str, dict[int, float]] = field(default_factory=dict)
     premise: Premise | None = None
     paper_headline: str = ""
     paper_ranking_line: str = ""
@@ -411,6 +413,7 @@ def _exposure(out: CaseAnalysis, options: ReportOptions) -> None:
             scores.append(SeedScores(vut, values))
         else:
             out.problems.append(f"{vut}: no outcome summary with a seed, so no exposure")
+    out.exposure_scores = {sc.name: dict(sc.values) for sc in scores}
     if scores:
         out.exposure_rows, out.exposure_pairs = rank_seeds(
             scores, higher_is_safer=False, level=options.level, alpha=options.welch_alpha
@@ -713,14 +716,7 @@ def _exposure_blocks(
     if not a.exposure_rows:
         return [*blocks, Paragraph("No exposure: no outcome summaries in this case yet.")]
     pct = f"{100 * options.level:g} %"
-    scores = {
-        vut: {
-            r.seed: r.outcome.mean_return.value
-            for r in members
-            if r.seed is not None and r.outcome is not None and r.outcome.mean_return.known
-        }
-        for vut, members in a.runs.items()
-    }
+    scores = a.exposure_scores
     path = figures.seed_scores_figure(
         a.exposure_rows,
         scores,
