@@ -184,11 +184,17 @@ class ControlledVut:
         self.last_command_mps2 = 0.0
 
     @classmethod
-    def from_vehicle_type(cls, vt: VehicleType, dt_s: float) -> ControlledVut | None:
-        """A driver for ``vt``'s controller (a fresh instance), or ``None`` for a SUMO model."""
+    def from_vehicle_type(
+        cls, vt: VehicleType, dt_s: float, where: str = "controller"
+    ) -> ControlledVut | None:
+        """A driver for ``vt``'s controller (a fresh instance), or ``None`` for a SUMO model.
+
+        This is where a user controller is imported and built (reading a config only checks
+        its form); ``where`` names the config field in the errors.
+        """
         if vt.controller is None:
             return None
-        return cls(vt.controller.build(), vt.controller, dt_s)
+        return cls(vt.controller.build(where), vt.controller, dt_s)
 
     def start(self, pair: VehiclePair) -> None:
         """Take over the freshly placed VUT (speed mode 0) and reset the controller."""

@@ -34,7 +34,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from sumo_ayss.analysis.discriminability import (
     DEFAULT_THRESHOLD_MPS2,
@@ -44,11 +44,17 @@ from sumo_ayss.analysis.discriminability import (
 )
 from sumo_ayss.atomic import atomic_write_json, atomic_write_text
 from sumo_ayss.cli import prog
-from sumo_ayss.config import Case, EnvConfig, read_yaml, to_dict
+from sumo_ayss.config import (
+    Case,
+    EnvConfig,
+    PipelineConfig,
+    experiment_from_dict,
+    load_experiment,
+    load_pipeline,
+    read_yaml,
+    to_dict,
+)
 from sumo_ayss.errors import AyssError, ConfigError
-
-if TYPE_CHECKING:
-    from sumo_ayss.pipeline import PipelineConfig
 
 logger = logging.getLogger(__name__)
 
@@ -85,14 +91,10 @@ def load_target(path: str | Path, vuts: Sequence[str] | None, case: Case | None)
     Raises:
         ConfigError: On unreadable files, unknown VUTs or cases, fewer than 2 VUTs.
     """
-    from sumo_ayss.experiment import experiment_from_dict
-
     path = Path(path)
     data = read_yaml(path)
     is_pipeline = "env" not in data and bool(set(data) & _PIPELINE_KEYS)
     if is_pipeline:
-        from sumo_ayss.pipeline import load_pipeline
-
         pipe = load_pipeline(path)
         case = case or pipe.grid.cases[0]
         env = pipeline_env(pipe, case)
@@ -120,8 +122,6 @@ def load_target(path: str | Path, vuts: Sequence[str] | None, case: Case | None)
 
 def pipeline_env(pipe: PipelineConfig, case: Case) -> EnvConfig:
     """The env of ``case``'s experiment in a pipeline, with the pipeline's extra VUTs."""
-    from sumo_ayss.experiment import load_experiment
-
     if case not in pipe.experiments:
         raise ConfigError(
             f"--case {case!r}: the pipeline has no experiment for it; "

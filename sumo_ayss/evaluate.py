@@ -3,7 +3,7 @@
     python -m sumo_ayss.evaluate runs/car_following/pi1/seed_0
     python -m sumo_ayss.evaluate <run_dir> --n-outcome 200 --n-ayss 100000 --seed 4242 --force
 
-Reads ``<run>/config.yaml`` (the resolved configuration, with ``vut`` and ``seed``) and the
+Reads ``<run>/config.yaml`` (the resolved configuration and the ``seed``) and the
 selected policy ``<run>/spcp.zip``, and writes into the run folder:
 
     outcome.csv   one row per outcome episode   (sumo_ayss.scenarios.tables.OUTCOME_SCHEMA)
@@ -32,13 +32,20 @@ from typing import Any
 
 from sumo_ayss.catalog import controller_imports
 from sumo_ayss.cli import prog
-from sumo_ayss.config import check_seed, safe_load_yaml, to_dict
+from sumo_ayss.config import (
+    DEFAULT_AYSS_SEED,
+    AyssConfig,
+    ExperimentConfig,
+    check_seed,
+    experiment_from_dict,
+    safe_load_yaml,
+    to_dict,
+)
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
-from sumo_ayss.experiment import ExperimentConfig, experiment_from_dict
 from sumo_ayss.paths import portable_path
-from sumo_ayss.scenarios.ayss import DEFAULT_AYSS_SEED, AyssConfig, run_ayss
+from sumo_ayss.scenarios.ayss import run_ayss
 from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_N, DEFAULT_OUTCOME_SEED, run_outcome
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.scenarios.tables import read_json, write_json, write_table
@@ -82,13 +89,17 @@ class EvaluationResult:
     ran_ayss: bool
 
 
-def load_run(run_dir: str | Path, *, trust_controller: bool = False) -> RunInfo:
+def load_run(run_dir: str | Path, *, known: tuple[ExperimentConfig, int] | None = None) -> RunInfo:
     """Read ``config.yaml`` (and ``spcp.json`` if present) of a run folder.
+
+    Reading never imports the user controller a config names: that happens when an env is
+    built, inside ``controller_imports(trust)`` (see :func:`evaluate_run`).
 
     Args:
         run_dir: The run folder.
-        trust_controller: Import the user controllers its config names (runs their code).
-            Without it their targets are checked for form only (see the README's trust model).
+        known: The run's configuration and seed as the caller already holds them (the
+            pipeline, which just trained or checked the folder): ``config.yaml`` is then
+            not parsed again.
 
     Raises:
         CheckpointError: If the folder or its config is missing or unreadable.
@@ -97,22 +108,30 @@ def load_run(run_dir: str | Path, *, trust_controller: bool = False) -> RunInfo:
     path = run_dir / "config.yaml"
     if not path.is_file():
         raise CheckpointError(f"{run_dir}: not a run folder (no config.yaml)")
-    try:
-        data = safe_load_yaml(path.read_text(encoding="utf-8"), str(path))
-        data = dict(data)
-        seed, vut = check_seed(data.pop("seed"), f"{path}: seed"), data.pop("vut")
-    except (ConfigError, TypeError, ValueError, KeyError, OSError, UnicodeDecodeError) as exc:
-        raise CheckpointError(f"{path}: unreadable run configuration ({exc})") from exc
-    try:
-        with controller_imports(trust_controller):
-            cfg = experiment_from_dict(data, run_dir).with_vut(vut)
-    except ConfigError as exc:
-        raise CheckpointError(f"{path}: invalid run configuration: {exc}") from exc
+    if known is not None:
+        cfg, seed = known
+    else:
+        cfg, seed = _read_run_config(path)
     spcp_step = None
     if (run_dir / "spcp.json").is_file():
         spcp = read_json(run_dir / "spcp.json")
         spcp_step = spcp.get("step") if isinstance(spcp, dict) else None
     return RunInfo(run_dir, cfg, seed, spcp_step)
+
+
+def _read_run_config(path: Path) -> tuple[ExperimentConfig, int]:
+    """A run folder's ``config.yaml``: the experiment and the seed."""
+    try:
+        data = safe_load_yaml(path.read_text(encoding="utf-8"), str(path))
+        data = dict(data)
+        seed = check_seed(data.pop("seed"), f"{path}: seed")
+        vut = data.pop("vut", None)  # folders written before the VUT was stored once
+    except (ConfigError, TypeError, ValueError, KeyError, OSError, UnicodeDecodeError) as exc:
+        raise CheckpointError(f"{path}: unreadable run configuration ({exc})") from exc
+    try:
+        return experiment_from_dict(data, path.parent).with_vut(vut), seed
+    except ConfigError as exc:
+        raise CheckpointError(f"{path}: invalid run configuration: {exc}") from exc
 
 
 def load_spcp(run: RunInfo, env: PairEnv) -> Policy:
@@ -212,6 +231,7 @@ def evaluate_run(
     progress: bool = True,
     policy: Policy | None = None,
     trust_controller: bool = False,
+    run: tuple[ExperimentConfig, int] | None = None,
 ) -> EvaluationResult:
     """Run the outcome and AYSS stages on a run folder (see the module docstring).
 
@@ -225,6 +245,8 @@ def evaluate_run(
         policy: Use this policy instead of ``<run>/spcp.zip`` (e.g. a scripted one).
         trust_controller: Allow importing the run's user-controller VUT (runs its code); a
             run whose VUT is a controller cannot be evaluated without it.
+        run: The run's configuration and seed, when the caller holds them (see
+            :func:`load_run`'s ``known``).
 
     Returns:
         The output paths and which stages ran.
@@ -233,7 +255,7 @@ def evaluate_run(
         CheckpointError: If the run folder, its config or its SPCP cannot be read.
     """
     with controller_imports(trust_controller):
-        return _evaluate_run(run_dir, n_outcome, outcome_seed, ayss, force, progress, policy)
+        return _evaluate_run(run_dir, n_outcome, outcome_seed, ayss, force, progress, policy, run)
 
 
 def _evaluate_run(
@@ -244,8 +266,9 @@ def _evaluate_run(
     force: bool,
     progress: bool,
     policy: Policy | None,
+    known: tuple[ExperimentConfig, int] | None = None,
 ) -> EvaluationResult:
-    run = load_run(run_dir, trust_controller=_trusted())
+    run = load_run(run_dir, known=known)
     ayss_cfg = ayss if ayss is not None else AyssConfig()
     d = run.run_dir
     paths = {n: d / n for n in (OUTCOME_CSV, OUTCOME_JSON, AYSS_CSV, AYSS_JSON)}
@@ -272,12 +295,6 @@ def _evaluate_run(
         do_outcome,
         do_ayss,
     )
-
-
-def _trusted() -> bool:
-    from sumo_ayss.catalog import _CONTROLLER_IMPORTS
-
-    return _CONTROLLER_IMPORTS.get()
 
 
 # --------------------------------------------------------------------------- CLI
@@ -324,12 +341,13 @@ def main(argv: Sequence[str] | None = None) -> None:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
     t0 = time.perf_counter()
     try:
-        set_torch_threads(load_run(args.run_dir).config.train.torch_threads)
+        run = load_run(args.run_dir)  # parsed once, then passed on
+        set_torch_threads(run.config.train.torch_threads)
         overrides: dict[str, Any] = {"n_samples": args.n_ayss}
         if args.seed is not None:
             overrides["seed"] = args.seed
         if args.ayss_speeds_from_odd:
-            ayss = AyssConfig.from_odd(load_run(args.run_dir).config.env.odd, **overrides)
+            ayss = AyssConfig.from_odd(run.config.env.odd, **overrides)
         else:
             ayss = dataclasses.replace(AyssConfig(), **overrides)
         result = evaluate_run(
@@ -340,6 +358,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             force=args.force,
             progress=not args.no_progress,
             trust_controller=args.trust_controller,
+            run=(run.config, run.seed),
         )
     except AyssError as e:
         sys.exit(f"error: {e}")

@@ -32,176 +32,36 @@ Pipeline YAML (every key optional)::
 from __future__ import annotations
 
 import argparse
-import collections
 import dataclasses
-import hashlib
-import json
 import logging
-import multiprocessing
 import os
 import sys
-import threading
-import time
-import traceback
-import types
-import typing
-from collections.abc import Mapping, Sequence
-from concurrent.futures import Future, ProcessPoolExecutor
-from dataclasses import dataclass, field
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, ClassVar, Literal
+from typing import Any, Literal
 
-from sumo_ayss.catalog import VehicleType
 from sumo_ayss.cli import prog
-from sumo_ayss.config import (
-    PROJECT_ROOT,
-    Case,
-    _require,
-    build,
-    check_out_dir,
-    check_seed,
-    read_yaml,
-    to_dict,
-)
+from sumo_ayss.config import PipelineConfig, check_out_dir, load_experiment, load_pipeline, to_dict
 from sumo_ayss.errors import AyssError, ConfigError
-from sumo_ayss.progress import GridProgress, JobStatus, format_duration
-from sumo_ayss.report.options import ReportOptions
+from sumo_ayss.grid_local import run_grid_local
+from sumo_ayss.jobs import JobSpec
+from sumo_ayss.progress import JobStatus
+from sumo_ayss.validation import suggest
 
 logger = logging.getLogger("sumo_ayss.pipeline")  # also when run as __main__
 
 Backend = Literal["local", "ray"]
 
 
-@dataclass(frozen=True)
-class GridConfig:
-    """The grid of jobs. Section ``grid``."""
-
-    SECTION: ClassVar[str] = "grid"
-
-    cases: tuple[Case, ...] = ("car_following", "cut_in")
-    vuts: tuple[str, ...] = ("pi1", "pi2")
-    seeds: tuple[int, ...] = (0, 1, 2)
-
-    def __post_init__(self) -> None:
-        for name in ("cases", "vuts", "seeds"):
-            values = getattr(self, name)
-            _require(len(values) > 0, f"grid.{name} must not be empty")
-            _require(len(set(values)) == len(values), f"grid.{name} has duplicates: {list(values)}")
-        for seed in self.seeds:
-            check_seed(seed, "grid.seeds[]")
-
-
-@dataclass(frozen=True)
-class EvaluateConfig:
-    """Outcome and AYSS sizes. Section ``evaluate``."""
-
-    n_outcome: int = 200
-    n_ayss: int = 100_000
-
-    def __post_init__(self) -> None:
-        _require(self.n_outcome >= 1, f"evaluate.n_outcome must be >= 1, got {self.n_outcome}")
-        _require(self.n_ayss >= 1, f"evaluate.n_ayss must be >= 1, got {self.n_ayss}")
-
-
-@dataclass(frozen=True)
-class PipelineConfig:
-    """A whole batch: grid, experiment file per case, output folder, parallelism."""
-
-    grid: GridConfig = field(default_factory=GridConfig)
-    experiments: Mapping[str, Path] = field(
-        default_factory=lambda: {
-            "car_following": PROJECT_ROOT / "configs" / "car_following.yaml",
-            "cut_in": PROJECT_ROOT / "configs" / "cut_in.yaml",
-        }
-    )
-    out: Path = Path("runs") / "paper"
-    total_timesteps: int | None = None
-    eval_every: int | None = None
-    evaluate: EvaluateConfig = field(default_factory=EvaluateConfig)
-    vuts: Mapping[str, VehicleType] = field(default_factory=dict)
-    """Extra VUTs (catalog syntax, as in ``env.vuts``) added to every case's experiment, so
-    that a leaderboard defines its VUTs once for all cases."""
-    report: ReportOptions = field(default_factory=ReportOptions)
-    """Statistical settings and analysis mode of the report and the ranking."""
-    expected_order: tuple[str, ...] = ()
-    """A known safety order of the grid's VUTs, safest first (validation studies such as
-    ladders): ``rank`` then reports Kendall's τ of its ranking against it and whether the
-    two ends differ significantly. Empty: no known order."""
-    workers: int = 0
-    retries: int = 1
-
-    def __post_init__(self) -> None:
-        _require(self.workers >= 0, f"workers must be >= 0, got {self.workers}")
-        _require(self.retries >= 0, f"retries must be >= 0, got {self.retries}")
-        if self.expected_order:
-            _require(
-                sorted(self.expected_order) == sorted(self.grid.vuts),
-                f"expected_order must list exactly the grid's VUTs {sorted(self.grid.vuts)}, "
-                f"got {list(self.expected_order)}",
-            )
-        object.__setattr__(self, "vuts", types.MappingProxyType(dict(self.vuts)))
-        for name, vt in self.vuts.items():
-            vt.validate(f"vuts.{name}")
-        known = typing.get_args(Case)
-        for case in self.experiments:
-            _require(
-                case in known,
-                f"experiments.{case}: unknown case; allowed: {list(known)}",
-            )
-        for case in self.grid.cases:
-            _require(
-                case in self.experiments,
-                f"experiments has no file for case {case!r}; given: {sorted(self.experiments)}",
-            )
-
-    @property
-    def n_workers(self) -> int:
-        return self.workers or os.cpu_count() or 1
-
-
-@dataclass(frozen=True)
-class JobSpec:
-    """One (case, VUT, seed): everything a worker process needs, picklable."""
-
-    case: str
-    vut: str
-    seed: int
-    experiment: dict[str, Any]
-    """The resolved experiment (``ExperimentConfig.to_dict()``, VUT set)."""
-    out: str
-    n_outcome: int
-    n_ayss: int
-
-    @property
-    def name(self) -> str:
-        return f"{self.case}/{self.vut}/seed_{self.seed}"
-
-    @property
-    def run_dir(self) -> Path:
-        return Path(self.out) / self.case / self.vut / f"seed_{self.seed}"
-
-
-# ---------------------------------------------------------------------- loading
-
-
-def load_pipeline(path: str | Path | None, **overrides: Any) -> PipelineConfig:
-    """Pipeline YAML over defaults, then ``overrides`` (None values are ignored)."""
-    if path is None:
-        cfg = PipelineConfig()
-    else:
-        path = Path(path)
-        cfg = build(PipelineConfig, read_yaml(path), "", path.resolve().parent)
-    clean = {k: v for k, v in overrides.items() if v is not None}
-    seeds = clean.pop("seeds", None)
-    if seeds is not None:
-        clean["grid"] = dataclasses.replace(cfg.grid, seeds=tuple(int(x) for x in seeds))
-    return dataclasses.replace(cfg, **clean) if clean else cfg
+__all__ = ["load_pipeline", "main", "plan_jobs", "run_pipeline"]
 
 
 def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
-    """Resolve every job's experiment; bad grids are refused here, before any job runs."""
-    from sumo_ayss.experiment import load_experiment
+    """Resolve every job's experiment; bad grids are refused here, before any job runs.
 
+    Each case's experiment file is parsed once; a job receives that frozen record with its
+    VUT set (workers never parse it again).
+    """
     jobs = []
     for case in cfg.grid.cases:
         exp = load_experiment(cfg.experiments[case])
@@ -222,8 +82,8 @@ def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
         for vut in cfg.grid.vuts:
             if vut not in exp.env.vuts:
                 raise ConfigError(
-                    f"grid.vuts: {vut!r} is not a VUT of the {case} experiment; "
-                    f"allowed: {sorted(exp.env.vuts)}"
+                    f"grid.vuts: {vut!r} is not a VUT of the {case} experiment"
+                    f"{suggest(vut, exp.env.vuts)}; allowed: {sorted(exp.env.vuts)}"
                 )
             for seed in cfg.grid.seeds:
                 jobs.append(
@@ -231,244 +91,13 @@ def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
                         case=case,
                         vut=vut,
                         seed=int(seed),
-                        experiment=exp.with_vut(vut).to_dict(),
+                        experiment=exp.with_vut(vut),
                         out=str(cfg.out),
                         n_outcome=cfg.evaluate.n_outcome,
-                        n_ayss=cfg.evaluate.n_ayss,
+                        ayss=cfg.evaluate.ayss,
                     )
                 )
     return jobs
-
-
-# ---------------------------------------------------------------------- one job
-
-
-def _fingerprint(*parts: Any) -> str:
-    h = hashlib.sha256()
-    for part in parts:
-        if isinstance(part, Path):
-            h.update(part.read_bytes())
-        else:
-            h.update(json.dumps(part, sort_keys=True, default=str).encode())
-    return h.hexdigest()[:16]
-
-
-def run_job(spec: JobSpec) -> dict[str, Any]:
-    """Train (or resume, or skip) and evaluate one job. Runs in a worker process."""
-    from sumo_ayss.atomic import atomic_write_json
-    from sumo_ayss.evaluate import evaluate_run
-    from sumo_ayss.experiment import experiment_from_dict
-    from sumo_ayss.scenarios.ayss import AyssConfig
-    from sumo_ayss.threads import set_torch_threads
-    from sumo_ayss.train import train, write_progress
-
-    run_dir = spec.run_dir
-    run_dir.mkdir(parents=True, exist_ok=True)
-    handler = logging.FileHandler(run_dir / "job.log")
-    handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s: %(message)s"))
-    root = logging.getLogger()
-    root.addHandler(handler)
-    root.setLevel(logging.INFO)
-    t0 = time.perf_counter()
-    stages: dict[str, str] = {}
-    times: dict[str, float] = {}
-    try:
-        cfg = experiment_from_dict(spec.experiment, run_dir)
-        set_torch_threads(cfg.train.torch_threads)  # for evaluate too, when training is skipped
-        if (run_dir / "spcp.json").is_file() and (run_dir / "config.yaml").is_file():
-            from sumo_ayss.train import _check_same_config
-
-            _check_same_config(run_dir, cfg, spec.seed)  # raises if the inputs changed
-            stages["train"] = "skipped"
-        else:
-            resume = (run_dir / "config.yaml").is_file()
-            train(cfg, spec.seed, Path(spec.out), resume=resume, argv=["--pipeline", spec.name])
-            stages["train"] = "resumed" if resume else "done"
-        times["train_s"] = time.perf_counter() - t0
-
-        write_progress(run_dir, "evaluate")
-        t1 = time.perf_counter()
-        marker = run_dir / "evaluate.done.json"
-        key = _fingerprint(run_dir / "spcp.zip", spec.n_outcome, spec.n_ayss)
-        done = json.loads(marker.read_text()) if marker.is_file() else {}
-        if done.get("inputs") == key:
-            stages["evaluate"] = "skipped"
-        else:
-            evaluate_run(
-                run_dir,
-                n_outcome=spec.n_outcome,
-                ayss=AyssConfig(n_samples=spec.n_ayss),
-                force=True,
-                progress=False,
-                trust_controller=True,  # the pipeline's own runs, from the user's configs
-            )
-            atomic_write_json(marker, {"inputs": key})
-            stages["evaluate"] = "done"
-        times["evaluate_s"] = time.perf_counter() - t1
-        write_progress(run_dir, "done")
-    except BaseException:
-        logger.exception("job %s failed", spec.name)
-        raise
-    finally:
-        root.removeHandler(handler)
-        handler.close()
-    return {"job": spec.name, "stages": stages, "wall_s": time.perf_counter() - t0, **times}
-
-
-# ---------------------------------------------------------------------- the grid
-
-
-def _worker_init() -> None:
-    """Worker initializer: die with the pipeline, and leave Ctrl-C to it.
-
-    On Linux a worker gets SIGKILLed when the pipeline process dies: without it a killed
-    pipeline leaves its workers running, and a rerun would race them for the same run
-    folders. A Ctrl-C reaches every process of the terminal's group; workers ignore it and
-    the pipeline stops them (:func:`_stop_workers`), so that no job starts afterwards.
-    It also runs before any job imports torch, so that torch's intra-op pool starts with one
-    BLAS/OpenMP thread (``run_job`` then applies ``train.torch_threads``).
-    """
-    import signal
-
-    from sumo_ayss.threads import single_thread_env
-
-    single_thread_env()
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if sys.platform.startswith("linux"):
-        import ctypes
-
-        libc = ctypes.CDLL("libc.so.6", use_errno=True)
-        pr_set_pdeathsig = 1
-        libc.prctl(pr_set_pdeathsig, signal.SIGKILL)
-
-
-def _stop_workers(pool: ProcessPoolExecutor, grace_s: float = 3.0) -> None:
-    """Terminate the pool's worker processes now (SIGTERM, then SIGKILL after ``grace_s``).
-
-    Safe for the run folders: every result is written atomically and a rerun resumes from
-    the last checkpoint (:func:`sumo_ayss.train.train`).
-    """
-    processes = list(getattr(pool, "_processes", {}).values())  # CPython's worker table
-    for proc in processes:
-        if proc.is_alive():
-            proc.terminate()
-    deadline = time.monotonic() + grace_s
-    for proc in processes:
-        proc.join(max(0.0, deadline - time.monotonic()))
-        if proc.is_alive():
-            proc.kill()
-            proc.join(1.0)
-    pool.shutdown(wait=False, cancel_futures=True)
-
-
-class _Terminated(KeyboardInterrupt):
-    """SIGTERM, handled as a Ctrl-C."""
-
-
-def _raise_terminated(signum: int, frame: Any) -> None:
-    raise _Terminated
-
-
-def run_grid_local(
-    jobs: Sequence[JobSpec], workers: int, retries: int, live: Any = None
-) -> list[JobStatus]:
-    """Run ``jobs`` on a local process pool with retries; report progress as it goes.
-
-    At most ``workers`` jobs are handed to the pool at a time; the others wait here, so the
-    jobs shown as running are the ones a worker holds, and a Ctrl-C (SIGINT) or SIGTERM
-    cancels them at once: running jobs are terminated (their state is ``interrupted``,
-    resumable), queued ones never start (``cancelled``), and the KeyboardInterrupt
-    propagates to the caller within seconds. Every job event is logged (one line each, with
-    the grid's counts and ETA); ``live`` (a :class:`rich.console.Console`, or None for
-    none) also shows a table of every job that refreshes twice a second.
-    """
-    import signal
-
-    statuses = [JobStatus(j) for j in jobs]
-    progress = GridProgress(statuses, workers)
-    queue: collections.deque[JobStatus] = collections.deque(statuses)
-    ctx = multiprocessing.get_context("spawn")  # fresh interpreters: no inherited libsumo
-    logger.info(
-        "%d jobs on %d worker processes; each job logs to <run folder>/job.log",
-        len(jobs),
-        workers,
-    )
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init)
-    pending: dict[Future[dict[str, Any]], JobStatus] = {}
-    in_main = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGTERM, _raise_terminated) if in_main else None
-    display = None
-
-    def submit(s: JobStatus) -> None:
-        s.start()
-        pending[pool.submit(run_job, s.spec)] = s
-        logger.info(progress.line(s, f"started (try {s.attempts})"))
-
-    try:
-        display = _live(progress, live) if live is not None else None
-        while pending or queue:
-            while queue and len(pending) < workers:
-                submit(queue.popleft())
-            finished = [f for f in list(pending) if f.done()]
-            for event in progress.poll():  # also the last events of the finished jobs
-                logger.info(event)
-            for fut in finished:
-                s = pending.pop(fut)
-                try:
-                    result = fut.result()
-                except Exception as e:  # a job's failure is data here
-                    s.error = "".join(traceback.format_exception_only(e)).strip()
-                    s.stage = ""
-                    if s.attempts <= retries:
-                        s.state = "queued"
-                        queue.appendleft(s)
-                        logger.warning(progress.line(s, f"failed ({s.error}); will retry"))
-                    else:
-                        s.state = "failed"
-                        log = s.spec.run_dir / "job.log"
-                        logger.error(progress.line(s, f"FAILED: {s.error} (log: {log})"))
-                    continue
-                logger.info(progress.finished(s, result))
-            if display is not None:
-                display.update(progress.table())
-            time.sleep(0.2)
-    except KeyboardInterrupt:
-        for s in queue:
-            s.state = "cancelled"
-        for fut, s in pending.items():
-            fut.cancel()
-            s.state = "interrupted"
-        _stop_workers(pool)
-        logger.warning(
-            "interrupted: %d running job(s) stopped, %d queued job(s) cancelled; rerun the "
-            "same command to resume",
-            len(pending),
-            len(queue),
-        )
-        raise
-    finally:
-        if in_main:
-            signal.signal(signal.SIGTERM, previous)
-        if display is not None:
-            display.update(progress.table())
-            display.stop()
-        pool.shutdown(wait=False, cancel_futures=True)
-    c = progress.counts()
-    logger.info(
-        "grid finished: %d done, %d failed, %s wall",
-        c["done"],
-        c["failed"],
-        format_duration(time.time() - progress.t0),
-    )
-    return statuses
-
-
-def _live(progress: GridProgress, console: Any) -> Any:
-    from rich.live import Live
-
-    live = Live(progress.table(), console=console, refresh_per_second=2, transient=False)
-    live.start()
-    return live
 
 
 def _relative_paths(data: Any, base: Path) -> Any:

@@ -48,7 +48,7 @@ class JobStatus:
     """What the pipeline knows about one job.
 
     Attributes:
-        spec: The job (:class:`sumo_ayss.pipeline.JobSpec`).
+        spec: The job (:class:`sumo_ayss.jobs.JobSpec`).
         state: One of :data:`STATES`; ``running`` only while a worker holds the job;
             ``interrupted`` / ``cancelled`` after a Ctrl-C (running / still queued then).
         attempts: Tries started so far.
@@ -83,7 +83,7 @@ class JobStatus:
     step_at_start: int = 0
 
     def __post_init__(self) -> None:
-        self.total = int(self.spec.experiment["train"]["total_timesteps"])
+        self.total = int(self.spec.experiment.train.total_timesteps)
         self.step = _finished_steps(self.spec.run_dir, self.total)
 
     def start(self) -> None:

@@ -28,7 +28,8 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.errors import ConfigError
-from sumo_ayss.pipeline import JobSpec, JobStatus, run_job
+from sumo_ayss.jobs import JobSpec, run_job
+from sumo_ayss.progress import JobStatus
 
 logger = logging.getLogger(__name__)
 

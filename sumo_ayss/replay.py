@@ -231,7 +231,7 @@ def export_scenario(
         raise ConfigError(f"decisions must be an integer >= 1, got {decisions!r}")
     run_dir, out = Path(run_dir), Path(out)
     with controller_imports(trust_controller):
-        run = load_run(run_dir, trust_controller=trust_controller)
+        run = load_run(run_dir)
         return _export(run, kind, index, out, policy, decisions)
 
 

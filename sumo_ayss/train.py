@@ -18,7 +18,7 @@ time-limit truncations (bootstrapped, not terminal) and every pair starts a fres
 
 Run folder ``<out>/<case>/<vut>/seed_<k>/``:
 
-    config.yaml        the exact resolved configuration (with vut and seed)
+    config.yaml        the exact resolved configuration (with the seed; the VUT is env.vut)
     command.txt        the command line
     versions.json      Python, package, SUMO, torch, SB3, gymnasium, numpy versions
     seeds.json         training seed, SUMO seed, evaluation-scenario seed
@@ -72,13 +72,21 @@ from sumo_ayss.atomic import (
     remove_stale_temporaries,
 )
 from sumo_ayss.cli import prog
-from sumo_ayss.config import check_out_dir, check_seed, safe_load_yaml, to_dict, write_yaml
+from sumo_ayss.config import (
+    ExperimentConfig,
+    check_out_dir,
+    check_seed,
+    experiment_from_dict,
+    load_experiment,
+    safe_load_yaml,
+    to_dict,
+    write_yaml,
+)
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.envs.vec_env import EpisodeTrace, PairVecEnv
 from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
-from sumo_ayss.experiment import ExperimentConfig, experiment_from_dict, load_experiment
 from sumo_ayss.paths import portable_python
 from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, run_episodes, summarize
 from sumo_ayss.selection import select_spcp
@@ -211,7 +219,7 @@ class Trainer:
 
     def write_metadata(self, argv: Sequence[str]) -> None:
         self.run_dir.mkdir(parents=True, exist_ok=True)
-        resolved = {"vut": self.cfg.env.vut, "seed": self.seed, **self.cfg.to_dict()}
+        resolved = {"seed": self.seed, **self.cfg.to_dict()}  # the VUT: env.vut
         # config.yaml before checkpoints/: a run killed in between must look resumable
         # (the pipeline resumes a folder with config.yaml; checkpoints/ alone is refused).
         write_yaml(self.run_dir / "config.yaml", resolved)
@@ -769,7 +777,7 @@ def _check_same_config(run_dir: Path, cfg: ExperimentConfig, seed: int) -> None:
         if not isinstance(stored, dict):
             raise CheckpointError(f"{path}: not a run configuration (top level is not a mapping)")
         stored_seed = stored.pop("seed")
-        stored.pop("vut")
+        stored.pop("vut", None)  # folders written before the VUT was stored once (env.vut)
         stored_cfg = experiment_from_dict(stored, run_dir)
     except (ConfigError, KeyError, OSError, UnicodeDecodeError) as e:
         raise CheckpointError(f"{path}: unreadable run configuration ({e})") from e

@@ -19,10 +19,9 @@ from typing import Any
 import pytest
 import yaml
 
-from sumo_ayss.config import EnvConfig, SimConfig, read_yaml
+from sumo_ayss.config import EnvConfig, SimConfig, load_experiment, read_yaml
 from sumo_ayss.controllers import ControllerError, bound_acceleration
 from sumo_ayss.errors import ActionError, AyssError, CheckpointError, ConfigError
-from sumo_ayss.experiment import load_experiment
 from tests.helpers import TINY_AGENT
 
 # ------------------------------------------------------------------------------ helpers
@@ -154,7 +153,8 @@ PIPELINE_CASES: list[tuple[str, str, str]] = [
     (
         "unknown case in experiments",
         "grid: {cases: [car_following]}\nexperiments: {car_following: EXP, car_follow: EXP}",
-        "experiments.car_follow: unknown case; allowed: ['car_following', 'cut_in']",
+        "experiments.car_follow: unknown case (did you mean 'car_following'?); allowed: "
+        "['car_following', 'cut_in']",
     ),
     (
         "negative seed",
@@ -496,8 +496,8 @@ def test_replay_export_on_a_corrupt_run_folder_gives_one_line(
 
 def _write_outcome_table(run: Path) -> None:
     """Evaluate a copy of the run (tiny) so that outcome.csv exists for export."""
+    from sumo_ayss.config import AyssConfig
     from sumo_ayss.evaluate import evaluate_run
-    from sumo_ayss.scenarios.ayss import AyssConfig
 
     evaluate_run(run, n_outcome=2, ayss=AyssConfig(n_samples=10), progress=False)
 
@@ -626,7 +626,6 @@ def test_a_run_folder_controller_is_imported_only_when_trusted(
         "class C:\n    def acceleration(self, state):\n        return 0.0\n"
     )
     data = yaml.safe_load((run / "config.yaml").read_text())
-    data["vut"] = "evil"
     data["env"]["vut"] = "evil"
     data["env"]["vuts"]["evil"] = {
         "model": "IDM",

@@ -7,8 +7,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from sumo_ayss.config import PROJECT_ROOT
-from sumo_ayss.experiment import load_experiment
+from sumo_ayss.config import PROJECT_ROOT, load_experiment
 from sumo_ayss.pipeline import load_pipeline, plan_jobs
 from sumo_ayss.report.checks import TRUSTED_TIMESTEPS
 

@@ -8,6 +8,7 @@ SUMO step, so they do not depend on :class:`~sumo_ayss.envs.pair_env.PairEnv`.
 from __future__ import annotations
 
 import math
+import pickle
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -163,8 +164,27 @@ def test_vehicle_type_mapping_round_trip() -> None:
     ],
 )
 def test_controller_config_errors(controller: dict[str, Any], match: str) -> None:
+    """Form errors when the config is read; target and params errors when it is built."""
     with pytest.raises(ConfigError, match=match):
-        VehicleType.from_mapping({"controller": controller}, "x")
+        vt = VehicleType.from_mapping({"controller": controller}, "x")
+        assert vt.controller is not None
+        vt.controller.build("x.controller")
+
+
+def test_reading_a_controller_vut_runs_no_user_code(tmp_path: Path) -> None:
+    """The target is imported, and its constructor run, when an env is built, not before."""
+    marker = tmp_path / "imported"
+    module = tmp_path / "marked_controller.py"
+    module.write_text(
+        f"import pathlib\npathlib.Path({str(marker)!r}).touch()\n"
+        "class C:\n    def acceleration(self, state):\n        return 0.0\n"
+    )
+    spec = {"target": f"{module}:C", "max_accel_mps2": 3.0, "max_decel_mps2": 6.0}
+    cfg = env_config_from_mapping({"vut": "m", "vuts": {"m": {"controller": spec}}}, tmp_path)
+    assert cfg.vut_type.controller is not None and not marker.exists()
+    assert pickle.loads(pickle.dumps(cfg)) == cfg and not marker.exists()
+    ControlledVut.from_vehicle_type(cfg.vut_type, 0.2)
+    assert marker.exists()
 
 
 def test_controller_vut_refuses_car_following_parameters() -> None:

@@ -124,7 +124,8 @@ def test_paper_fidelity_pipeline_plans_the_grid() -> None:
         for s in (0, 1, 2)
     )
     for job in jobs:
-        env = job.experiment["env"]
-        assert env["actuator"]["mode"] == "highway_env"
-        assert env["odd"]["vut_speed_mps"] == [0.0, 40.0]
-        assert env["vuts"][job.vut]["controller"]["target"].endswith(":HighwayEnvIDM")
+        env = job.experiment.env
+        assert env.actuator.mode == "highway_env"
+        assert env.odd.vut_speed_mps == (0.0, 40.0)
+        controller = env.vuts[job.vut].controller
+        assert controller is not None and controller.target.endswith(":HighwayEnvIDM")

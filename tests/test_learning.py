@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from sumo_ayss.config import load_experiment
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import sample_initial_conditions
-from sumo_ayss.experiment import load_experiment
 from sumo_ayss.scenarios.rollout import run_episodes, summarize
 from sumo_ayss.train import read_eval_table, train
 

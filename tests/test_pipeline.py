@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import pickle
 import signal
 import subprocess
 import sys
@@ -14,7 +15,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from sumo_ayss.config import PROJECT_ROOT
+from sumo_ayss.config import PROJECT_ROOT, AyssConfig, ExperimentConfig
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.pipeline import load_pipeline, plan_jobs, run_pipeline
 from tests.helpers import TINY_AGENT
@@ -130,17 +131,56 @@ def test_pipeline_vuts_report_and_known_order_sections(tmp_path: Path) -> None:
     assert cfg.report.mode == "paper" and cfg.report.premise_reward == 0.5
     jobs = plan_jobs(cfg)
     assert [j.name for j in jobs[:3]] == [f"car_following/bold/seed_{s}" for s in (5, 6, 7)]
-    params = jobs[0].experiment["env"]["vuts"]["bold"]["params"]
+    params = jobs[0].experiment.env.vuts["bold"].params
     assert params["minGap"] == 1.0 and params["tau"] == 0.6
-    assert "pi1" in jobs[0].experiment["env"]["vuts"]  # the built-ins stay
+    assert "pi1" in jobs[0].experiment.env.vuts  # the built-ins stay
+    assert jobs[0].experiment.env.vut == "bold"
+
+
+def test_jobs_carry_the_config_parsed_once_and_it_pickles(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each case's experiment is parsed once; the frozen records travel to workers as is."""
+    import sumo_ayss.config.experiment as experiment_module
+
+    ayss = {"n_samples": 300, "h_m": [0.0, 4.0], "seed": 7}
+    path = write_configs(tmp_path, [0, 1], evaluate={"n_outcome": 10, "ayss": ayss})
+    cfg = load_pipeline(path)
+    assert cfg.evaluate.ayss.n_samples == 300 and cfg.evaluate.n_ayss is None
+    parsed: list[type] = []
+    real_build = experiment_module.build
+
+    def counting_build(cls: type, *args: object, **kwargs: object) -> object:
+        parsed.append(cls)
+        return real_build(cls, *args, **kwargs)
+
+    monkeypatch.setattr(experiment_module, "build", counting_build)
+    jobs = plan_jobs(cfg)
+    assert parsed == [ExperimentConfig]  # one case: one parse for its 4 jobs
+    assert len(jobs) == 4
+    assert all(j.ayss == AyssConfig(n_samples=300, h_m=(0.0, 4.0), seed=7) for j in jobs)
+    assert [j.experiment.env.vut for j in jobs] == [j.vut for j in jobs]
+    assert all(j.experiment.train.total_timesteps == 600 for j in jobs)
+    assert pickle.loads(pickle.dumps(jobs)) == jobs
 
 
 @pytest.mark.parametrize(
     ("extra", "match"),
     [
         ({"expected_order": ["pi1"]}, r"expected_order must list exactly the grid's VUTs"),
-        ({"report": {"mode": "fancy"}}, r"mode must be one of \['exposure', 'paper'\]"),
-        ({"report": {"premise_reward": -1}}, r"premise_reward must be a finite number >= 0"),
+        ({"report": {"mode": "fancy"}}, r"report\.mode must be one of \['exposure', 'paper'\]"),
+        (
+            {"report": {"premise_reward": -1}},
+            r"report\.premise_reward must be a finite number >= 0",
+        ),
+        ({"report": {"n_boot": 0}}, r"report\.n_boot must be an int >= 1, got 0"),
+        ({"report": {"levels": 0.9}}, r"report: unknown key 'levels' \(did you mean 'level'\?\)"),
+        ({"evaluate": {"ayss": {"h_m": [5, 0]}}}, r"evaluate\.ayss\.h_m must have min <= max"),
+        (
+            {"evaluate": {"n_ayss": 10, "ayss": {"n_samples": 20}}},
+            r"evaluate\.n_ayss \(10\) and evaluate\.ayss\.n_samples \(20\) differ",
+        ),
+        ({"evaluate": {"ayss": {"seeds": 1}}}, r"evaluate\.ayss: unknown key 'seeds'"),
         ({"vuts": {"x": {"model": "IDM", "params": {"tau": -1}}}}, r"vuts\.x"),
     ],
 )

@@ -19,9 +19,9 @@ import numpy.typing as npt
 import pytest
 import yaml
 
+from sumo_ayss.config import AyssConfig, load_experiment
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.evaluate import evaluate_run
-from sumo_ayss.experiment import load_experiment
 from sumo_ayss.replay import (
     POSITION_TOL_M,
     SPEED_TOL_MPS,
@@ -29,7 +29,6 @@ from sumo_ayss.replay import (
     main,
     replay_headless,
 )
-from sumo_ayss.scenarios.ayss import AyssConfig
 from sumo_ayss.scenarios.tables import AYSS_SCHEMA, OUTCOME_SCHEMA, read_table
 from sumo_ayss.sim.export import read_fcd
 from sumo_ayss.train import train
@@ -63,7 +62,7 @@ def ci_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A cut-in run folder (config only) evaluated with :func:`cut_in_policy`."""
     run = tmp_path_factory.mktemp("ci")
     (run / "config.yaml").write_text(
-        yaml.safe_dump({"env": {"case": "cut_in"}, "seed": 3, "vut": "pi2"})
+        yaml.safe_dump({"env": {"case": "cut_in", "vut": "pi2"}, "seed": 3})
     )
     evaluate_run(
         run, n_outcome=4, ayss=AyssConfig(n_samples=300), progress=False, policy=cut_in_policy

@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 import yaml
 
-from sumo_ayss.experiment import ExperimentConfig, load_experiment
+from sumo_ayss.config import ExperimentConfig, load_experiment
 from sumo_ayss.train import _CandidateCallback, read_eval_table, train
 from tests.helpers import TINY_AGENT
 

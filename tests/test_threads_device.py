@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 import torch as th
 
+from sumo_ayss.config import TrainConfig, load_experiment
 from sumo_ayss.errors import ConfigError
-from sumo_ayss.experiment import TrainConfig, load_experiment
 from sumo_ayss.threads import THREAD_ENV_VARS, set_torch_threads, single_thread_env
 from sumo_ayss.train import check_device, train
 from tests.test_train import tiny_config

@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from sumo_ayss.config import load_experiment
 from sumo_ayss.errors import CheckpointError
-from sumo_ayss.experiment import load_experiment
 from sumo_ayss.selection import select_spcp
 from sumo_ayss.train import read_eval_table, train
 from tests.helpers import TINY_AGENT
@@ -48,7 +48,8 @@ def test_train_writes_a_complete_run_folder(tmp_path: Path) -> None:
     assert spcp["step"] == select_spcp(rows).step  # the argmax of the table on disk
     assert (run / "spcp.zip").is_file()
     resolved = yaml.safe_load((run / "config.yaml").read_text())
-    assert resolved["vut"] == "pi2" and resolved["seed"] == 3
+    assert resolved["env"]["vut"] == "pi2" and resolved["seed"] == 3
+    assert "vut" not in resolved  # the VUT is written once, as env.vut
     assert resolved["agent"]["feature_net_arch"] == [32]
     versions = json.loads((run / "versions.json").read_text())
     assert versions["libsumo"] == "1.28.0"

@@ -8,13 +8,12 @@ rejects unknown keys and suggests the closest allowed one.
 from __future__ import annotations
 
 import dataclasses
-import difflib
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 from sumo_ayss.errors import ConfigError
+from sumo_ayss.validation import check_int, check_keys, check_number
 
 _DEFAULT_PREFIX = "agent"
 _ARCH_FIELDS = ("feature_net_arch", "value_net_arch", "advantage_net_arch")
@@ -117,14 +116,7 @@ class DQNHyperParams:
         """
         if not isinstance(data, Mapping):
             raise ConfigError(f"{prefix} must be a mapping, got {type(data).__name__}")
-        allowed = [f.name for f in dataclasses.fields(cls)]
-        for key in data:
-            if key not in allowed:
-                close = difflib.get_close_matches(str(key), allowed, n=1)
-                hint = f"; did you mean {prefix}.{close[0]}?" if close else ""
-                raise ConfigError(
-                    f"unknown key {prefix}.{key}{hint} (allowed keys: {', '.join(allowed)})"
-                )
+        check_keys(prefix, data, [f.name for f in dataclasses.fields(cls)])
         try:
             return cls(**dict(data))
         except ConfigError as err:
@@ -136,8 +128,8 @@ class DQNHyperParams:
     def _validate(self) -> None:
         """Check every field; raise :class:`ConfigError` naming the first bad one."""
         p = _DEFAULT_PREFIX
-        _check_float(p, "gamma", self.gamma, low=0.0, high=1.0, low_open=True)
-        _check_float(p, "learning_rate", self.learning_rate, low=0.0, low_open=True)
+        check_number(f"{p}.gamma", self.gamma, low=0.0, high=1.0, low_open=True)
+        check_number(f"{p}.learning_rate", self.learning_rate, low=0.0, low_open=True)
         for name in _BOOL_FIELDS:
             value = getattr(self, name)
             if not isinstance(value, bool):
@@ -148,58 +140,27 @@ class DQNHyperParams:
                 raise ConfigError(
                     f"{p}.{name} must be a list of positive ints (layer widths), got {value!r}"
                 )
-        _check_float(p, "per_alpha", self.per_alpha, low=0.0, high=1.0)
-        _check_float(p, "per_beta0", self.per_beta0, low=0.0, high=1.0)
-        if self.per_beta_steps is not None:
-            _check_int(p, "per_beta_steps", self.per_beta_steps, low=1, none_ok=True)
-        _check_float(p, "per_eps", self.per_eps, low=0.0, low_open=True)
-        _check_int(p, "buffer_size", self.buffer_size, low=1)
-        _check_int(p, "batch_size", self.batch_size, low=1)
-        _check_int(p, "learning_starts", self.learning_starts, low=0)
+        check_number(f"{p}.per_alpha", self.per_alpha, low=0.0, high=1.0)
+        check_number(f"{p}.per_beta0", self.per_beta0, low=0.0, high=1.0)
+        check_int(f"{p}.per_beta_steps", self.per_beta_steps, low=1, none_ok=True)
+        check_number(f"{p}.per_eps", self.per_eps, low=0.0, low_open=True)
+        check_int(f"{p}.buffer_size", self.buffer_size, low=1)
+        check_int(f"{p}.batch_size", self.batch_size, low=1)
+        check_int(f"{p}.learning_starts", self.learning_starts, low=0)
         if self.buffer_size < self.batch_size:
             raise ConfigError(
                 f"{p}.buffer_size ({self.buffer_size}) must be >= {p}.batch_size "
                 f"({self.batch_size}): a minibatch is drawn from the buffer"
             )
-        _check_int(p, "train_freq", self.train_freq, low=1)
-        _check_int(p, "gradient_steps", self.gradient_steps, low=1)
-        _check_int(p, "target_update_interval", self.target_update_interval, low=1)
-        _check_float(p, "exploration_fraction", self.exploration_fraction, low=0.0, high=1.0)
-        _check_float(p, "exploration_initial_eps", self.exploration_initial_eps, 0.0, 1.0)
-        _check_float(p, "exploration_final_eps", self.exploration_final_eps, 0.0, 1.0)
-        _check_float(p, "max_grad_norm", self.max_grad_norm, low=0.0, low_open=True)
+        check_int(f"{p}.train_freq", self.train_freq, low=1)
+        check_int(f"{p}.gradient_steps", self.gradient_steps, low=1)
+        check_int(f"{p}.target_update_interval", self.target_update_interval, low=1)
+        check_number(f"{p}.exploration_fraction", self.exploration_fraction, low=0.0, high=1.0)
+        check_number(f"{p}.exploration_initial_eps", self.exploration_initial_eps, 0.0, 1.0)
+        check_number(f"{p}.exploration_final_eps", self.exploration_final_eps, 0.0, 1.0)
+        check_number(f"{p}.max_grad_norm", self.max_grad_norm, low=0.0, low_open=True)
 
 
 def _is_int(value: object) -> bool:
     """Return whether ``value`` is an int and not a bool."""
     return isinstance(value, int) and not isinstance(value, bool)
-
-
-def _check_int(prefix: str, name: str, value: object, low: int, none_ok: bool = False) -> None:
-    """Raise :class:`ConfigError` unless ``value`` is an int >= ``low``."""
-    if not _is_int(value) or value < low:  # type: ignore[operator]
-        extra = " or null" if none_ok else ""
-        raise ConfigError(f"{prefix}.{name} must be an int >= {low}{extra}, got {value!r}")
-
-
-def _check_float(
-    prefix: str,
-    name: str,
-    value: object,
-    low: float,
-    high: float = math.inf,
-    low_open: bool = False,
-) -> None:
-    """Raise :class:`ConfigError` unless ``value`` is a finite real number in the interval."""
-    left = "(" if low_open else "["
-    right = ")" if math.isinf(high) else "]"
-    interval = f"{left}{low:g}, {'inf' if math.isinf(high) else f'{high:g}'}{right}"
-    ok = (
-        isinstance(value, int | float)
-        and not isinstance(value, bool)
-        and math.isfinite(value)
-        and (value > low if low_open else value >= low)
-        and value <= high
-    )
-    if not ok:
-        raise ConfigError(f"{prefix}.{name} must be in {interval}, got {value!r}")

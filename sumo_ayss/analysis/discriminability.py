@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -24,6 +24,7 @@ import numpy.typing as npt
 
 from sumo_ayss.analysis.metrics import ttc_longitudinal
 from sumo_ayss.errors import ConfigError
+from sumo_ayss.validation import check_range
 
 __all__ = [
     "DEFAULT_THRESHOLD_MPS2",
@@ -42,18 +43,6 @@ BoolArray = npt.NDArray[np.bool_]
 
 #: Two responses "differ" where they are further apart than this [m/s²].
 DEFAULT_THRESHOLD_MPS2 = 0.1
-
-
-def check_range(where: str, value: Sequence[float], low: float = -math.inf) -> tuple[float, float]:
-    """``value`` as a finite ``(min, max)`` with ``low <= min <= max``; ConfigError naming
-    ``where`` otherwise."""
-    try:
-        lo, hi = (float(v) for v in value)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{where} must be [min, max], got {value!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and low <= lo <= hi):
-        raise ConfigError(f"{where} must be finite with {low} <= min <= max, got [{lo}, {hi}]")
-    return lo, hi
 
 
 def _positive(where: str, value: float) -> float:

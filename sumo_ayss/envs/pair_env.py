@@ -146,7 +146,9 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         self._reward_cfg = config.reward
         # A user controller VUT (None for SUMO's own models): it computes the VUT's speed
         # before every SUMO step, from what a real vehicle would sense.
-        self._vut_control = ControlledVut.from_vehicle_type(config.vut_type, self._dt_s)
+        self._vut_control = ControlledVut.from_vehicle_type(
+            config.vut_type, self._dt_s, f"env.vuts.{config.vut}.controller"
+        )
         # highway-env's laws (sumo_ayss.hwenv_laws), integrated here at ``substeps`` Euler
         # sub-steps per SUMO step: the POV in actuator mode highway_env, and a VUT whose
         # controller is HighwayEnvIDM. None in the default mode (no per-step cost there).

@@ -1,16 +1,18 @@
-"""Statistical settings and analysis modes of a report (no heavy imports: configuration
-loads this module, the report and the leaderboard use it)."""
+"""Statistical settings and analysis modes of a report, section ``report`` of a pipeline
+YAML (no heavy imports: configuration loads this module, the report and the leaderboard use
+it)."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import ClassVar, Literal
+from typing import TYPE_CHECKING, ClassVar, Literal
 
-import numpy as np
+from sumo_ayss.validation import check_choice, check_int, check_number, require
 
-from sumo_ayss.errors import ConfigError
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = ["MODES", "ReportOptions"]
 
@@ -72,20 +74,25 @@ class ReportOptions:
     premise_final_headway_m: float = 2.0
 
     def __post_init__(self) -> None:
-        if self.mode not in MODES:
-            raise ConfigError(f"mode must be one of {list(MODES)}, got {self.mode!r}")
+        s = self.SECTION
+        check_choice(f"{s}.mode", self.mode, list(MODES))
         for name in ("premise_reward", "premise_crash_rate", "premise_final_headway_m"):
             value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0):
-                raise ConfigError(f"{name} must be a finite number >= 0, got {value!r}")
-        if not (math.isfinite(self.h_max_m) and self.h_max_m > 0):
-            raise ConfigError(f"h_max_m must be > 0, got {self.h_max_m}")
-        if not (0 < self.bin_width_m <= self.h_max_m):
-            raise ConfigError(f"bin_width_m must be in (0, h_max_m], got {self.bin_width_m}")
-        if self.index_bins < 1 or self.n_boot < 1:
-            raise ConfigError("index_bins and n_boot must be >= 1")
-        if not (0 < self.level < 1 and 0 < self.welch_alpha < 1):
-            raise ConfigError("level and welch_alpha must be in (0, 1)")
+            require(
+                isinstance(value, int | float) and math.isfinite(value) and value >= 0,
+                f"{s}.{name} must be a finite number >= 0, got {value!r}",
+            )
+        check_number(f"{s}.h_max_m", self.h_max_m, low=0.0, low_open=True)
+        require(
+            0 < self.bin_width_m <= self.h_max_m,
+            f"{s}.bin_width_m must be in (0, h_max_m = {self.h_max_m}], got {self.bin_width_m}",
+        )
+        check_int(f"{s}.index_bins", self.index_bins, low=1)
+        check_int(f"{s}.n_boot", self.n_boot, low=1)
+        check_int(f"{s}.rng_seed", self.rng_seed, low=0)
+        for name in ("level", "welch_alpha"):
+            value = getattr(self, name)
+            require(0 < value < 1, f"{s}.{name} must be in (0, 1), got {value!r}")
 
     @property
     def premise_tolerances(self) -> dict[str, float]:
@@ -104,5 +111,7 @@ class ReportOptions:
     @property
     def figure_edges(self) -> np.ndarray:
         """Headway bin edges of the indicator figure, m."""
+        import numpy as np  # lazily: configuration loads this module
+
         n = max(1, round(self.h_max_m / self.bin_width_m))
         return np.linspace(0.0, self.h_max_m, n + 1)

@@ -40,19 +40,17 @@ sample in draw order; a seed gives the same table every time.
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 from tqdm import tqdm
 
-from sumo_ayss.analysis.discriminability import check_range
 from sumo_ayss.analysis.metrics import ttc_longitudinal
-from sumo_ayss.config import ActuatorConfig, OddConfig
+from sumo_ayss.config import ActuatorConfig, AyssConfig
 from sumo_ayss.envs.car_following import target_speed_mps as cf_target_speed_mps
 from sumo_ayss.envs.cut_in import LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
@@ -69,10 +67,8 @@ from sumo_ayss.scenarios.tables import (
 from sumo_ayss.sim.actuator import pov_acceleration
 
 __all__ = [
-    "DEFAULT_AYSS_SEED",
     "INDICATOR_ACCEL",
     "INDICATOR_DELTA_V_BAR",
-    "AyssConfig",
     "AyssResult",
     "CutInStepResult",
     "car_following_indicator",
@@ -85,79 +81,12 @@ __all__ = [
     "ttc_s",
 ]
 
-#: Default Monte Carlo seed, shared by every SPCP (common random numbers across VUTs).
-DEFAULT_AYSS_SEED = 4242
-
 #: Reset must reproduce a sample to this tolerance [m, m/s] (float32 observation).
 _RESET_TOL = 1e-3
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 BoolArray = npt.NDArray[np.bool_]
-
-
-# --------------------------------------------------------------------------- configuration
-
-
-def _positive_int(where: str, value: object) -> None:
-    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-        raise ConfigError(f"{where} must be an integer >= 1, got {value!r}")
-
-
-@dataclass(frozen=True)
-class AyssConfig:
-    """Monte Carlo settings of the AYSS stage. Units m, m/s, s.
-
-    Defaults: speeds over the whole observed range up to the 30 m/s speed limit, [0, 30] m/s
-    (the ODD only says where episodes *start*; within an episode the POV brakes down towards
-    0, so the SPCP acts on slower states too; :meth:`from_odd` restricts the speeds to the
-    ODD instead). Headways in [0, 5] m, the kept range, so that no draw is wasted on the h
-    filter; a wider ``h_m`` box is sampled and then filtered the same way. 100,000 draws
-    keep about 10,000 samples per 0.5 m headway bin in car-following, so a bin's 95 %
-    interval of the mean acceleration is about ±0.05 m/s² wide for a 3 m/s² spread.
-
-    Attributes:
-        n_samples: Monte Carlo draws (before filtering), >= 1.
-        v_pov_mps: Sampled POV speed range [m/s].
-        v_vut_mps: Sampled VUT speed range [m/s].
-        h_m: Sampled headway range [m] (POV rear bumper minus VUT front bumper).
-        max_headway_m: Keep ``h <= max_headway_m`` (paper: 5 m).
-        min_ttc_s: Keep ``TTC >= min_ttc_s`` (paper: 0.2 s).
-        seed: Seed of the draws; the same seed gives the same samples for every SPCP.
-        batch_size: Observations per policy forward pass.
-    """
-
-    SECTION: ClassVar[str] = "ayss"
-
-    n_samples: int = 100_000
-    v_pov_mps: tuple[float, float] = (0.0, 30.0)
-    v_vut_mps: tuple[float, float] = (0.0, 30.0)
-    h_m: tuple[float, float] = (0.0, 5.0)
-    max_headway_m: float = 5.0
-    min_ttc_s: float = 0.2
-    seed: int = DEFAULT_AYSS_SEED
-    batch_size: int = 65_536
-
-    def __post_init__(self) -> None:
-        s = self.SECTION
-        _positive_int(f"{s}.n_samples", self.n_samples)
-        _positive_int(f"{s}.batch_size", self.batch_size)
-        for name, low in (("v_pov_mps", 0.0), ("v_vut_mps", 0.0), ("h_m", -math.inf)):
-            object.__setattr__(self, name, check_range(f"{s}.{name}", getattr(self, name), low))
-        if not (math.isfinite(self.max_headway_m) and self.max_headway_m > 0):
-            raise ConfigError(f"{s}.max_headway_m must be > 0, got {self.max_headway_m}")
-        if not (math.isfinite(self.min_ttc_s) and self.min_ttc_s >= 0):
-            raise ConfigError(f"{s}.min_ttc_s must be >= 0, got {self.min_ttc_s}")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
-            raise ConfigError(f"{s}.seed must be an integer >= 0, got {self.seed!r}")
-
-    @classmethod
-    def from_odd(cls, odd: OddConfig, **overrides: Any) -> AyssConfig:
-        """Speeds sampled in the ODD's ranges instead of [0, 30] m/s."""
-        return cls(**{"v_pov_mps": odd.pov_speed_mps, "v_vut_mps": odd.vut_speed_mps, **overrides})
-
-    def to_dict(self) -> dict[str, Any]:
-        return {k: list(v) if isinstance(v, tuple) else v for k, v in self.__dict__.items()}
 
 
 # --------------------------------------------------------------------------- sampling, filters

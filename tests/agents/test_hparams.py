@@ -92,21 +92,22 @@ def test_from_mapping_accepts_lists_and_keeps_defaults() -> None:
 
 def test_from_mapping_unknown_key_suggests() -> None:
     with pytest.raises(
-        ConfigError, match=r"unknown key agent\.gama; did you mean agent\.gamma\?"
+        ConfigError, match=r"^agent: unknown key 'gama' \(did you mean 'gamma'\?\)"
     ) as err:
         DQNHyperParams.from_mapping({"gama": 0.9})
-    assert "allowed keys: gamma, learning_rate" in str(err.value)
+    assert "allowed: ['advantage_net_arch', 'batch_size', " in str(err.value)
+    assert "'gamma', 'gradient_steps', 'learning_rate'" in str(err.value)
 
 
 def test_from_mapping_unknown_key_without_close_match() -> None:
-    with pytest.raises(ConfigError, match=r"unknown key agent\.zzz \(allowed keys: "):
+    with pytest.raises(ConfigError, match=r"^agent: unknown key 'zzz'; allowed: \["):
         DQNHyperParams.from_mapping({"zzz": 1})
 
 
 def test_from_mapping_uses_prefix() -> None:
     with pytest.raises(ConfigError, match=r"^learner\.per_alpha must be in \[0, 1\], got 2"):
         DQNHyperParams.from_mapping({"per_alpha": 2}, prefix="learner")
-    with pytest.raises(ConfigError, match=r"unknown key learner\.batchsize; did you mean"):
+    with pytest.raises(ConfigError, match=r"^learner: unknown key 'batchsize' \(did you mean"):
         DQNHyperParams.from_mapping({"batchsize": 2}, prefix="learner")
 
 

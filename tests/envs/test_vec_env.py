@@ -25,13 +25,12 @@ from stable_baselines3.common.vec_env.util import obs_space_info
 
 from sumo_ayss.agents import AyssDQN
 from sumo_ayss.agents.hparams import DQNHyperParams
-from sumo_ayss.config import ActuatorConfig, EnvConfig, SimConfig
+from sumo_ayss.config import ActuatorConfig, EnvConfig, SimConfig, load_experiment
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.cut_in import LANE_CHANGE
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
 from sumo_ayss.envs.vec_env import PairVecEnv
 from sumo_ayss.errors import ActionError, ConfigError
-from sumo_ayss.experiment import load_experiment
 from sumo_ayss.scenarios.rollout import run_episodes
 from sumo_ayss.sim.network import (
     NETWORK_DIR,

@@ -9,13 +9,12 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 
-from sumo_ayss.config import ActuatorConfig
+from sumo_ayss.config import ActuatorConfig, AyssConfig
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.cut_in import FIRST_SPEED_ACTION, LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.errors import ActionError, ConfigError
 from sumo_ayss.scenarios.ayss import (
-    AyssConfig,
     car_following_indicator,
     cut_in_mask,
     run_ayss,

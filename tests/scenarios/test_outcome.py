@@ -12,12 +12,11 @@ import numpy.typing as npt
 import pytest
 import yaml
 
+from sumo_ayss.config import AyssConfig, load_experiment
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.evaluate import evaluate_run, main
-from sumo_ayss.experiment import load_experiment
-from sumo_ayss.scenarios.ayss import AyssConfig
 from sumo_ayss.scenarios.outcome import (
     MeanInterval,
     Proportion,

@@ -16,8 +16,11 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from sumo_ayss.agents.hparams import DQNHyperParams
-from sumo_ayss.config import EnvConfig, _require, build, check_seed, read_yaml, to_dict
+from sumo_ayss.config.env import EnvConfig
+from sumo_ayss.config.mapping import build, to_dict
+from sumo_ayss.config.yaml_io import read_yaml
 from sumo_ayss.selection import CRITERIA
+from sumo_ayss.validation import check_choice, check_seed, require
 
 
 @dataclass(frozen=True)
@@ -63,22 +66,19 @@ class TrainConfig:
             "n_envs",
         ):
             value = getattr(self, name)
-            _require(value >= 1, f"{s}.{name} must be >= 1, got {value}")
+            require(value >= 1, f"{s}.{name} must be >= 1, got {value}")
         check_seed(self.eval_seed, f"{s}.eval_seed")
-        _require(
+        require(
             self.eval_every <= self.total_timesteps,
             f"{s}.eval_every ({self.eval_every}) must be <= total_timesteps "
             f"({self.total_timesteps})",
         )
-        _require(
+        require(
             isinstance(self.device, str)
             and re.fullmatch(r"cpu|cuda(:[0-9]+)?", self.device) is not None,
             f"{s}.device must be 'cpu', 'cuda' or 'cuda:<index>', got {self.device!r}",
         )
-        _require(
-            self.selection in CRITERIA,
-            f"{s}.selection must be one of {sorted(CRITERIA)}, got {self.selection!r}",
-        )
+        check_choice(f"{s}.selection", self.selection, sorted(CRITERIA))
 
 
 @dataclass(frozen=True)
@@ -91,7 +91,7 @@ class ExperimentConfig:
 
     def __post_init__(self) -> None:
         a, t = self.agent, self.train
-        _require(
+        require(
             a.learning_starts < t.total_timesteps,
             f"agent.learning_starts ({a.learning_starts}) must be < train.total_timesteps "
             f"({t.total_timesteps}): otherwise the run never learns",

@@ -1,0 +1,92 @@
+"""Typed, validated configuration: defaults in code, YAML holds overrides.
+
+Every section is a frozen dataclass checked in ``__post_init__``; a bad value raises
+:class:`~sumo_ayss.errors.ConfigError` naming the dotted field and the allowed values
+(the idiom of :mod:`sumo_ayss.validation`). YAML files are merged over the defaults by
+:func:`build`; unknown keys are rejected with a suggestion, relative paths resolve against
+the YAML file's folder.
+
+Sections and their modules:
+
+* ``env`` (:class:`EnvConfig` and its ``sim``, ``actuator``, ``odd``, ``reward``):
+  :mod:`sumo_ayss.config.env`;
+* an experiment, ``env`` + ``agent`` + ``train`` (:class:`ExperimentConfig`):
+  :mod:`sumo_ayss.config.experiment`;
+* the AYSS Monte Carlo (:class:`AyssConfig`): :mod:`sumo_ayss.config.ayss`;
+* a pipeline, ``grid``, ``experiments``, ``evaluate``, ``report``, ... (:class:`PipelineConfig`):
+  :mod:`sumo_ayss.config.pipeline`.
+
+A configuration is parsed once and then travels as is (it pickles: worker processes and Ray
+tasks receive the frozen record). Importing this package imports neither torch, libsumo nor
+stable-baselines3, and reading a config runs no user code: a controller VUT is imported when
+an env that drives it is built.
+
+Units: lengths m, speeds m/s, accelerations m/s², times s. Sign convention: accelerations
+are positive forward, braking is negative (the POV actuator bounds are ``[-6, 6]`` m/s²).
+"""
+
+from __future__ import annotations
+
+from sumo_ayss.config.ayss import DEFAULT_AYSS_SEED, AyssConfig
+from sumo_ayss.config.env import (
+    MANAGED_SUMO_OPTIONS,
+    PROJECT_ROOT,
+    ActuatorConfig,
+    ActuatorMode,
+    Case,
+    EnvConfig,
+    OddConfig,
+    RewardConfig,
+    RewardShape,
+    ShapeKind,
+    SimConfig,
+)
+from sumo_ayss.config.experiment import (
+    ExperimentConfig,
+    TrainConfig,
+    experiment_from_dict,
+    load_experiment,
+)
+from sumo_ayss.config.mapping import build, env_config_from_mapping, to_dict
+from sumo_ayss.config.pipeline import (
+    EvaluateConfig,
+    GridConfig,
+    PipelineConfig,
+    load_pipeline,
+)
+from sumo_ayss.config.yaml_io import read_yaml, safe_load_yaml, write_yaml
+from sumo_ayss.validation import SEED_MAX, check_out_dir, check_seed, check_sumo_network
+
+__all__ = [
+    "DEFAULT_AYSS_SEED",
+    "MANAGED_SUMO_OPTIONS",
+    "PROJECT_ROOT",
+    "SEED_MAX",
+    "ActuatorConfig",
+    "ActuatorMode",
+    "AyssConfig",
+    "Case",
+    "EnvConfig",
+    "EvaluateConfig",
+    "ExperimentConfig",
+    "GridConfig",
+    "OddConfig",
+    "PipelineConfig",
+    "RewardConfig",
+    "RewardShape",
+    "ShapeKind",
+    "SimConfig",
+    "TrainConfig",
+    "build",
+    "check_out_dir",
+    "check_seed",
+    "check_sumo_network",
+    "env_config_from_mapping",
+    "experiment_from_dict",
+    "load_experiment",
+    "load_pipeline",
+    "read_yaml",
+    "safe_load_yaml",
+    "to_dict",
+    "write_yaml",
+]

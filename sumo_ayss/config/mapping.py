@@ -1,0 +1,147 @@
+"""Mapping -> frozen dataclass, and back: how YAML (and a run folder's ``config.yaml``)
+becomes a configuration record.
+
+:func:`build` merges a mapping over a section's defaults (or over a given record), converts
+each value to its field's type and rejects unknown keys with a suggestion; the section's own
+``__post_init__`` then checks the values. Relative paths resolve against ``base_dir`` (the
+YAML file's folder). :func:`to_dict` is the inverse (YAML-safe plain data).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+import typing
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, Literal
+
+from sumo_ayss.catalog import ControllerSpec, VehicleType
+from sumo_ayss.config.env import EnvConfig
+from sumo_ayss.errors import ConfigError
+from sumo_ayss.validation import check_choice, unknown_key
+
+
+def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> Any:
+    origin = typing.get_origin(tp)
+    args = typing.get_args(tp)
+    if tp is ControllerSpec:  # free-form params: parsed and validated by the catalog
+        if isinstance(value, ControllerSpec):
+            return value
+        return ControllerSpec.from_mapping(value, where)
+    if dataclasses.is_dataclass(tp) and isinstance(tp, type):
+        if isinstance(value, tp):
+            return value
+        return build(tp, value, where, base_dir, default)
+    if tp is VehicleType:
+        return VehicleType.from_mapping(value, where)
+    if origin in (types.UnionType, typing.Union):
+        if value is None and type(None) in args:
+            return None
+        non_none = [a for a in args if a is not type(None)]
+        return _convert(non_none[0], value, where, base_dir, default)
+    if origin is Literal:
+        check_choice(where, value, args)
+        return value
+    if tp is Path:
+        if not isinstance(value, str | Path):
+            raise ConfigError(f"{where} must be a path string, got {value!r}")
+        path = Path(value).expanduser()
+        return path if path.is_absolute() else (base_dir / path).resolve()
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(f"{where} must be true or false, got {value!r}")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{where} must be an integer, got {value!r}")
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ConfigError(f"{where} must be a number, got {value!r}")
+        if not math.isfinite(value):  # YAML's .inf / .nan: no field of ours takes them
+            raise ConfigError(f"{where} must be a finite number, got {value!r}")
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str):
+            raise ConfigError(f"{where} must be a string, got {value!r}")
+        return value
+    if origin is tuple:
+        if not isinstance(value, list | tuple):
+            raise ConfigError(f"{where} must be a list, got {value!r}")
+        item_types = [args[0]] * len(value) if (len(args) == 2 and args[1] is Ellipsis) else args
+        if len(item_types) != len(value):
+            raise ConfigError(f"{where} must have {len(item_types)} items, got {list(value)}")
+        return tuple(
+            _convert(t, v, f"{where}[{i}]", base_dir, None)
+            for i, (t, v) in enumerate(zip(item_types, value, strict=True))
+        )
+    if origin in (Mapping, dict) or tp is dict:
+        if not isinstance(value, Mapping):
+            raise ConfigError(f"{where} must be a mapping, got {value!r}")
+        # A catalog of VUTs extends the built-ins; any other mapping (e.g. the pipeline's
+        # ``experiments``) replaces its default whole, so ``{}`` never falls back silently.
+        merged = dict(default or {}) if args and args[1] is VehicleType else {}
+        for k, v in value.items():
+            merged[str(k)] = _convert(args[1], v, f"{where}.{k}", base_dir, merged.get(str(k)))
+        return merged
+    raise ConfigError(f"{where}: unsupported type {tp!r}")  # pragma: no cover
+
+
+def build(cls: type, data: Any, where: str, base_dir: Path, default: Any = None) -> Any:
+    """Build dataclass ``cls`` from a mapping, over ``default`` (or the class defaults).
+
+    Errors name the dotted field under ``where``: a section whose checks name its usual
+    place (``SECTION``, e.g. ``ayss``) gets ``where`` instead when it sits elsewhere
+    (``evaluate.ayss``).
+    """
+    if data is None:
+        data = {}
+    if not isinstance(data, Mapping):
+        raise ConfigError(f"{where or 'config'} must be a mapping, got {data!r}")
+    hints = typing.get_type_hints(cls)
+    names = [f.name for f in dataclasses.fields(cls)]
+    base = default if default is not None else None
+    kwargs: dict[str, Any] = {}
+    for key, value in data.items():
+        if key not in names:
+            raise unknown_key(where or "config", str(key), names)
+        sub_default = getattr(base, key) if base is not None else _field_default(cls, key)
+        child = f"{where}.{key}" if where else str(key)
+        kwargs[key] = _convert(hints[key], value, child, base_dir, sub_default)
+    try:
+        return dataclasses.replace(base, **kwargs) if base is not None else cls(**kwargs)
+    except ConfigError as e:
+        section = getattr(cls, "SECTION", "")
+        message = str(e)
+        if section and where and where != section and message.startswith(section + "."):
+            raise ConfigError(where + message[len(section) :]) from e
+        raise
+
+
+def _field_default(cls: type, name: str) -> Any:
+    f = next(f for f in dataclasses.fields(cls) if f.name == name)
+    if f.default is not dataclasses.MISSING:
+        return f.default
+    if f.default_factory is not dataclasses.MISSING:
+        return f.default_factory()
+    return None
+
+
+def to_dict(obj: Any) -> Any:
+    """Plain YAML-safe form of a config (the exact resolved config a run used)."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: to_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, Mapping):
+        return {str(k): to_dict(v) for k, v in obj.items()}
+    if isinstance(obj, tuple | list):
+        return [to_dict(v) for v in obj]
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def env_config_from_mapping(data: Mapping[str, Any], base_dir: Path | None = None) -> EnvConfig:
+    """Build an :class:`EnvConfig` from the contents of an ``env:`` section."""
+    return build(EnvConfig, data, "env", base_dir or Path.cwd())

@@ -1,0 +1,137 @@
+"""The pipeline's own sections: ``grid``, ``experiments``, ``evaluate`` (with ``ayss``),
+``report``, ``vuts``, ``out`` and the parallelism (see :mod:`sumo_ayss.pipeline`)."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import typing
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar
+
+from sumo_ayss.catalog import VehicleType
+from sumo_ayss.config.ayss import AyssConfig
+from sumo_ayss.config.env import PROJECT_ROOT, Case
+from sumo_ayss.config.mapping import build
+from sumo_ayss.config.yaml_io import read_yaml
+from sumo_ayss.frozen import FrozenMap
+from sumo_ayss.report.options import ReportOptions
+from sumo_ayss.validation import check_seed, require, suggest
+
+
+@dataclass(frozen=True)
+class GridConfig:
+    """The grid of jobs. Section ``grid``."""
+
+    SECTION: ClassVar[str] = "grid"
+
+    cases: tuple[Case, ...] = ("car_following", "cut_in")
+    vuts: tuple[str, ...] = ("pi1", "pi2")
+    seeds: tuple[int, ...] = (0, 1, 2)
+
+    def __post_init__(self) -> None:
+        for name in ("cases", "vuts", "seeds"):
+            values = getattr(self, name)
+            require(len(values) > 0, f"grid.{name} must not be empty")
+            require(len(set(values)) == len(values), f"grid.{name} has duplicates: {list(values)}")
+        for seed in self.seeds:
+            check_seed(seed, "grid.seeds[]")
+
+
+@dataclass(frozen=True)
+class EvaluateConfig:
+    """The outcome and AYSS stages of every job. Section ``evaluate``."""
+
+    SECTION: ClassVar[str] = "evaluate"
+
+    n_outcome: int = 200
+    """Outcome episodes per job (paper: 200)."""
+    ayss: AyssConfig = field(default_factory=AyssConfig)
+    """Monte Carlo settings of the AYSS stage (section ``evaluate.ayss``)."""
+    n_ayss: int | None = None
+    """Shorthand for ``ayss.n_samples`` (Monte Carlo draws), or None: ``ayss`` decides."""
+
+    def __post_init__(self) -> None:
+        s = self.SECTION
+        require(self.n_outcome >= 1, f"{s}.n_outcome must be >= 1, got {self.n_outcome}")
+        if self.n_ayss is None or self.n_ayss == self.ayss.n_samples:
+            return
+        require(self.n_ayss >= 1, f"{s}.n_ayss must be >= 1, got {self.n_ayss}")
+        require(
+            self.ayss.n_samples == AyssConfig().n_samples,
+            f"{s}.n_ayss ({self.n_ayss}) and {s}.ayss.n_samples ({self.ayss.n_samples}) "
+            "differ; give one of them",
+        )
+        object.__setattr__(self, "ayss", dataclasses.replace(self.ayss, n_samples=self.n_ayss))
+
+
+@dataclass(frozen=True)
+class PipelineConfig:
+    """A whole batch: grid, experiment file per case, output folder, parallelism."""
+
+    grid: GridConfig = field(default_factory=GridConfig)
+    experiments: Mapping[str, Path] = field(
+        default_factory=lambda: {
+            "car_following": PROJECT_ROOT / "configs" / "car_following.yaml",
+            "cut_in": PROJECT_ROOT / "configs" / "cut_in.yaml",
+        }
+    )
+    out: Path = Path("runs") / "paper"
+    total_timesteps: int | None = None
+    eval_every: int | None = None
+    evaluate: EvaluateConfig = field(default_factory=EvaluateConfig)
+    vuts: Mapping[str, VehicleType] = field(default_factory=dict)
+    """Extra VUTs (catalog syntax, as in ``env.vuts``) added to every case's experiment, so
+    that a leaderboard defines its VUTs once for all cases."""
+    report: ReportOptions = field(default_factory=ReportOptions)
+    """Statistical settings and analysis mode of the report and the ranking."""
+    expected_order: tuple[str, ...] = ()
+    """A known safety order of the grid's VUTs, safest first (validation studies such as
+    ladders): ``rank`` then reports Kendall's τ of its ranking against it and whether the
+    two ends differ significantly. Empty: no known order."""
+    workers: int = 0
+    retries: int = 1
+
+    def __post_init__(self) -> None:
+        require(self.workers >= 0, f"workers must be >= 0, got {self.workers}")
+        require(self.retries >= 0, f"retries must be >= 0, got {self.retries}")
+        if self.expected_order:
+            require(
+                sorted(self.expected_order) == sorted(self.grid.vuts),
+                f"expected_order must list exactly the grid's VUTs {sorted(self.grid.vuts)}, "
+                f"got {list(self.expected_order)}",
+            )
+        object.__setattr__(self, "vuts", FrozenMap(self.vuts))
+        for name, vt in self.vuts.items():
+            vt.validate(f"vuts.{name}")
+        known = typing.get_args(Case)
+        for case in self.experiments:
+            require(
+                case in known,
+                f"experiments.{case}: unknown case{suggest(case, known)}; allowed: {list(known)}",
+            )
+        for case in self.grid.cases:
+            require(
+                case in self.experiments,
+                f"experiments has no file for case {case!r}; given: {sorted(self.experiments)}",
+            )
+
+    @property
+    def n_workers(self) -> int:
+        return self.workers or os.cpu_count() or 1
+
+
+def load_pipeline(path: str | Path | None, **overrides: Any) -> PipelineConfig:
+    """Pipeline YAML over defaults, then ``overrides`` (None values are ignored)."""
+    if path is None:
+        cfg = PipelineConfig()
+    else:
+        path = Path(path)
+        cfg = build(PipelineConfig, read_yaml(path), "", path.resolve().parent)
+    clean = {k: v for k, v in overrides.items() if v is not None}
+    seeds = clean.pop("seeds", None)
+    if seeds is not None:
+        clean["grid"] = dataclasses.replace(cfg.grid, seeds=tuple(int(x) for x in seeds))
+    return dataclasses.replace(cfg, **clean) if clean else cfg

@@ -1,0 +1,177 @@
+"""The pipeline's local scheduler: jobs on a pool of spawned worker processes, with
+retries, progress events, a live table, and a clean stop on Ctrl-C or SIGTERM.
+
+One SUMO per process (libsumo holds one simulation each), so jobs run in separate
+interpreters (``spawn``: no inherited libsumo state).
+"""
+
+from __future__ import annotations
+
+import collections
+import logging
+import multiprocessing
+import sys
+import threading
+import time
+import traceback
+from collections.abc import Sequence
+from concurrent.futures import Future, ProcessPoolExecutor
+from typing import Any
+
+from sumo_ayss.jobs import JobSpec, run_job
+from sumo_ayss.progress import GridProgress, JobStatus, format_duration
+
+logger = logging.getLogger("sumo_ayss.pipeline")
+
+
+def _worker_init() -> None:
+    """Worker initializer: die with the pipeline, and leave Ctrl-C to it.
+
+    On Linux a worker gets SIGKILLed when the pipeline process dies: without it a killed
+    pipeline leaves its workers running, and a rerun would race them for the same run
+    folders. A Ctrl-C reaches every process of the terminal's group; workers ignore it and
+    the pipeline stops them (:func:`_stop_workers`), so that no job starts afterwards.
+    It also runs before any job imports torch, so that torch's intra-op pool starts with one
+    BLAS/OpenMP thread (``run_job`` then applies ``train.torch_threads``).
+    """
+    import signal
+
+    from sumo_ayss.threads import single_thread_env
+
+    single_thread_env()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        pr_set_pdeathsig = 1
+        libc.prctl(pr_set_pdeathsig, signal.SIGKILL)
+
+
+def _stop_workers(pool: ProcessPoolExecutor, grace_s: float = 3.0) -> None:
+    """Terminate the pool's worker processes now (SIGTERM, then SIGKILL after ``grace_s``).
+
+    Safe for the run folders: every result is written atomically and a rerun resumes from
+    the last checkpoint (:func:`sumo_ayss.train.train`).
+    """
+    processes = list(getattr(pool, "_processes", {}).values())  # CPython's worker table
+    for proc in processes:
+        if proc.is_alive():
+            proc.terminate()
+    deadline = time.monotonic() + grace_s
+    for proc in processes:
+        proc.join(max(0.0, deadline - time.monotonic()))
+        if proc.is_alive():
+            proc.kill()
+            proc.join(1.0)
+    pool.shutdown(wait=False, cancel_futures=True)
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, handled as a Ctrl-C."""
+
+
+def _raise_terminated(signum: int, frame: Any) -> None:
+    raise _Terminated
+
+
+def run_grid_local(
+    jobs: Sequence[JobSpec], workers: int, retries: int, live: Any = None
+) -> list[JobStatus]:
+    """Run ``jobs`` on a local process pool with retries; report progress as it goes.
+
+    At most ``workers`` jobs are handed to the pool at a time; the others wait here, so the
+    jobs shown as running are the ones a worker holds, and a Ctrl-C (SIGINT) or SIGTERM
+    cancels them at once: running jobs are terminated (their state is ``interrupted``,
+    resumable), queued ones never start (``cancelled``), and the KeyboardInterrupt
+    propagates to the caller within seconds. Every job event is logged (one line each, with
+    the grid's counts and ETA); ``live`` (a :class:`rich.console.Console`, or None for
+    none) also shows a table of every job that refreshes twice a second.
+    """
+    import signal
+
+    statuses = [JobStatus(j) for j in jobs]
+    progress = GridProgress(statuses, workers)
+    queue: collections.deque[JobStatus] = collections.deque(statuses)
+    ctx = multiprocessing.get_context("spawn")  # fresh interpreters: no inherited libsumo
+    logger.info(
+        "%d jobs on %d worker processes; each job logs to <run folder>/job.log",
+        len(jobs),
+        workers,
+    )
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init)
+    pending: dict[Future[dict[str, Any]], JobStatus] = {}
+    in_main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _raise_terminated) if in_main else None
+    display = None
+
+    def submit(s: JobStatus) -> None:
+        s.start()
+        pending[pool.submit(run_job, s.spec)] = s
+        logger.info(progress.line(s, f"started (try {s.attempts})"))
+
+    try:
+        display = _live(progress, live) if live is not None else None
+        while pending or queue:
+            while queue and len(pending) < workers:
+                submit(queue.popleft())
+            finished = [f for f in list(pending) if f.done()]
+            for event in progress.poll():  # also the last events of the finished jobs
+                logger.info(event)
+            for fut in finished:
+                s = pending.pop(fut)
+                try:
+                    result = fut.result()
+                except Exception as e:  # a job's failure is data here
+                    s.error = "".join(traceback.format_exception_only(e)).strip()
+                    s.stage = ""
+                    if s.attempts <= retries:
+                        s.state = "queued"
+                        queue.appendleft(s)
+                        logger.warning(progress.line(s, f"failed ({s.error}); will retry"))
+                    else:
+                        s.state = "failed"
+                        log = s.spec.run_dir / "job.log"
+                        logger.error(progress.line(s, f"FAILED: {s.error} (log: {log})"))
+                    continue
+                logger.info(progress.finished(s, result))
+            if display is not None:
+                display.update(progress.table())
+            time.sleep(0.2)
+    except KeyboardInterrupt:
+        for s in queue:
+            s.state = "cancelled"
+        for fut, s in pending.items():
+            fut.cancel()
+            s.state = "interrupted"
+        _stop_workers(pool)
+        logger.warning(
+            "interrupted: %d running job(s) stopped, %d queued job(s) cancelled; rerun the "
+            "same command to resume",
+            len(pending),
+            len(queue),
+        )
+        raise
+    finally:
+        if in_main:
+            signal.signal(signal.SIGTERM, previous)
+        if display is not None:
+            display.update(progress.table())
+            display.stop()
+        pool.shutdown(wait=False, cancel_futures=True)
+    c = progress.counts()
+    logger.info(
+        "grid finished: %d done, %d failed, %s wall",
+        c["done"],
+        c["failed"],
+        format_duration(time.time() - progress.t0),
+    )
+    return statuses
+
+
+def _live(progress: GridProgress, console: Any) -> Any:
+    from rich.live import Live
+
+    live = Live(progress.table(), console=console, refresh_per_second=2, transient=False)
+    live.start()
+    return live

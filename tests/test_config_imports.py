@@ -1,0 +1,40 @@
+"""Reading a configuration stays light: no torch, libsumo, SB3, and no user code."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+from sumo_ayss.config import PROJECT_ROOT
+
+HEAVY = ("torch", "libsumo", "traci", "stable_baselines3", "matplotlib")
+
+SCRIPT = """
+import json, sys
+from pathlib import Path
+import sumo_ayss.config as config
+import sumo_ayss.agents.hparams
+import sumo_ayss.report.options
+root = Path(sys.argv[1])
+pipe = config.load_pipeline(root / "configs" / "paper.yaml")
+for case, path in pipe.experiments.items():
+    config.load_experiment(path)
+print(json.dumps(sorted({m.split(".")[0] for m in sys.modules})))
+"""
+
+
+def test_reading_configs_imports_no_heavy_module() -> None:
+    """Parse the paper's pipeline and experiments in a fresh interpreter; list its imports."""
+    env = {**os.environ, "PYTHONPATH": str(PROJECT_ROOT)}
+    out = subprocess.run(
+        [sys.executable, "-c", SCRIPT, str(PROJECT_ROOT)],
+        capture_output=True,
+        text=True,
+        check=True,
+        env=env,
+        timeout=120,
+    )
+    loaded = set(json.loads(out.stdout.strip().splitlines()[-1]))
+    assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
