@@ -14,6 +14,11 @@ Ray tasks. Every stage writes atomically and is skipped when its output exists a
 from the same inputs, so rerunning after a crash or Ctrl-C continues where it stopped. A
 failing job is retried once, then reported with its log; it never costs the other jobs.
 
+Where things live: the sections below in :mod:`sumo_ayss.config.pipeline`; one job
+(:class:`~sumo_ayss.jobs.JobSpec`, :func:`~sumo_ayss.jobs.run_job`) in :mod:`sumo_ayss.jobs`;
+the local process pool in :mod:`sumo_ayss.grid_local`; Ray in :mod:`sumo_ayss.ray_backend`.
+This module plans the grid (each case's experiment parsed once), runs it and the report.
+
 Pipeline YAML (every key optional)::
 
     grid: {cases: [car_following, cut_in], vuts: [pi1, pi2], seeds: [0, 1, 2]}
@@ -21,9 +26,10 @@ Pipeline YAML (every key optional)::
     out: ../runs/paper          # relative to the YAML file
     total_timesteps: null       # override every experiment's train.total_timesteps
     eval_every: null            # override every experiment's train.eval_every
-    evaluate: {n_outcome: 200, n_ayss: 100000}
+    evaluate: {n_outcome: 200, n_ayss: 100000}  # n_ayss: shorthand for ayss.n_samples
+    #   ayss: {h_m: [0, 5], seed: 4242, ...}   # Monte Carlo (sumo_ayss.config.AyssConfig)
     vuts: {}                    # extra VUTs (name: vehicle type) added to every experiment
-    report: {mode: exposure}    # report options (sumo_ayss.report.options.ReportOptions)
+    report: {mode: exposure, n_boot: 2000}  # sumo_ayss.report.options.ReportOptions
     expected_order: []          # a known safety order, safest first (validation studies)
     workers: 0                  # 0 = as many as cores
     retries: 1
