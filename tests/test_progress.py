@@ -10,6 +10,7 @@ from typing import Any
 
 import pytest
 
+from sumo_ayss.config import ExperimentConfig, TrainConfig
 from sumo_ayss.progress import PROGRESS_FILE, GridProgress, JobStatus, format_duration
 
 
@@ -17,8 +18,8 @@ from sumo_ayss.progress import PROGRESS_FILE, GridProgress, JobStatus, format_du
 class Spec:
     name: str
     run_dir: Path
-    experiment: dict[str, Any] = field(
-        default_factory=lambda: {"train": {"total_timesteps": 10_000}}
+    experiment: ExperimentConfig = field(
+        default_factory=lambda: ExperimentConfig(train=TrainConfig(total_timesteps=10_000))
     )
 
 
