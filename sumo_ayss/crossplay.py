@@ -1,0 +1,192 @@
+"""Cross-play stage: the pooled SPCPs of a grid against every VUT, and their ranking.
+
+    python -m sumo_ayss.crossplay configs/ladders/time_headway.yaml [--out DIR] [--seeds ...]
+
+After a pipeline grid (or ``python -m sumo_ayss.rank``) has trained and evaluated every
+(case, VUT, seed) job, this runs every SPCP of a case against every VUT of that case on the
+outcome scenarios (``evaluate.n_outcome`` of the outcome seed) and writes, per case,
+
+* ``<out>/<case>/crossplay.csv``: one row per (VUT, opponent, scenario)
+  (:data:`~sumo_ayss.scenarios.crossplay.CROSSPLAY_SCHEMA`);
+* ``<out>/<case>/crossplay.json``: the settings, the opponents with the SHA-256 of their
+  ``spcp.zip``, and the wall time. A rerun with the same settings and SPCPs skips the case.
+
+It then prints the cross-play ranking (:mod:`sumo_ayss.analysis.crossplay`) and, with the
+config's ``expected_order``, Kendall's τ against it. ``rank --mode crossplay`` runs this
+stage itself and writes the ranking files.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import logging
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+from sumo_ayss.analysis.crossplay import BLOCKS
+from sumo_ayss.catalog import controller_imports
+from sumo_ayss.cli import prog
+from sumo_ayss.errors import AyssError, CheckpointError
+
+logger = logging.getLogger(__name__)
+
+CROSSPLAY_CSV = "crossplay.csv"
+CROSSPLAY_JSON = "crossplay.json"
+#: Pairs simulated at once in one SUMO simulation.
+DEFAULT_N_ENVS = 50
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def case_runs(out: Path, case: str, vuts: Sequence[str], seeds: Sequence[int]) -> list[Path]:
+    """The run folders of one case of a grid, VUTs then seeds in grid order.
+
+    Raises:
+        CheckpointError: If a run folder has no ``spcp.zip`` (its job did not finish).
+    """
+    dirs = [out / case / v / f"seed_{s}" for v in vuts for s in seeds]
+    missing = [str(d) for d in dirs if not (d / "spcp.zip").is_file()]
+    if missing:
+        raise CheckpointError(
+            f"cross-play needs every SPCP of the grid; no spcp.zip in {', '.join(missing)} "
+            "(run the grid first: python -m sumo_ayss.rank <config>)"
+        )
+    return dirs
+
+
+def run_case(
+    run_dirs: Sequence[Path],
+    case_dir: Path,
+    *,
+    n: int,
+    seed: int,
+    n_envs: int = DEFAULT_N_ENVS,
+    force: bool = False,
+    trust_controller: bool = False,
+    progress: Callable[[str], None] | None = None,
+) -> Path:
+    """Cross-play of one case's runs; writes and returns ``case_dir / crossplay.csv``."""
+    from sumo_ayss.evaluate import load_run, load_spcp
+    from sumo_ayss.scenarios.crossplay import Opponent, run_crossplay
+    from sumo_ayss.scenarios.tables import read_json, write_json, write_table
+
+    runs = [load_run(d) for d in run_dirs]
+    opponents_meta = [
+        {"vut": r.config.env.vut, "seed": r.seed, "spcp_sha256": _sha256(r.run_dir / "spcp.zip")}
+        for r in runs
+    ]
+    requested = {"n": n, "seed": seed, "opponents": opponents_meta}
+    csv_path, json_path = case_dir / CROSSPLAY_CSV, case_dir / CROSSPLAY_JSON
+    if not force and csv_path.is_file() and json_path.is_file():
+        done = read_json(json_path)
+        if {k: done.get(k) for k in requested} == requested:
+            logger.info("%s: cross-play done with these settings and SPCPs; skipped", case_dir)
+            return csv_path
+    envs: dict[str, Any] = {}
+    for r in runs:
+        envs.setdefault(r.config.env.vut, r.config.env)
+    opponents = [
+        Opponent(r.config.env.vut, r.seed, lambda env, r=r: load_spcp(r, env)) for r in runs
+    ]
+    t0 = time.perf_counter()
+    with controller_imports(trust_controller):
+        table = run_crossplay(envs, opponents, n=n, seed=seed, n_envs=n_envs, progress=progress)
+    case_dir.mkdir(parents=True, exist_ok=True)
+    write_table(csv_path, table)
+    record = {
+        "stage": "crossplay",
+        "case": runs[0].config.env.case,
+        **requested,
+        "vuts": list(envs),
+        "wall_s": round(time.perf_counter() - t0, 3),
+    }
+    write_json(json_path, record)
+    return csv_path
+
+
+def read_matrix(csv_path: Path) -> Any:
+    """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of a ``crossplay.csv``."""
+    from sumo_ayss.analysis.crossplay import crossplay_matrix
+    from sumo_ayss.scenarios.crossplay import CROSSPLAY_SCHEMA
+    from sumo_ayss.scenarios.tables import read_table
+
+    t = read_table(csv_path, CROSSPLAY_SCHEMA)
+    c = t.columns
+    return crossplay_matrix(
+        c["vut"], c["opponent_vut"], c["opponent_seed"], c["episode_return"], c["collided"]
+    )
+
+
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    p = argparse.ArgumentParser(
+        prog=prog("python -m sumo_ayss.crossplay"),
+        description="Cross-play: every SPCP of a grid against every VUT, and the ranking.",
+    )
+    p.add_argument("config", help="pipeline YAML (the grid to cross-play)")
+    p.add_argument("--out", default=None, help="replace the config's out")
+    p.add_argument("--seeds", type=int, nargs="+", default=None, help="replace grid.seeds")
+    p.add_argument("--n-envs", type=int, default=DEFAULT_N_ENVS, help="pairs per simulation")
+    p.add_argument("--force", action="store_true", help="rerun even when done")
+    p.add_argument(
+        "--blocks",
+        choices=BLOCKS,
+        default="seed",
+        help="block unit of the paired test: training seeds (default) or single opponents",
+    )
+    p.add_argument(
+        "--trust-controller",
+        action="store_true",
+        help="allow importing user-controller VUTs named by the run folders (runs their code)",
+    )
+    return p.parse_args(argv)
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """Entry point of ``python -m sumo_ayss.crossplay``."""
+    import sys
+
+    from sumo_ayss.analysis.crossplay import crossplay_sentence, rank_crossplay
+    from sumo_ayss.analysis.seeds import kendall_tau
+    from sumo_ayss.config import load_pipeline
+    from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
+
+    args = parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    try:
+        out = Path(args.out) if args.out is not None else None
+        cfg = load_pipeline(args.config, out=out, seeds=args.seeds)
+        seeds = cfg.grid.seeds
+        for case in cfg.grid.cases:
+            dirs = case_runs(Path(cfg.out), case, cfg.grid.vuts, seeds)
+            csv_path = run_case(
+                dirs,
+                Path(cfg.out) / case,
+                n=cfg.evaluate.n_outcome,
+                seed=DEFAULT_OUTCOME_SEED,
+                n_envs=args.n_envs,
+                force=args.force,
+                trust_controller=args.trust_controller,
+                progress=lambda line, case=case: print(f"{case}: {line}", flush=True),
+            )
+            rows, _pairs = rank_crossplay(read_matrix(csv_path), blocks=args.blocks)
+            print(f"\n{case}: cross-play ranking, safest first (lower exposure = safer)")
+            for r in rows:
+                print(f"  {r.rank}. {r.name}: X = {r.mean:.2f} ({r.lo:.2f} to {r.hi:.2f})")
+                if r.vs_next is not None:
+                    print(f"     {crossplay_sentence(r.vs_next, args.blocks)}")
+            if cfg.expected_order:
+                order = [r.name for r in rows]
+                print(
+                    f"  Kendall tau vs expected order: {kendall_tau(order, cfg.expected_order):.2f}"
+                )
+    except AyssError as exc:
+        sys.exit(f"error: {exc}")
+
+
+if __name__ == "__main__":
+    main()
