@@ -66,6 +66,7 @@ from sumo_ayss.config import (
 from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.progress import GridProgress, JobStatus, format_duration
 from sumo_ayss.report.options import ReportOptions
+from sumo_ayss.run_folder import RunFolder, run_dir_for
 
 logger = logging.getLogger("sumo_ayss.pipeline")  # also when run as __main__
 
@@ -178,7 +179,7 @@ class JobSpec:
 
     @property
     def run_dir(self) -> Path:
-        return Path(self.out) / self.case / self.vut / f"seed_{self.seed}"
+        return run_dir_for(self.out, self.case, self.vut, self.seed)
 
 
 # ---------------------------------------------------------------------- loading
@@ -255,16 +256,17 @@ def _fingerprint(*parts: Any) -> str:
 
 def run_job(spec: JobSpec) -> dict[str, Any]:
     """Train (or resume, or skip) and evaluate one job. Runs in a worker process."""
-    from sumo_ayss.atomic import atomic_write_json
     from sumo_ayss.evaluate import evaluate_run
     from sumo_ayss.experiment import experiment_from_dict
+    from sumo_ayss.run_folder import read_evaluate_done, write_evaluate_done, write_progress
     from sumo_ayss.scenarios.ayss import AyssConfig
     from sumo_ayss.threads import set_torch_threads
-    from sumo_ayss.train import train, write_progress
+    from sumo_ayss.train import train
 
     run_dir = spec.run_dir
+    folder = RunFolder(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
-    handler = logging.FileHandler(run_dir / "job.log")
+    handler = logging.FileHandler(folder.job_log)
     handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s: %(message)s"))
     root = logging.getLogger()
     root.addHandler(handler)
@@ -275,23 +277,21 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
     try:
         cfg = experiment_from_dict(spec.experiment, run_dir)
         set_torch_threads(cfg.train.torch_threads)  # for evaluate too, when training is skipped
-        if (run_dir / "spcp.json").is_file() and (run_dir / "config.yaml").is_file():
+        if folder.spcp_json.is_file() and folder.config.is_file():
             from sumo_ayss.train import _check_same_config
 
             _check_same_config(run_dir, cfg, spec.seed)  # raises if the inputs changed
             stages["train"] = "skipped"
         else:
-            resume = (run_dir / "config.yaml").is_file()
+            resume = folder.config.is_file()
             train(cfg, spec.seed, Path(spec.out), resume=resume, argv=["--pipeline", spec.name])
             stages["train"] = "resumed" if resume else "done"
         times["train_s"] = time.perf_counter() - t0
 
         write_progress(run_dir, "evaluate")
         t1 = time.perf_counter()
-        marker = run_dir / "evaluate.done.json"
-        key = _fingerprint(run_dir / "spcp.zip", spec.n_outcome, spec.n_ayss)
-        done = json.loads(marker.read_text()) if marker.is_file() else {}
-        if done.get("inputs") == key:
+        key = _fingerprint(folder.spcp_zip, spec.n_outcome, spec.n_ayss)
+        if read_evaluate_done(folder.evaluate_done) == key:
             stages["evaluate"] = "skipped"
         else:
             evaluate_run(
@@ -302,7 +302,7 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
                 progress=False,
                 trust_controller=True,  # the pipeline's own runs, from the user's configs
             )
-            atomic_write_json(marker, {"inputs": key})
+            write_evaluate_done(folder.evaluate_done, key)
             stages["evaluate"] = "done"
         times["evaluate_s"] = time.perf_counter() - t1
         write_progress(run_dir, "done")
@@ -425,7 +425,7 @@ def run_grid_local(
                         logger.warning(progress.line(s, f"failed ({s.error}); will retry"))
                     else:
                         s.state = "failed"
-                        log = s.spec.run_dir / "job.log"
+                        log = RunFolder(s.spec.run_dir).job_log
                         logger.error(progress.line(s, f"FAILED: {s.error} (log: {log})"))
                     continue
                 logger.info(progress.finished(s, result))
@@ -503,7 +503,7 @@ def configure_logging(live: bool) -> Any:
 def final_messages(statuses: Sequence[JobStatus], report: Path | None) -> list[str]:
     """What the CLI prints at the end: failures, the report and its trust warnings."""
     lines = [
-        f"FAILED {s.spec.name}: {s.error}  (log: {s.spec.run_dir / 'job.log'})"
+        f"FAILED {s.spec.name}: {s.error}  (log: {RunFolder(s.spec.run_dir).job_log})"
         for s in statuses
         if s.state == "failed"
     ]
