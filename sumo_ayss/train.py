@@ -72,6 +72,7 @@ from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
 from sumo_ayss.experiment import ExperimentConfig, experiment_from_dict, load_experiment
 from sumo_ayss.paths import portable_python
 from sumo_ayss.run_folder import (
+    CHECKPOINTS_DIR,
     EVAL_COLUMNS,
     MODEL_ZIP,
     REPLAY_PKL,
@@ -414,7 +415,7 @@ class Trainer:
             ]
             for row in self.rows:  # every earlier candidate must still be a readable policy
                 ckpt = Path(str(row["checkpoint"]))
-                if ckpt.is_absolute() or ".." in ckpt.parts or ckpt.parts[:1] != ("checkpoints",):
+                if ckpt.is_absolute() or ".." in ckpt.parts or ckpt.parts[:1] != (CHECKPOINTS_DIR,):
                     raise CheckpointError(
                         f"{self.eval_path}: step {row['step']}: checkpoint must be a path "
                         f"under checkpoints/, got {str(ckpt)!r}"
