@@ -50,8 +50,8 @@ from torch import nn
 from torch.nn import functional as F
 
 from sumo_ayss.agents import AyssDQN, PrioritizedReplayBuffer
+from sumo_ayss.config import ExperimentConfig, TrainConfig, load_experiment
 from sumo_ayss.errors import ConfigError
-from sumo_ayss.experiment import ExperimentConfig, TrainConfig, load_experiment
 from sumo_ayss.train import Trainer, check_device, hparams_for_n_envs
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -23,15 +23,15 @@ mpl.use("Agg")
 from matplotlib.figure import Figure
 
 from sumo_ayss.atomic import atomic_write_text
+from sumo_ayss.run_folder import RunFolder, read_outcome_json, seed_of_dir
 
 
 def _per_seed(study: Path, case: str, vut: str) -> dict[int, float]:
     out = {}
     for run in sorted((study / case / vut).glob("seed_*")):
-        path = run / "outcome.json"
-        if path.is_file():
-            summary = json.loads(path.read_text())["summary"]
-            out[int(run.name.split("_")[1])] = float(summary["mean_return"]["mean"])
+        folder, seed = RunFolder(run), seed_of_dir(run)
+        if seed is not None and folder.outcome_json.is_file():
+            out[seed] = read_outcome_json(folder.outcome_json).outcome.mean_return.value
     return out
 
 

@@ -7,9 +7,12 @@ After a pipeline grid (or ``python -m sumo_ayss.rank``) has trained and evaluate
 outcome scenarios (``evaluate.n_outcome`` of the outcome seed) and writes, per case,
 
 * ``<out>/<case>/crossplay.csv``: one row per (VUT, opponent, scenario)
-  (:data:`~sumo_ayss.scenarios.crossplay.CROSSPLAY_SCHEMA`);
+  (:data:`~sumo_ayss.run_folder.CROSSPLAY_SCHEMA`);
 * ``<out>/<case>/crossplay.json``: the settings, the opponents with the SHA-256 of their
-  ``spcp.zip``, and the wall time. A rerun with the same settings and SPCPs skips the case.
+  ``spcp.zip``, and the wall time (:class:`~sumo_ayss.run_folder.CrossplayRecord`). A rerun
+  with the same settings and SPCPs skips the case.
+
+(file names, writers and readers: :mod:`sumo_ayss.run_folder`).
 
 It then prints the cross-play ranking (:mod:`sumo_ayss.analysis.crossplay`) and, with the
 config's ``expected_order``, Kendall's τ against it. ``rank --mode crossplay`` runs this
@@ -19,6 +22,7 @@ stage itself and writes the ranking files.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import hashlib
 import logging
 import time
@@ -29,12 +33,23 @@ from typing import Any
 from sumo_ayss.analysis.crossplay import BLOCKS
 from sumo_ayss.catalog import controller_imports
 from sumo_ayss.cli import prog
-from sumo_ayss.errors import AyssError, CheckpointError
+from sumo_ayss.errors import AyssError, CheckpointError, TableError
+from sumo_ayss.run_folder import (
+    CROSSPLAY_SCHEMA,
+    CaseFolder,
+    CrossplayOpponent,
+    CrossplayRecord,
+    RunFolder,
+    case_dir_for,
+    read_crossplay_json,
+    read_table,
+    run_dir_for,
+    write_crossplay_json,
+    write_table,
+)
 
 logger = logging.getLogger(__name__)
 
-CROSSPLAY_CSV = "crossplay.csv"
-CROSSPLAY_JSON = "crossplay.json"
 #: Pairs simulated at once in one SUMO simulation.
 DEFAULT_N_ENVS = 50
 
@@ -49,8 +64,8 @@ def case_runs(out: Path, case: str, vuts: Sequence[str], seeds: Sequence[int]) -
     Raises:
         CheckpointError: If a run folder has no ``spcp.zip`` (its job did not finish).
     """
-    dirs = [out / case / v / f"seed_{s}" for v in vuts for s in seeds]
-    missing = [str(d) for d in dirs if not (d / "spcp.zip").is_file()]
+    dirs = [run_dir_for(out, case, v, s) for v in vuts for s in seeds]
+    missing = [str(d) for d in dirs if not RunFolder(d).spcp_zip.is_file()]
     if missing:
         raise CheckpointError(
             f"cross-play needs every SPCP of the grid; no spcp.zip in {', '.join(missing)} "
@@ -70,23 +85,27 @@ def run_case(
     trust_controller: bool = False,
     progress: Callable[[str], None] | None = None,
 ) -> Path:
-    """Cross-play of one case's runs; writes and returns ``case_dir / crossplay.csv``."""
+    """Cross-play of one case's runs; writes and returns the case folder's ``crossplay.csv``."""
     from sumo_ayss.evaluate import load_run, load_spcp
     from sumo_ayss.scenarios.crossplay import Opponent, run_crossplay
-    from sumo_ayss.scenarios.tables import read_json, write_json, write_table
 
     runs = [load_run(d) for d in run_dirs]
-    opponents_meta = [
-        {"vut": r.config.env.vut, "seed": r.seed, "spcp_sha256": _sha256(r.run_dir / "spcp.zip")}
+    pool = tuple(
+        CrossplayOpponent(r.config.env.vut, r.seed, _sha256(RunFolder(r.run_dir).spcp_zip))
         for r in runs
-    ]
-    requested = {"n": n, "seed": seed, "opponents": opponents_meta}
-    csv_path, json_path = case_dir / CROSSPLAY_CSV, case_dir / CROSSPLAY_JSON
+    )
+    folder = CaseFolder(case_dir)
+    csv_path, json_path = folder.crossplay_csv, folder.crossplay_json
+    requested = CrossplayRecord(runs[0].config.env.case, n, seed, pool, (), 0.0)
     if not force and csv_path.is_file() and json_path.is_file():
-        done = read_json(json_path)
-        if {k: done.get(k) for k in requested} == requested:
-            logger.info("%s: cross-play done with these settings and SPCPs; skipped", case_dir)
-            return csv_path
+        try:
+            done = read_crossplay_json(json_path)
+        except TableError as exc:
+            logger.warning("%s; cross-play of %s runs again", exc, case_dir)
+        else:
+            if done.same_inputs(requested):
+                logger.info("%s: cross-play done with these settings and SPCPs; skipped", case_dir)
+                return csv_path
     envs: dict[str, Any] = {}
     for r in runs:
         envs.setdefault(r.config.env.vut, r.config.env)
@@ -96,24 +115,16 @@ def run_case(
     t0 = time.perf_counter()
     with controller_imports(trust_controller):
         table = run_crossplay(envs, opponents, n=n, seed=seed, n_envs=n_envs, progress=progress)
-    case_dir.mkdir(parents=True, exist_ok=True)
+    folder.path.mkdir(parents=True, exist_ok=True)
     write_table(csv_path, table)
-    record = {
-        "stage": "crossplay",
-        "case": runs[0].config.env.case,
-        **requested,
-        "vuts": list(envs),
-        "wall_s": round(time.perf_counter() - t0, 3),
-    }
-    write_json(json_path, record)
+    wall_s = time.perf_counter() - t0
+    write_crossplay_json(json_path, dataclasses.replace(requested, vuts=tuple(envs), wall_s=wall_s))
     return csv_path
 
 
 def read_matrix(csv_path: Path) -> Any:
     """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of a ``crossplay.csv``."""
     from sumo_ayss.analysis.crossplay import crossplay_matrix
-    from sumo_ayss.scenarios.crossplay import CROSSPLAY_SCHEMA
-    from sumo_ayss.scenarios.tables import read_table
 
     t = read_table(csv_path, CROSSPLAY_SCHEMA)
     c = t.columns
@@ -165,7 +176,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             dirs = case_runs(Path(cfg.out), case, cfg.grid.vuts, seeds)
             csv_path = run_case(
                 dirs,
-                Path(cfg.out) / case,
+                case_dir_for(cfg.out, case),
                 n=cfg.evaluate.n_outcome,
                 seed=DEFAULT_OUTCOME_SEED,
                 n_envs=args.n_envs,

@@ -6,10 +6,12 @@
 Reads ``<run>/config.yaml`` (the resolved configuration and the ``seed``) and the
 selected policy ``<run>/spcp.zip``, and writes into the run folder:
 
-    outcome.csv   one row per outcome episode   (sumo_ayss.scenarios.tables.OUTCOME_SCHEMA)
+    outcome.csv   one row per outcome episode   (sumo_ayss.run_folder.OUTCOME_SCHEMA)
     outcome.json  crash / lane-change rates, mean reward and final headway with 95 % CIs
-    ayss.csv      one row per kept AYSS sample  (sumo_ayss.scenarios.tables.AYSS_SCHEMA)
+    ayss.csv      one row per kept AYSS sample  (sumo_ayss.run_folder.AYSS_SCHEMA)
     ayss.json     filter counts, throughput, the Monte Carlo settings, mean indicator
+
+(file names, writers and readers: :mod:`sumo_ayss.run_folder`).
 
 Both stages run in one env, so in one SUMO simulation (libsumo allows one per process). A
 stage whose CSV and JSON both exist is skipped unless ``--force``; a skipped stage whose
@@ -25,7 +27,7 @@ import json
 import logging
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -36,27 +38,32 @@ from sumo_ayss.config import (
     DEFAULT_AYSS_SEED,
     AyssConfig,
     ExperimentConfig,
-    check_seed,
     experiment_from_dict,
-    safe_load_yaml,
     to_dict,
 )
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
 from sumo_ayss.paths import portable_path
+from sumo_ayss.run_folder import (
+    RunFolder,
+    StageHeader,
+    read_ayss_json,
+    read_outcome_json,
+    read_run_config,
+    read_spcp,
+    write_ayss_json,
+    write_outcome_json,
+    write_table,
+)
 from sumo_ayss.scenarios.ayss import run_ayss
 from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_N, DEFAULT_OUTCOME_SEED, run_outcome
 from sumo_ayss.scenarios.rollout import Policy
-from sumo_ayss.scenarios.tables import read_json, write_json, write_table
 from sumo_ayss.threads import set_torch_threads
 
 __all__ = ["EvaluationResult", "evaluate_run", "load_run", "main"]
 
 logger = logging.getLogger(__name__)
-
-OUTCOME_CSV, OUTCOME_JSON = "outcome.csv", "outcome.json"
-AYSS_CSV, AYSS_JSON = "ayss.csv", "ayss.json"
 
 
 @dataclass(frozen=True)
@@ -104,32 +111,21 @@ def load_run(run_dir: str | Path, *, known: tuple[ExperimentConfig, int] | None 
     Raises:
         CheckpointError: If the folder or its config is missing or unreadable.
     """
-    run_dir = Path(run_dir)
-    path = run_dir / "config.yaml"
+    folder = RunFolder(Path(run_dir))
+    path = folder.config
     if not path.is_file():
-        raise CheckpointError(f"{run_dir}: not a run folder (no config.yaml)")
-    if known is not None:
-        cfg, seed = known
-    else:
-        cfg, seed = _read_run_config(path)
-    spcp_step = None
-    if (run_dir / "spcp.json").is_file():
-        spcp = read_json(run_dir / "spcp.json")
-        spcp_step = spcp.get("step") if isinstance(spcp, dict) else None
-    return RunInfo(run_dir, cfg, seed, spcp_step)
+        raise CheckpointError(f"{folder.path}: not a run folder (no {path.name})")
+    cfg, seed = known if known is not None else _read_run_config(path)
+    spcp_step = read_spcp(folder.spcp_json).step if folder.spcp_json.is_file() else None
+    return RunInfo(folder.path, cfg, seed, spcp_step)
 
 
 def _read_run_config(path: Path) -> tuple[ExperimentConfig, int]:
-    """A run folder's ``config.yaml``: the experiment and the seed."""
+    """A run folder's ``config.yaml`` (:func:`~sumo_ayss.run_folder.read_run_config`): the
+    experiment, its VUT set, and the seed."""
+    stored = read_run_config(path)
     try:
-        data = safe_load_yaml(path.read_text(encoding="utf-8"), str(path))
-        data = dict(data)
-        seed = check_seed(data.pop("seed"), f"{path}: seed")
-        vut = data.pop("vut", None)  # folders written before the VUT was stored once
-    except (ConfigError, TypeError, ValueError, KeyError, OSError, UnicodeDecodeError) as exc:
-        raise CheckpointError(f"{path}: unreadable run configuration ({exc})") from exc
-    try:
-        return experiment_from_dict(data, path.parent).with_vut(vut), seed
+        return experiment_from_dict(stored.experiment, path.parent), stored.seed
     except ConfigError as exc:
         raise CheckpointError(f"{path}: invalid run configuration: {exc}") from exc
 
@@ -138,9 +134,9 @@ def load_spcp(run: RunInfo, env: PairEnv) -> Policy:
     """The run's SPCP as a greedy policy, its weights read without unpickling (trust model)."""
     from sumo_ayss.agents.weights import load_greedy_policy
 
-    path = run.run_dir / "spcp.zip"
+    path = RunFolder(run.run_dir).spcp_zip
     if not path.is_file():
-        raise CheckpointError(f"{run.run_dir}: no spcp.zip (was the SPCP selected?)")
+        raise CheckpointError(f"{run.run_dir}: no {path.name} (was the SPCP selected?)")
     return load_greedy_policy(
         path,
         run.config.agent,
@@ -149,23 +145,22 @@ def load_spcp(run: RunInfo, env: PairEnv) -> Policy:
     )
 
 
-def _base_record(run: RunInfo, stage: str) -> dict[str, Any]:
+def _header(run: RunInfo) -> StageHeader:
     env = run.config.env
-    return {
-        "stage": stage,
-        "run_dir": portable_path(run.run_dir),
-        "case": env.case,
-        "vut": env.vut,
-        "train_seed": run.seed,
-        "spcp_step": run.spcp_step,
-    }
+    return StageHeader(portable_path(run.run_dir), env.case, env.vut, run.seed, run.spcp_step)
 
 
-def _should_run(csv_path: Path, json_path: Path, requested: dict[str, Any], force: bool) -> bool:
+def _should_run(
+    csv_path: Path,
+    json_path: Path,
+    read_settings: Callable[[Path], dict[str, Any]],
+    requested: dict[str, Any],
+    force: bool,
+) -> bool:
     """Whether a stage runs; logs a skip, and a warning if its stored settings differ."""
     if force or not (csv_path.is_file() and json_path.is_file()):
         return True
-    stored = read_json(json_path).get("settings")
+    stored = read_settings(json_path)
     logger.info("skipping %s: outputs exist (pass --force to recompute)", csv_path.name)
     requested = json.loads(json.dumps(requested))  # tuples -> lists, as stored
     if stored != requested:
@@ -188,15 +183,16 @@ def _outcome_stage(
             seed,
         )
     result = run_outcome(env, policy, n=n, seed=seed, progress=progress)
-    write_table(run.run_dir / OUTCOME_CSV, result.table)
-    record = {
-        **_base_record(run, "outcome"),
-        "settings": {"n": n, "seed": seed},
-        "odd": to_dict(run.config.env.odd),
-        "summary": result.summary.as_dict(),
-        "wall_s": round(result.wall_s, 3),
-    }
-    write_json(run.run_dir / OUTCOME_JSON, record)
+    folder = RunFolder(run.run_dir)
+    write_table(folder.outcome_csv, result.table)
+    write_outcome_json(
+        folder.outcome_json,
+        _header(run),
+        {"n": n, "seed": seed},
+        to_dict(run.config.env.odd),
+        result.summary.as_dict(),
+        result.wall_s,
+    )
     s = result.summary
     logger.info(
         "outcome: crash rate %.3f [%.3f, %.3f], mean return %.3f",
@@ -211,11 +207,11 @@ def _ayss_stage(
     env: PairEnv, policy: Policy, run: RunInfo, cfg: AyssConfig, progress: bool
 ) -> None:
     result = run_ayss(env, policy, cfg, progress=progress)
-    write_table(run.run_dir / AYSS_CSV, result.table)
+    folder = RunFolder(run.run_dir)
+    write_table(folder.ayss_csv, result.table)
     summary = result.summary()
     settings = summary.pop("config")  # the AyssConfig used, compared on a later skip
-    record = {**_base_record(run, "ayss"), **summary, "settings": settings}
-    write_json(run.run_dir / AYSS_JSON, record)
+    write_ayss_json(folder.ayss_json, _header(run), settings, summary)
     logger.info(
         "ayss: kept %d of %d samples in %.1f s", len(result.table), cfg.n_samples, result.wall_s
     )
@@ -270,12 +266,17 @@ def _evaluate_run(
 ) -> EvaluationResult:
     run = load_run(run_dir, known=known)
     ayss_cfg = ayss if ayss is not None else AyssConfig()
-    d = run.run_dir
-    paths = {n: d / n for n in (OUTCOME_CSV, OUTCOME_JSON, AYSS_CSV, AYSS_JSON)}
+    f = RunFolder(run.run_dir)
     do_outcome = _should_run(
-        paths[OUTCOME_CSV], paths[OUTCOME_JSON], {"n": n_outcome, "seed": outcome_seed}, force
+        f.outcome_csv,
+        f.outcome_json,
+        lambda p: read_outcome_json(p).settings,
+        {"n": n_outcome, "seed": outcome_seed},
+        force,
     )
-    do_ayss = _should_run(paths[AYSS_CSV], paths[AYSS_JSON], ayss_cfg.to_dict(), force)
+    do_ayss = _should_run(
+        f.ayss_csv, f.ayss_json, lambda p: read_ayss_json(p).settings, ayss_cfg.to_dict(), force
+    )
     if do_outcome or do_ayss:
         env = make_env(run.config.env, sumo_seed=run.seed)
         try:
@@ -287,13 +288,7 @@ def _evaluate_run(
         finally:
             env.close()
     return EvaluationResult(
-        d,
-        paths[OUTCOME_CSV],
-        paths[OUTCOME_JSON],
-        paths[AYSS_CSV],
-        paths[AYSS_JSON],
-        do_outcome,
-        do_ayss,
+        f.path, f.outcome_csv, f.outcome_json, f.ayss_csv, f.ayss_json, do_outcome, do_ayss
     )
 
 

@@ -20,6 +20,7 @@ from typing import Any
 
 from sumo_ayss.jobs import JobSpec, run_job
 from sumo_ayss.progress import GridProgress, JobStatus, format_duration
+from sumo_ayss.run_folder import RunFolder
 
 logger = logging.getLogger("sumo_ayss.pipeline")
 
@@ -131,7 +132,7 @@ def run_grid_local(
                         logger.warning(progress.line(s, f"failed ({s.error}); will retry"))
                     else:
                         s.state = "failed"
-                        log = s.spec.run_dir / "job.log"
+                        log = RunFolder(s.spec.run_dir).job_log
                         logger.error(progress.line(s, f"FAILED: {s.error} (log: {log})"))
                     continue
                 logger.info(progress.finished(s, result))

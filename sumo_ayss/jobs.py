@@ -17,6 +17,13 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.config import AyssConfig, ExperimentConfig
+from sumo_ayss.run_folder import (
+    RunFolder,
+    read_evaluate_done,
+    run_dir_for,
+    write_evaluate_done,
+    write_progress,
+)
 
 logger = logging.getLogger("sumo_ayss.pipeline")
 
@@ -53,7 +60,7 @@ class JobSpec:
 
     @property
     def run_dir(self) -> Path:
-        return Path(self.out) / self.case / self.vut / f"seed_{self.seed}"
+        return run_dir_for(self.out, self.case, self.vut, self.seed)
 
 
 def _fingerprint(*parts: Any) -> str:
@@ -77,14 +84,14 @@ def _ayss_key(ayss: AyssConfig) -> list[Any]:
 
 def run_job(spec: JobSpec) -> dict[str, Any]:
     """Train (or resume, or skip) and evaluate one job. Runs in a worker process."""
-    from sumo_ayss.atomic import atomic_write_json
     from sumo_ayss.evaluate import evaluate_run
     from sumo_ayss.threads import set_torch_threads
-    from sumo_ayss.train import train, write_progress
+    from sumo_ayss.train import train
 
     run_dir = spec.run_dir
+    folder = RunFolder(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
-    handler = logging.FileHandler(run_dir / "job.log")
+    handler = logging.FileHandler(folder.job_log)
     handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s: %(message)s"))
     root = logging.getLogger()
     root.addHandler(handler)
@@ -95,23 +102,21 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
     try:
         cfg = spec.experiment
         set_torch_threads(cfg.train.torch_threads)  # for evaluate too, when training is skipped
-        if (run_dir / "spcp.json").is_file() and (run_dir / "config.yaml").is_file():
+        if folder.spcp_json.is_file() and folder.config.is_file():
             from sumo_ayss.train import _check_same_config
 
             _check_same_config(run_dir, cfg, spec.seed)  # raises if the inputs changed
             stages["train"] = "skipped"
         else:
-            resume = (run_dir / "config.yaml").is_file()
+            resume = folder.config.is_file()
             train(cfg, spec.seed, Path(spec.out), resume=resume, argv=["--pipeline", spec.name])
             stages["train"] = "resumed" if resume else "done"
         times["train_s"] = time.perf_counter() - t0
 
         write_progress(run_dir, "evaluate")
         t1 = time.perf_counter()
-        marker = run_dir / "evaluate.done.json"
-        key = _fingerprint(run_dir / "spcp.zip", spec.n_outcome, *_ayss_key(spec.ayss))
-        done = json.loads(marker.read_text()) if marker.is_file() else {}
-        if done.get("inputs") == key:
+        key = _fingerprint(folder.spcp_zip, spec.n_outcome, *_ayss_key(spec.ayss))
+        if read_evaluate_done(folder.evaluate_done) == key:
             stages["evaluate"] = "skipped"
         else:
             evaluate_run(
@@ -123,7 +128,7 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
                 trust_controller=True,  # the pipeline's own runs, from the user's configs
                 run=(cfg, spec.seed),  # the config in hand: config.yaml is not parsed again
             )
-            atomic_write_json(marker, {"inputs": key})
+            write_evaluate_done(folder.evaluate_done, key)
             stages["evaluate"] = "done"
         times["evaluate_s"] = time.perf_counter() - t1
         write_progress(run_dir, "done")

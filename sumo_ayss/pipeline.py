@@ -52,6 +52,7 @@ from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.grid_local import run_grid_local
 from sumo_ayss.jobs import JobSpec
 from sumo_ayss.progress import JobStatus
+from sumo_ayss.run_folder import RunFolder
 from sumo_ayss.validation import suggest
 
 logger = logging.getLogger("sumo_ayss.pipeline")  # also when run as __main__
@@ -138,7 +139,7 @@ def configure_logging(live: bool) -> Any:
 def final_messages(statuses: Sequence[JobStatus], report: Path | None) -> list[str]:
     """What the CLI prints at the end: failures, the report and its trust warnings."""
     lines = [
-        f"FAILED {s.spec.name}: {s.error}  (log: {s.spec.run_dir / 'job.log'})"
+        f"FAILED {s.spec.name}: {s.error}  (log: {RunFolder(s.spec.run_dir).job_log})"
         for s in statuses
         if s.state == "failed"
     ]

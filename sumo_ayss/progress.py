@@ -1,8 +1,9 @@
 """Progress of a pipeline grid that a person can follow: per-job state, steps, rate, ETA.
 
 The main process never talks to its workers about progress: it reads what each job writes
-into its run folder. The trainer rewrites ``progress.json`` atomically every few seconds
-(:func:`sumo_ayss.train.write_progress`: stage, step, total, rate); ``checkpoints/
+into its run folder (read with :mod:`sumo_ayss.run_folder`'s readers). The trainer rewrites
+``progress.json`` atomically every few seconds (:func:`sumo_ayss.run_folder.write_progress`:
+stage, step, total, rate); ``checkpoints/
 latest.json`` names the last candidate; ``spcp.json`` and ``evaluate.done.json`` mark the
 finished stages. From these :class:`GridProgress` makes
 
@@ -17,8 +18,6 @@ Imports neither SUMO nor torch.
 
 from __future__ import annotations
 
-import csv
-import json
 import math
 import statistics
 import time
@@ -27,8 +26,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
-PROGRESS_FILE = "progress.json"
-"""Written by :func:`sumo_ayss.train.write_progress` (same name; not imported: torch)."""
+from sumo_ayss.errors import CheckpointError
+from sumo_ayss.run_folder import RunFolder, read_eval_rows, read_latest, read_progress
 
 STATES = ("queued", "running", "done", "failed", "interrupted", "cancelled")
 
@@ -95,36 +94,24 @@ class JobStatus:
         self.candidate_step = found[-1][0] if found else None
 
 
-def _read_json(path: Path) -> dict[str, Any] | None:
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
-    return data if isinstance(data, dict) else None
-
-
 def _finished_steps(run_dir: Path, total: int) -> int:
     """Training transitions already in ``run_dir`` from an earlier invocation."""
-    if (run_dir / "spcp.json").is_file():
+    folder = RunFolder(run_dir)
+    if folder.spcp_json.is_file():
         return total
-    latest = _read_json(run_dir / "checkpoints" / "latest.json")
-    return int(latest["step"]) if latest and "step" in latest else 0
+    try:
+        return read_latest(folder.latest)[0]
+    except CheckpointError:  # missing (no checkpoint yet) or being replaced
+        return 0
 
 
 def _candidates(run_dir: Path) -> list[tuple[int, str]]:
-    """(step, mean evaluation reward as written) of each SPCP candidate in ``eval.csv``."""
+    """(step, mean evaluation reward to 2 decimals) of each SPCP candidate in ``eval.csv``."""
     try:
-        with (run_dir / "eval.csv").open(newline="") as f:
-            rows = list(csv.DictReader(f))
-    except (OSError, csv.Error):
+        rows = read_eval_rows(RunFolder(run_dir).eval_table, skip_bad_rows=True)[0]
+    except CheckpointError:
         return []
-    out = []
-    for row in rows:
-        try:
-            out.append((int(row["step"]), f"{float(row['mean_return']):.2f}"))
-        except (KeyError, TypeError, ValueError):
-            continue
-    return out
+    return [(int(row["step"]), f"{row['mean_return']:.2f}") for row in rows]
 
 
 def format_duration(seconds: float) -> str:
@@ -155,7 +142,7 @@ class GridProgress:
         self.t0 = time.time()
 
     def finished(self, s: JobStatus, result: dict[str, Any]) -> str:
-        """Record a finished try (``result``: :func:`sumo_ayss.pipeline.run_job`'s); event."""
+        """Record a finished try (``result``: :func:`sumo_ayss.jobs.run_job`'s); event."""
         s.state, s.stage = "done", "done"
         s.wall_s, s.stages = float(result["wall_s"]), dict(result["stages"])
         s.train_s, s.evaluate_s = result.get("train_s"), result.get("evaluate_s")
@@ -178,7 +165,7 @@ class GridProgress:
             if s.state != "running":
                 continue
             run_dir = s.spec.run_dir
-            progress = _read_json(run_dir / PROGRESS_FILE)
+            progress = read_progress(run_dir)
             if progress and float(progress.get("time", 0)) < (s.started_at or 0) - 1:
                 progress = None  # left by an earlier invocation
             rate = progress.get("rate_steps_per_s") if progress else None
@@ -197,7 +184,7 @@ class GridProgress:
                         s.rate_steps_per_s = float(rate)
                 if stage and stage != s.stage:
                     if stage == "evaluate":
-                        s.step = s.total if (run_dir / "spcp.json").is_file() else s.step
+                        s.step = s.total if RunFolder(run_dir).spcp_json.is_file() else s.step
                         events.append(self.line(s, "training finished; evaluating"))
                     s.stage = stage
         return events

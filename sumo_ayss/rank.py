@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.errors import AyssError, ConfigError
+from sumo_ayss.run_folder import OUTCOME_JSON, RunFolder
 
 if TYPE_CHECKING:
     from sumo_ayss.report.document import CaseAnalysis, ReportOptions
@@ -233,7 +234,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument(
         "--no-run",
         action="store_true",
-        help="rank the grid's existing run folders (with outcome.json) without running jobs",
+        help=f"rank the grid's existing run folders (with {OUTCOME_JSON}) without running jobs",
     )
     parser.add_argument("--no-live", action="store_true", help="no live table (log lines)")
     args = parser.parse_args(argv)
@@ -246,7 +247,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             cfg = dataclasses.replace(cfg, report=dataclasses.replace(cfg.report, mode=args.mode))
         if args.no_run:
             planned = [j.run_dir for j in plan_jobs(cfg)]
-            done = [d for d in planned if (d / "outcome.json").is_file()]
+            done = [d for d in planned if RunFolder(d).outcome_json.is_file()]
             complete = len(done) == len(planned)
             if not done:
                 raise ConfigError(f"--no-run: no finished run folder under {cfg.out}")

@@ -30,6 +30,7 @@ from typing import Any
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.jobs import JobSpec, run_job
 from sumo_ayss.progress import JobStatus
+from sumo_ayss.run_folder import RunFolder
 
 logger = logging.getLogger(__name__)
 
@@ -121,7 +122,7 @@ def run_grid_ray(jobs: Sequence[JobSpec], retries: int, address: str | None) -> 
                 else:
                     s.state = "failed"
                     s.spec.run_dir.mkdir(parents=True, exist_ok=True)
-                    (s.spec.run_dir / "job.log").write_text(s.error + "\n")
+                    RunFolder(s.spec.run_dir).job_log.write_text(s.error + "\n")
     finally:
         if started_here:
             ray.shutdown()

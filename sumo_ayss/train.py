@@ -37,10 +37,7 @@ last, so a kill at any moment leaves a resumable folder.
 from __future__ import annotations
 
 import argparse
-import csv
 import dataclasses
-import io
-import json
 import logging
 import math
 import platform
@@ -64,13 +61,7 @@ from sumo_ayss.agents.dqn import AyssDQN
 from sumo_ayss.agents.greedy import GreedyPolicy
 from sumo_ayss.agents.hparams import DQNHyperParams
 from sumo_ayss.agents.weights import read_policy_state
-from sumo_ayss.atomic import (
-    atomic_copy,
-    atomic_write_json,
-    atomic_write_text,
-    atomic_write_with,
-    remove_stale_temporaries,
-)
+from sumo_ayss.atomic import atomic_copy, atomic_write_with, remove_stale_temporaries
 from sumo_ayss.cli import prog
 from sumo_ayss.config import (
     ExperimentConfig,
@@ -78,9 +69,7 @@ from sumo_ayss.config import (
     check_seed,
     experiment_from_dict,
     load_experiment,
-    safe_load_yaml,
     to_dict,
-    write_yaml,
 )
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
@@ -88,73 +77,37 @@ from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.envs.vec_env import EpisodeTrace, PairVecEnv
 from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
 from sumo_ayss.paths import portable_python
+from sumo_ayss.run_folder import (
+    CHECKPOINTS_DIR,
+    EVAL_COLUMNS,
+    MODEL_ZIP,
+    REPLAY_PKL,
+    RESUME_FILES,
+    RESUME_MODEL_ZIP,
+    STATE_JSON,
+    TORCH_RNG_PT,
+    RunConfig,
+    RunFolder,
+    Seeds,
+    read_checkpoint_state,
+    read_eval_table,
+    read_latest,
+    read_run_config,
+    run_dir_for,
+    write_checkpoint_state,
+    write_command,
+    write_eval_table,
+    write_latest,
+    write_progress,
+    write_run_config,
+    write_seeds,
+    write_spcp,
+    write_versions,
+)
 from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, run_episodes, summarize
 from sumo_ayss.selection import select_spcp
 
 logger = logging.getLogger(__name__)
-
-#: Files of a checkpoint that only the latest keeps (what a resume needs beyond model.zip).
-RESUME_FILES = ("replay.pkl", "resume_model.zip")
-
-EVAL_COLUMNS = [
-    "step",
-    "mean_return",
-    "std_return",
-    "crash_rate",
-    "lane_change_rate",
-    "mean_final_headway_m",
-    "n_episodes",
-    "wall_s",
-    "checkpoint",
-]
-
-
-# ---------------------------------------------------------------------- atomic file helpers
-
-
-def write_eval_table(path: Path, rows: Sequence[dict[str, Any]]) -> None:
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=EVAL_COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    atomic_write_text(path, buf.getvalue())
-
-
-def read_eval_table(path: Path) -> list[dict[str, Any]]:
-    """The rows of ``eval.csv`` (none if it does not exist).
-
-    Raises:
-        CheckpointError: The file is unreadable, lacks a column, or has a bad cell; the
-            message names the file, the line and the column.
-    """
-    if not path.is_file():
-        return []
-    try:
-        with path.open(encoding="utf-8", newline="") as f:
-            reader = csv.DictReader(f)
-            missing = [c for c in EVAL_COLUMNS if c not in (reader.fieldnames or [])]
-            if missing:
-                raise CheckpointError(f"{path}: not an eval table (missing columns {missing})")
-            rows = list(reader)
-    except (OSError, UnicodeDecodeError, csv.Error) as e:
-        raise CheckpointError(f"{path}: unreadable ({e})") from e
-    for line, row in enumerate(rows, start=2):
-        for key in EVAL_COLUMNS:
-            if key == "checkpoint":
-                continue
-            cell = row[key]
-            try:
-                value = int(cell) if key in ("step", "n_episodes") else float(cell)
-            except (TypeError, ValueError):
-                raise CheckpointError(
-                    f"{path}, line {line}: column {key!r} must be a number, got {cell!r}"
-                ) from None
-            if key not in ("std_return",) and not math.isfinite(value):
-                raise CheckpointError(
-                    f"{path}, line {line}: column {key!r} must be finite, got {cell!r}"
-                )
-            row[key] = value
-    return rows
 
 
 def versions() -> dict[str, str]:
@@ -176,10 +129,6 @@ def versions() -> dict[str, str]:
     return out
 
 
-def run_dir_for(out: Path, cfg: ExperimentConfig, seed: int) -> Path:
-    return out / cfg.env.case / cfg.env.vut / f"seed_{seed}"
-
-
 # ---------------------------------------------------------------------- the trainer
 
 
@@ -190,8 +139,9 @@ class Trainer:
         self.cfg = cfg
         self.seed = seed
         self.run_dir = run_dir
-        self.ckpt_dir = run_dir / "checkpoints"
-        self.eval_path = run_dir / "eval.csv"
+        self.folder = RunFolder(run_dir)
+        self.ckpt_dir = self.folder.checkpoints
+        self.eval_path = self.folder.eval_table
         self.scenarios = sample_initial_conditions(
             cfg.env.odd, cfg.train.n_eval_scenarios, cfg.train.eval_seed
         )
@@ -219,26 +169,19 @@ class Trainer:
 
     def write_metadata(self, argv: Sequence[str]) -> None:
         self.run_dir.mkdir(parents=True, exist_ok=True)
-        resolved = {"seed": self.seed, **self.cfg.to_dict()}  # the VUT: env.vut
+        resolved = RunConfig(self.cfg.env.vut, self.seed, self.cfg.to_dict())
         # config.yaml before checkpoints/: a run killed in between must look resumable
         # (the pipeline resumes a folder with config.yaml; checkpoints/ alone is refused).
-        write_yaml(self.run_dir / "config.yaml", resolved)
+        write_run_config(self.folder.config, resolved)
         self.ckpt_dir.mkdir(exist_ok=True)
-        atomic_write_text(
-            self.run_dir / "command.txt",
+        write_command(
+            self.folder.command,
             shlex.join([portable_python(), "-m", __spec__.name, *argv])
             if __spec__
             else shlex.join(argv),
         )
-        atomic_write_json(self.run_dir / "versions.json", versions())
-        atomic_write_json(
-            self.run_dir / "seeds.json",
-            {
-                "train_seed": self.seed,
-                "sumo_seed": self.seed,
-                "eval_seed": self.cfg.train.eval_seed,
-            },
-        )
+        write_versions(self.folder.versions, versions())
+        write_seeds(self.folder.seeds, Seeds(self.seed, self.seed, self.cfg.train.eval_seed))
 
     # -- model ---------------------------------------------------------------------------
 
@@ -286,9 +229,9 @@ class Trainer:
         model = self.model
         assert model is not None
         step = model.num_timesteps
-        step_dir = self.ckpt_dir / f"step_{step:09d}"
+        step_dir = self.folder.step_dir(step)
         step_dir.mkdir(parents=True, exist_ok=True)
-        _atomic_model_save(model, step_dir / "model.zip")
+        _atomic_model_save(model, step_dir / MODEL_ZIP)
 
         t0 = time.perf_counter()
         if self.pair_vec is not None:
@@ -312,7 +255,7 @@ class Trainer:
         summary = summarize(results)
 
         row: dict[str, Any] = {"step": step, **summary.as_dict(), "wall_s": round(wall, 3)}
-        row["checkpoint"] = str(step_dir.relative_to(self.run_dir) / "model.zip")
+        row["checkpoint"] = self.folder.checkpoint_model(step_dir)
         row = {k: row[k] for k in EVAL_COLUMNS}
         self.rows.append(row)
         model.logger.record("eval/mean_return", summary.mean_return)
@@ -348,10 +291,7 @@ class Trainer:
         if step_dir is None:
             return
         self._save_resume_state(step_dir)
-        atomic_write_json(
-            self.ckpt_dir / "latest.json",
-            {"step": int(step_dir.name.split("_")[1]), "dir": step_dir.name},
-        )
+        write_latest(self.folder.latest, step_dir)
         self._pending_dir = None
         self._prune_resume_files(step_dir)
 
@@ -406,8 +346,8 @@ class Trainer:
     def _save_resume_state(self, step_dir: Path) -> None:
         model = self.model
         assert model is not None
-        _atomic_model_save(model, step_dir / "resume_model.zip")
-        atomic_write_with(step_dir / "replay.pkl", model.save_replay_buffer)
+        _atomic_model_save(model, step_dir / RESUME_MODEL_ZIP)
+        atomic_write_with(step_dir / REPLAY_PKL, model.save_replay_buffer)
         state = {
             "num_timesteps": model.num_timesteps,
             "next_eval": self.next_eval,
@@ -419,17 +359,14 @@ class Trainer:
             "action_space_rng": model.action_space.np_random.bit_generator.state,
         }
         torch_state = th.get_rng_state()
-        atomic_write_with(step_dir / "torch_rng.pt", lambda tmp: th.save(torch_state, tmp))
-        atomic_write_json(step_dir / "state.json", state)
+        atomic_write_with(step_dir / TORCH_RNG_PT, lambda tmp: th.save(torch_state, tmp))
+        write_checkpoint_state(step_dir / STATE_JSON, state)
 
     def _latest(self) -> Path | None:
-        path = self.ckpt_dir / "latest.json"
+        path = self.folder.latest
         if not path.is_file():
             return None
-        data = _read_json(path)
-        name = data.get("dir") if isinstance(data, dict) else None
-        if not isinstance(name, str) or Path(name).name != name or not name.startswith("step_"):
-            raise CheckpointError(f"{path}: 'dir' must name a step_* folder, got {name!r}")
+        _, name = read_latest(path)
         latest = self.ckpt_dir / name
         if not latest.is_dir():
             raise CheckpointError(f"{path} points at {name}, which does not exist")
@@ -454,28 +391,26 @@ class Trainer:
         latest = self._latest()
         if latest is None:
             raise CheckpointError(f"{self.run_dir}: no checkpoint to resume from")
-        state = _read_json(latest / "state.json")
-        if not isinstance(state, dict) or not {"num_timesteps", "next_eval"} <= set(state):
-            raise CheckpointError(f"{latest / 'state.json'}: not a checkpoint state")
+        state = read_checkpoint_state(latest / STATE_JSON)
         th.set_num_threads(self.cfg.train.torch_threads)
         # Resuming trusts the folder: SB3's loader unpickles parts of model.zip and replay.pkl
         # (see "Trust model" in the README); evaluating and reporting never do.
         try:
             model = AyssDQN.load(
-                str(latest / "resume_model.zip"),
+                str(latest / RESUME_MODEL_ZIP),
                 env=self.vec_env,
                 device=check_device(self.cfg.train.device),
                 tensorboard_log=str(self.run_dir / "tb"),
             )
         except Exception as e:  # zipfile, pickle, torch: any corruption
             raise CheckpointError(
-                f"{latest / 'resume_model.zip'}: unreadable checkpoint ({type(e).__name__}: {e})"
+                f"{latest / RESUME_MODEL_ZIP}: unreadable checkpoint ({type(e).__name__}: {e})"
             ) from e
         try:
-            model.load_replay_buffer(latest / "replay.pkl")
+            model.load_replay_buffer(latest / REPLAY_PKL)
         except Exception as e:
             raise CheckpointError(
-                f"{latest / 'replay.pkl'}: unreadable replay buffer ({type(e).__name__}: {e})"
+                f"{latest / REPLAY_PKL}: unreadable replay buffer ({type(e).__name__}: {e})"
             ) from e
         self._prune_resume_files(latest)
         self.model = model
@@ -486,7 +421,7 @@ class Trainer:
             ]
             for row in self.rows:  # every earlier candidate must still be a readable policy
                 ckpt = Path(str(row["checkpoint"]))
-                if ckpt.is_absolute() or ".." in ckpt.parts or ckpt.parts[:1] != ("checkpoints",):
+                if ckpt.is_absolute() or ".." in ckpt.parts or ckpt.parts[:1] != (CHECKPOINTS_DIR,):
                     raise CheckpointError(
                         f"{self.eval_path}: step {row['step']}: checkpoint must be a path "
                         f"under checkpoints/, got {str(ckpt)!r}"
@@ -519,12 +454,12 @@ class Trainer:
             model.action_space.np_random.bit_generator.state = state["action_space_rng"]
         except (KeyError, TypeError, ValueError) as e:
             raise CheckpointError(
-                f"{latest / 'state.json'}: inconsistent checkpoint state ({type(e).__name__}: {e})"
+                f"{latest / STATE_JSON}: inconsistent checkpoint state ({type(e).__name__}: {e})"
             ) from e
         try:
-            th.set_rng_state(th.load(latest / "torch_rng.pt", weights_only=True))
+            th.set_rng_state(th.load(latest / TORCH_RNG_PT, weights_only=True))
         except Exception as e:
-            raise CheckpointError(f"{latest / 'torch_rng.pt'}: unreadable ({e})") from e
+            raise CheckpointError(f"{latest / TORCH_RNG_PT}: unreadable ({e})") from e
         logger.info("resumed %s at step %d", self.run_dir, model.num_timesteps)
 
     def _resume_pairs(self, state: dict[str, Any]) -> None:
@@ -546,9 +481,9 @@ class Trainer:
     def select(self) -> dict[str, Any]:
         choice = select_spcp(self.rows, self.cfg.train.selection)
         row = self.rows[choice.index]
-        atomic_copy(self.run_dir / row["checkpoint"], self.run_dir / "spcp.zip")
+        atomic_copy(self.run_dir / row["checkpoint"], self.folder.spcp_zip)
         record = {**dataclasses.asdict(choice), "checkpoint": row["checkpoint"], "row": row}
-        atomic_write_json(self.run_dir / "spcp.json", record)
+        write_spcp(self.folder.spcp_json, choice, row["checkpoint"], row)
         return record
 
     def close(self) -> None:
@@ -557,19 +492,8 @@ class Trainer:
             self.env.close()
 
 
-PROGRESS_FILE = "progress.json"
 PROGRESS_EVERY_S = 2.0
 """Seconds between two rewrites of a run's ``progress.json`` during training."""
-
-
-def write_progress(run_dir: Path, stage: str, **fields: Any) -> None:
-    """Atomically (re)write ``run_dir/progress.json``: ``stage`` plus ``fields``.
-
-    Stages: ``train`` (with ``step``, ``total`` in transitions and ``rate_steps_per_s``,
-    transitions per second of wall time since this process started training), ``evaluate``,
-    ``done``. Only watchers (the pipeline's progress display) read it; nothing depends on it.
-    """
-    atomic_write_json(run_dir / PROGRESS_FILE, {"stage": stage, "time": time.time(), **fields})
 
 
 class _CandidateCallback(BaseCallback):
@@ -700,14 +624,6 @@ def _episode_result(trace: EpisodeTrace) -> EpisodeResult:
     )
 
 
-def _read_json(path: Path) -> Any:
-    """JSON from a run-folder file; a missing, unreadable or malformed file -> CheckpointError."""
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as e:
-        raise CheckpointError(f"{path}: unreadable JSON ({e})") from e
-
-
 def _atomic_model_save(model: AyssDQN, path: Path) -> None:
     atomic_write_with(path, model.save)
 
@@ -743,13 +659,13 @@ def train(
     check_device(cfg.train.device)  # before the run folder exists
     seed = check_seed(seed, "--seed")
     check_out_dir(Path(out), "--out")
-    run_dir = run_dir_for(out, cfg, seed)
-    config_file = run_dir / "config.yaml"
+    run_dir = run_dir_for(out, cfg.env.case, cfg.env.vut, seed)
+    config_file = RunFolder(run_dir).config
     if resume:
         if not config_file.is_file():
             raise CheckpointError(f"--resume: no run folder at {run_dir}")
         _check_same_config(run_dir, cfg, seed)
-    elif (run_dir / "checkpoints").exists():
+    elif RunFolder(run_dir).checkpoints.exists():
         raise CheckpointError(
             f"{run_dir} already holds a run; pass --resume to continue it or choose another --out"
         )
@@ -771,16 +687,13 @@ def train(
 
 
 def _check_same_config(run_dir: Path, cfg: ExperimentConfig, seed: int) -> None:
-    path = run_dir / "config.yaml"
+    path = RunFolder(run_dir).config
+    stored = read_run_config(path)
     try:
-        stored = safe_load_yaml(path.read_text(encoding="utf-8"), str(path))
-        if not isinstance(stored, dict):
-            raise CheckpointError(f"{path}: not a run configuration (top level is not a mapping)")
-        stored_seed = stored.pop("seed")
-        stored.pop("vut", None)  # folders written before the VUT was stored once (env.vut)
-        stored_cfg = experiment_from_dict(stored, run_dir)
-    except (ConfigError, KeyError, OSError, UnicodeDecodeError) as e:
+        stored_cfg = experiment_from_dict(stored.experiment, run_dir)
+    except ConfigError as e:
         raise CheckpointError(f"{path}: unreadable run configuration ({e})") from e
+    stored_seed = stored.seed
     if stored_seed != seed or to_dict(stored_cfg) != to_dict(cfg):
         raise CheckpointError(
             f"--resume: {run_dir}/config.yaml differs from the requested configuration; "

@@ -10,8 +10,9 @@ import pytest
 from sumo_ayss.config import load_experiment
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import sample_initial_conditions
+from sumo_ayss.run_folder import read_eval_table
 from sumo_ayss.scenarios.rollout import run_episodes, summarize
-from sumo_ayss.train import read_eval_table, train
+from sumo_ayss.train import train
 
 pytestmark = [pytest.mark.slow, pytest.mark.sumo, pytest.mark.timeout(1800)]
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -11,7 +10,8 @@ from typing import Any
 import pytest
 
 from sumo_ayss.config import ExperimentConfig, TrainConfig
-from sumo_ayss.progress import PROGRESS_FILE, GridProgress, JobStatus, format_duration
+from sumo_ayss.progress import GridProgress, JobStatus, format_duration
+from sumo_ayss.run_folder import PROGRESS_JSON, write_eval_table, write_progress
 
 
 @dataclass(frozen=True)
@@ -41,24 +41,26 @@ def test_events_from_run_folder_files(tmp_path: Path) -> None:
     job.start()
     assert progress.poll() == []
     job.spec.run_dir.mkdir(parents=True)
-    (job.spec.run_dir / "eval.csv").write_text("step,mean_return\n5000,11.8312\n")
-    _write(
-        job.spec.run_dir / PROGRESS_FILE,
-        {
-            "stage": "train",
-            "time": time.time(),
-            "step": 5200,
-            "total": 10_000,
-            "rate_steps_per_s": 100.0,
-        },
-    )
+    row = {
+        "step": 5000,
+        "mean_return": 11.8312,
+        "std_return": 2.0,
+        "crash_rate": 0.0,
+        "lane_change_rate": 0.0,
+        "mean_final_headway_m": 2.1,
+        "n_episodes": 10,
+        "wall_s": 1.5,
+        "checkpoint": "checkpoints/step_000005000/model.zip",
+    }
+    write_eval_table(job.spec.run_dir / "eval.csv", [row])
+    write_progress(job.spec.run_dir, "train", step=5200, total=10_000, rate_steps_per_s=100.0)
     events = progress.poll()
     assert len(events) == 1 and events[0].endswith(
         "seed_0: SPCP candidate at step 5,000/10,000 (100 steps/s): mean evaluation reward 11.83"
     )
     assert "0/3 done, 1 running, 2 queued, 0 failed" in events[0]
     assert (job.step, job.rate_steps_per_s) == (5200, 100.0)
-    _write(job.spec.run_dir / PROGRESS_FILE, {"stage": "evaluate", "time": time.time()})
+    write_progress(job.spec.run_dir, "evaluate")
     (job.spec.run_dir / "spcp.json").write_text("{}")
     assert progress.poll()[0].endswith("training finished; evaluating")
     assert progress.poll() == []  # each event once
@@ -67,7 +69,7 @@ def test_events_from_run_folder_files(tmp_path: Path) -> None:
 def test_stale_progress_file_of_an_earlier_invocation_is_ignored(tmp_path: Path) -> None:
     [job] = _grid(tmp_path, 1)
     _write(
-        job.spec.run_dir / PROGRESS_FILE,
+        job.spec.run_dir / PROGRESS_JSON,
         {"stage": "train", "time": 0.0, "step": 9000, "rate_steps_per_s": 1.0},
     )
     job.start()

@@ -29,7 +29,7 @@ from sumo_ayss.replay import (
     main,
     replay_headless,
 )
-from sumo_ayss.scenarios.tables import AYSS_SCHEMA, OUTCOME_SCHEMA, read_table
+from sumo_ayss.run_folder import AYSS_SCHEMA, OUTCOME_SCHEMA, read_table
 from sumo_ayss.sim.export import read_fcd
 from sumo_ayss.train import train
 from tests.helpers import tiny_experiment

@@ -16,7 +16,8 @@ import pytest
 import yaml
 
 from sumo_ayss.config import ExperimentConfig, load_experiment
-from sumo_ayss.train import _CandidateCallback, read_eval_table, train
+from sumo_ayss.run_folder import read_eval_table
+from sumo_ayss.train import _CandidateCallback, train
 from tests.helpers import TINY_AGENT
 
 pytestmark = pytest.mark.sumo

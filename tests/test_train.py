@@ -16,8 +16,9 @@ import yaml
 
 from sumo_ayss.config import load_experiment
 from sumo_ayss.errors import CheckpointError
+from sumo_ayss.run_folder import read_eval_table
 from sumo_ayss.selection import select_spcp
-from sumo_ayss.train import read_eval_table, train
+from sumo_ayss.train import train
 from tests.helpers import TINY_AGENT
 
 pytestmark = pytest.mark.sumo

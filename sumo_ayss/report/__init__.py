@@ -30,8 +30,6 @@ _LAZY = {
     "significance_rule": "sumo_ayss.report.document",
     "vut_safety_index": "sumo_ayss.report.document",
     "write_report": "sumo_ayss.report.document",
-    "AYSS_COLUMNS": "sumo_ayss.report.load",
-    "OUTCOME_KEYS": "sumo_ayss.report.load",
     "RUN_FILES": "sumo_ayss.report.load",
     "Run": "sumo_ayss.report.load",
     "find_run_dirs": "sumo_ayss.report.load",

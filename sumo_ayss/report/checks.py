@@ -21,7 +21,6 @@ Imports neither SUMO nor torch.
 from __future__ import annotations
 
 import contextlib
-import csv
 import hashlib
 import json
 import math
@@ -31,7 +30,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
+from sumo_ayss.errors import AyssError
+from sumo_ayss.run_folder import RunFolder, read_eval_rows, read_run_config, read_spcp
 
 TRUSTED_TIMESTEPS = 100_000
 """Training transitions per run below which verdicts are flagged as not to be trusted: the
@@ -106,37 +106,24 @@ def _int_or_none(value: Any) -> int | None:
 
 def read_training(run_dir: Path) -> Training:
     """The :class:`Training` of ``run_dir``; unreadable files leave fields unknown."""
+    folder = RunFolder(run_dir)
     total = every = None
     key = ""
-    try:
-        config = yaml.safe_load((run_dir / "config.yaml").read_text()) or {}
-        train = config.get("train") or {}
+    with contextlib.suppress(AyssError, AttributeError):
+        config = read_run_config(folder.config)
+        train = config.experiment.get("train") or {}
         total, every = (
             _int_or_none(train.get("total_timesteps")),
             _int_or_none(train.get("eval_every")),
         )
-        key = config_key(config)
-    except (OSError, ValueError, AttributeError, yaml.YAMLError):
-        pass
-    rows: list[dict[str, float]] = []
-    try:
-        with (run_dir / "eval.csv").open(newline="") as f:
-            for row in csv.DictReader(f):
-                try:
-                    rows.append(
-                        {
-                            k: float(row.get(k) or "nan")
-                            for k in ("step", "mean_return", "std_return", "n_episodes")
-                        }
-                    )
-                except ValueError:
-                    continue
-    except OSError:
-        pass
+        key = config_key(config.as_dict())
+    rows: list[dict[str, Any]] = []
+    with contextlib.suppress(AyssError):
+        rows = read_eval_rows(folder.eval_table, skip_bad_rows=True)[0]
     rows.sort(key=lambda r: r["step"])
     spcp_step = None
-    with contextlib.suppress(OSError, ValueError, AttributeError):
-        spcp_step = _int_or_none(json.loads((run_dir / "spcp.json").read_text()).get("step"))
+    with contextlib.suppress(AyssError):
+        spcp_step = read_spcp(folder.spcp_json).step
     if not rows or spcp_step is None:
         return Training(total, every, key, len(rows), spcp_step)
     last = rows[-1]

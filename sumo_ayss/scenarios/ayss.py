@@ -33,7 +33,7 @@ safety-critical, avoidable starts are kept. Procedure of :func:`run_ayss`:
      slower near standstill, as SUMO moves it) is part of Δv̄. Δv̄ at the sampled state is
      kept too (``delta_v_bar_before_mps``), and the headway after the step (``h_after_m``).
 
-The output table follows :data:`sumo_ayss.scenarios.tables.AYSS_SCHEMA`, one row per kept
+The output table follows :data:`sumo_ayss.run_folder.AYSS_SCHEMA`, one row per kept
 sample in draw order; a seed gives the same table every time.
 """
 
@@ -56,14 +56,14 @@ from sumo_ayss.envs.cut_in import LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.errors import ActionError, ConfigError, SimulationError
-from sumo_ayss.scenarios.outcome import MeanInterval
-from sumo_ayss.scenarios.rollout import Policy
-from sumo_ayss.scenarios.tables import (
+from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     INDICATOR_ACCEL,
     INDICATOR_DELTA_V_BAR,
     Table,
 )
+from sumo_ayss.scenarios.outcome import MeanInterval
+from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.sim.actuator import pov_acceleration
 
 __all__ = [

@@ -13,7 +13,8 @@ own quality from the comparison (:mod:`sumo_ayss.analysis.crossplay`).
 ``seed`` (by default those of the outcome stage, so the diagonal "own SPCP vs own VUT" is
 the outcome table), ``n_envs`` episodes at a time in one SUMO simulation
 (:class:`~sumo_ayss.envs.vec_env.PairVecEnv`, bit-identical per pair to the single env).
-One row per (VUT, opponent, scenario) goes to :data:`CROSSPLAY_SCHEMA`.
+One row per (VUT, opponent, scenario) goes to
+:data:`~sumo_ayss.run_folder.CROSSPLAY_SCHEMA`.
 """
 
 from __future__ import annotations
@@ -28,29 +29,10 @@ import numpy as np
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.errors import ConfigError
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, Table
 from sumo_ayss.scenarios.rollout import Policy
-from sumo_ayss.scenarios.tables import Column, Table, TableSchema
 
-__all__ = ["CROSSPLAY_SCHEMA", "Opponent", "run_crossplay"]
-
-CROSSPLAY_SCHEMA = TableSchema(
-    "crossplay",
-    (
-        Column("vut", "str", "-", "the VUT driven against"),
-        Column("opponent_vut", "str", "-", "the VUT the opponent SPCP was trained against"),
-        Column("opponent_seed", "int", "-", "the training seed of the opponent SPCP"),
-        Column("scenario", "int", "-", "index of the initial condition in the scenario set"),
-        Column("episode_return", "float", "-", "undiscounted sum of the rewards R of the episode"),
-        Column("collided", "bool", "-", "the episode ended in a collision"),
-        Column(
-            "final_headway_m",
-            "float",
-            "m",
-            "headway h after the last step (POV rear minus VUT front; < 0 = overlap)",
-        ),
-        Column("n_steps", "int", "-", "decisions in the episode"),
-    ),
-)
+__all__ = ["Opponent", "run_crossplay"]
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ default seed :data:`DEFAULT_OUTCOME_SEED` differs from the training's candidate-
 seed (``train.eval_seed``, 2024), so an SPCP is not scored on the scenarios it was selected
 on.
 
-One row per episode goes to the outcome table (:data:`~sumo_ayss.scenarios.tables.
+One row per episode goes to the outcome table (:data:`~sumo_ayss.run_folder.
 OUTCOME_SCHEMA`); :func:`summarize_outcome` reduces it to
 
 * crash rate and lane-change rate: proportions with a Wilson score interval
@@ -35,8 +35,8 @@ from sumo_ayss.analysis.stats import check_level, mean_ci
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.errors import ConfigError
+from sumo_ayss.run_folder import OUTCOME_SCHEMA, Table
 from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, run_episode
-from sumo_ayss.scenarios.tables import OUTCOME_SCHEMA, Table
 
 __all__ = [
     "DEFAULT_OUTCOME_N",
@@ -165,7 +165,7 @@ class OutcomeSummary:
     lc_no_collision_final_headway_m: MeanInterval | None
 
     def as_dict(self) -> dict[str, Any]:
-        """Nested plain dict (NaN stays NaN; :func:`tables.write_json` writes it as null)."""
+        """Nested plain dict (NaN stays NaN; ``run_folder.write_json`` writes it as null)."""
         return asdict(self)
 
 

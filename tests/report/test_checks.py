@@ -2,31 +2,54 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import pytest
-import yaml
 
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.report import write_report
 from sumo_ayss.report.checks import read_training, trust_warnings
+from sumo_ayss.run_folder import (
+    RunConfig,
+    RunFolder,
+    read_run_config,
+    write_eval_table,
+    write_run_config,
+    write_spcp,
+)
+from sumo_ayss.selection import Selection
 from tests.report.test_report import FAST, make_run
 
 
 def _set_budget(run_dir: Path, total: int, every: int = 10_000) -> None:
-    path = run_dir / "config.yaml"
-    data = yaml.safe_load(path.read_text())
-    data["train"] = {"total_timesteps": total, "eval_every": every}
-    path.write_text(yaml.safe_dump(data))
+    folder = RunFolder(run_dir)
+    config = read_run_config(folder.config)
+    train = {"total_timesteps": total, "eval_every": every}
+    write_run_config(
+        folder.config, RunConfig(config.vut, config.seed, {**config.experiment, "train": train})
+    )
 
 
 def _set_eval(run_dir: Path, returns: list[float], spcp_step: int) -> None:
-    lines = ["step,mean_return,std_return,n_episodes"]
-    lines += [f"{10_000 * (k + 1)},{r},2.0,100" for k, r in enumerate(returns)]
-    (run_dir / "eval.csv").write_text("\n".join(lines) + "\n")
-    spcp = json.loads((run_dir / "spcp.json").read_text())
-    (run_dir / "spcp.json").write_text(json.dumps({**spcp, "step": spcp_step}))
+    folder = RunFolder(run_dir)
+    rows = [
+        {
+            "step": 10_000 * (k + 1),
+            "mean_return": r,
+            "std_return": 2.0,
+            "crash_rate": 0.0,
+            "lane_change_rate": 0.0,
+            "mean_final_headway_m": 2.0,
+            "n_episodes": 100,
+            "wall_s": 1.0,
+            "checkpoint": folder.checkpoint_model(folder.step_dir(10_000 * (k + 1))),
+        }
+        for k, r in enumerate(returns)
+    ]
+    write_eval_table(folder.eval_table, rows)
+    row = next(r for r in rows if r["step"] == spcp_step)
+    choice = Selection(rows.index(row), spcp_step, row["mean_return"], "mean_reward", "best")
+    write_spcp(folder.spcp_json, choice, row["checkpoint"], row)
 
 
 def test_spcp_state_from_the_learning_curve(tmp_path: Path) -> None:

@@ -1,8 +1,8 @@
-"""Report stage on synthetic run folders (no SUMO, no training, no torch)."""
+"""Report stage on synthetic run folders written by the real writers (no SUMO run, no
+training, no torch)."""
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 import re
@@ -14,14 +14,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
 from sumo_ayss.analysis.ranking import POV_ACCELERATION, SafetyIndex
 from sumo_ayss.catalog import BUILTIN_VUTS
 from sumo_ayss.config import RewardConfig, to_dict
 from sumo_ayss.report import (
-    AYSS_COLUMNS,
-    OUTCOME_KEYS,
     RUN_FILES,
     ReportOptions,
     find_run_dirs,
@@ -31,11 +28,21 @@ from sumo_ayss.report import (
     write_report,
 )
 from sumo_ayss.report.__main__ import main
-
-EVAL_HEADER = (
-    "step,mean_return,std_return,crash_rate,lane_change_rate,mean_final_headway_m,"
-    "n_episodes,wall_s,checkpoint"
+from sumo_ayss.run_folder import (
+    AYSS_SCHEMA,
+    RunConfig,
+    RunFolder,
+    StageHeader,
+    Table,
+    write_eval_table,
+    write_outcome_json,
+    write_run_config,
+    write_spcp,
+    write_table,
+    write_versions,
 )
+from sumo_ayss.scenarios.outcome import MeanInterval, OutcomeSummary, Proportion
+from sumo_ayss.selection import Selection
 
 #: Mean indicator offset per VUT: pi2's SPCPs are clearly more aggressive (more negative).
 OFFSET = {"pi1": 0.0, "pi2": -1.5, "pi1_again": 0.0}
@@ -45,8 +52,12 @@ EXPOSURE = {"pi1": 0.0, "pi2": -1.0, "pi1_again": 0.0}
 FAST = ReportOptions(n_boot=400)
 
 
-def _estimate(value: float, half: float) -> dict[str, float]:
-    return {"value": value, "lo": max(0.0, value - half), "hi": value + half}
+def _proportion(value: float, half: float, n: int = 200) -> Proportion:
+    return Proportion(round(value * n), n, value, max(0.0, value - half), value + half, 0.95)
+
+
+def _mean(value: float, half: float, n: int = 200) -> MeanInterval:
+    return MeanInterval(n, value, value - half, value + half, 0.95)
 
 
 def make_run(
@@ -58,9 +69,10 @@ def make_run(
     files: Sequence[str] = ("config", "eval", "spcp", "outcome", "ayss", "versions"),
     n_samples: int = 300,
 ) -> Path:
-    """Writes a plausible run folder ``root/case/vut/seed_<seed>`` with synthetic data."""
-    run_dir = root / case / vut / f"seed_{seed}"
-    run_dir.mkdir(parents=True)
+    """Writes a plausible run folder ``root/case/vut/seed_<seed>`` with synthetic data,
+    through the run folder's own writers (those train and evaluate call)."""
+    folder = RunFolder(root / case / vut / f"seed_{seed}")
+    folder.path.mkdir(parents=True)
     rng = np.random.default_rng([seed, zlib.crc32(vut.encode()), int(case == "cut_in")])
     if "config" in files:
         env = {
@@ -69,57 +81,58 @@ def make_run(
             "vuts": {k: to_dict(v) for k, v in BUILTIN_VUTS.items()},
             "reward": to_dict(RewardConfig()),
         }
-        data = {"vut": vut, "seed": seed, "env": env, "agent": {"gamma": 0.8}, "train": {}}
-        (run_dir / RUN_FILES.config).write_text(yaml.safe_dump(data, sort_keys=False))
+        experiment = {"env": env, "agent": {"gamma": 0.8}, "train": {}}
+        write_run_config(folder.config, RunConfig(vut, seed, experiment))
     steps = np.arange(10_000, 200_001, 10_000)
     returns = 19.0 * (1 - np.exp(-steps / 40_000)) + rng.normal(0, 0.3, steps.size)
+    rows = []
+    for s, r in zip(steps, returns, strict=True):
+        crash = max(0.0, 0.3 * math.exp(-s / 50_000) + rng.normal(0, 0.01))
+        rows.append(
+            {
+                "step": int(s),
+                "mean_return": round(float(r), 4),
+                "std_return": 2.0,
+                "crash_rate": round(crash, 3),
+                "lane_change_rate": 0.9 if case == "cut_in" else 0.0,
+                "mean_final_headway_m": 2.1,
+                "n_episodes": 100,
+                "wall_s": 12.5,
+                "checkpoint": folder.checkpoint_model(folder.step_dir(int(s))),
+            }
+        )
     if "eval" in files:
-        lines = [EVAL_HEADER]
-        for s, r in zip(steps, returns, strict=True):
-            crash = max(0.0, 0.3 * math.exp(-s / 50_000) + rng.normal(0, 0.01))
-            lc = 0.9 if case == "cut_in" else 0.0
-            lines.append(f"{s},{r:.4f},2.0,{crash:.3f},{lc},2.1,100,12.5,ckpt/step_{s}/model.zip")
-        (run_dir / RUN_FILES.eval_table).write_text("\n".join(lines) + "\n")
+        write_eval_table(folder.eval_table, rows)
     if "spcp" in files:
         best = int(np.argmax(returns))
-        spcp = {
-            "step": int(steps[best]),
-            "score": float(returns[best]),
-            "criterion": "mean_reward",
-            "reason": "best",
-            "checkpoint": f"ckpt/step_{steps[best]}/model.zip",
-            "row": {},
-        }
-        (run_dir / RUN_FILES.spcp).write_text(json.dumps(spcp))
+        choice = Selection(best, int(steps[best]), float(returns[best]), "mean_reward", "best")
+        write_spcp(folder.spcp_json, choice, rows[best]["checkpoint"], rows[best])
     if "outcome" in files:
         outcome_rng = np.random.default_rng([seed, zlib.crc32(vut.encode()), 7])
-        outcome = {
-            OUTCOME_KEYS.n: 200,
-            OUTCOME_KEYS.crash_rate: _estimate(0.01 * (seed % 3), 0.01),
-            OUTCOME_KEYS.mean_return: _estimate(
-                19.4 + EXPOSURE.get(vut, 0.0) + outcome_rng.normal(0.0, 0.1), 0.2
-            ),
-            OUTCOME_KEYS.mean_final_headway_m: _estimate(1.7 + 0.8 * (vut == "pi2"), 0.3),
-        }
-        if case == "cut_in":
-            outcome[OUTCOME_KEYS.lane_change_rate] = _estimate(0.99, 0.01)
-            outcome[OUTCOME_KEYS.lane_change_no_collision] = {
-                "n": 196,
-                OUTCOME_KEYS.mean_return: _estimate(20.8, 0.2),
-                OUTCOME_KEYS.mean_final_headway_m: _estimate(0.36, 0.05),
-            }
-        (run_dir / RUN_FILES.outcome).write_text(json.dumps(outcome))
+        cut_in = case == "cut_in"
+        summary = OutcomeSummary(
+            case=case,
+            n_episodes=200,
+            crash_rate=_proportion(0.01 * (seed % 3), 0.01),
+            lane_change_rate=_proportion(0.99, 0.01) if cut_in else None,
+            mean_return=_mean(19.4 + EXPOSURE.get(vut, 0.0) + outcome_rng.normal(0.0, 0.1), 0.2),
+            mean_final_headway_m=_mean(1.7 + 0.8 * (vut == "pi2"), 0.3),
+            lc_no_collision_return=_mean(20.8, 0.2, 196) if cut_in else None,
+            lc_no_collision_final_headway_m=_mean(0.36, 0.05, 196) if cut_in else None,
+        )
+        header = StageHeader(str(folder.path), case, vut, seed, None)
+        settings = {"n": 200, "seed": 4242}
+        write_outcome_json(folder.outcome_json, header, settings, {}, summary.as_dict(), 1.0)
     if "ayss" in files:
-        _write_ayss(run_dir / RUN_FILES.ayss, case, vut, rng, n_samples)
+        _write_ayss(folder.ayss_csv, case, vut, rng, n_samples)
     if "versions" in files:
         versions = {"python": "3.11.2", "eclipse-sumo": "1.28.0", "numpy": np.__version__}
-        (run_dir / RUN_FILES.versions).write_text(json.dumps(versions))
-    return run_dir
+        write_versions(folder.versions, versions)
+    return folder.path
 
 
 def _write_ayss(path: Path, case: str, vut: str, rng: np.random.Generator, n: int) -> None:
-    cols = AYSS_COLUMNS
-    h = rng.uniform(0.0, 5.0, n)
+    h = np.round(rng.uniform(0.0, 5.0, n), 4)
     seed_shift = rng.normal(0.0, 0.1)
     if case == "car_following":
         y = np.clip(-2.5 + 0.35 * h + OFFSET[vut] + seed_shift + rng.normal(0, 0.8, n), -6, 6)
@@ -127,22 +140,21 @@ def _write_ayss(path: Path, case: str, vut: str, rng: np.random.Generator, n: in
     else:
         y = -1.0 - 0.2 * h + OFFSET[vut] + seed_shift + rng.normal(0, 0.6, n)
         name = "delta_v_bar_mps"
-    header = [
-        cols.v_pov,
-        cols.v_vut,
-        cols.h,
-        cols.same_lane,
-        cols.action,
-        cols.target_speed_mps,
-        cols.ttc_s,
-        cols.indicator,
-        cols.indicator_name,
-    ]
-    with path.open("w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow(header)
-        for hi, yi in zip(h, y, strict=True):
-            writer.writerow([20.0, 22.0, f"{hi:.4f}", 0, 3, 15.0, 2.5, f"{yi:.4f}", name])
+    columns = {
+        "sample": np.arange(n),
+        "v_pov_mps": np.full(n, 20.0),
+        "v_vut_mps": np.full(n, 22.0),
+        "h_m": h,
+        "same_lane": np.full(n, int(case == "car_following")),
+        "action": np.full(n, 3),
+        "target_speed_mps": np.full(n, 15.0),
+        "ttc_s": np.full(n, 2.5),
+        "indicator_name": np.full(n, name),
+        "indicator": np.round(y, 4),
+        "h_after_m": np.full(n, np.nan),
+        "delta_v_bar_before_mps": np.full(n, np.nan),
+    }
+    write_table(path, Table(AYSS_SCHEMA, columns))
 
 
 @pytest.fixture(scope="module")
@@ -277,9 +289,9 @@ def test_bootstrap_alone_is_not_significant() -> None:
     assert pair.sentence.startswith("A is safer than B") and "Welch test: p" in pair.sentence
 
 
-def test_outcome_reader_accepts_variants(tmp_path: Path) -> None:
+def test_outcome_reader_refuses_shapes_no_writer_produces(tmp_path: Path) -> None:
     run_dir = make_run(tmp_path, "cut_in", "pi1", 0, files=("config",))
-    outcome = {
+    outcome = {  # estimates at the top level, aliased keys: not what evaluate writes
         "n_episodes": 200,
         "crash_rate": {"mean": 0.02, "ci": [0.005, 0.05]},
         "lane_change_rate": 0.98,
@@ -287,28 +299,33 @@ def test_outcome_reader_accepts_variants(tmp_path: Path) -> None:
     }
     (run_dir / RUN_FILES.outcome).write_text(json.dumps(outcome))
     run = load_run(run_dir)
-    o = run.outcome
-    assert o is not None and o.n == 200
-    assert (o.crash_rate.value, o.crash_rate.lo, o.crash_rate.hi) == (0.02, 0.005, 0.05)
-    assert o.lane_change_rate is not None and o.lane_change_rate.value == 0.98
-    assert math.isnan(o.lane_change_rate.lo)
-    assert not o.mean_final_headway_m.known and o.lane_change_no_collision is None
+    assert run.outcome is None
+    text = " | ".join(run.problems)
+    assert "outcome.json unreadable" in text and "missing field 'summary'" in text
     assert run.reward == RewardConfig() and run.seed == 0 and run.case == "cut_in"
     assert "ayss.csv missing" in run.problems and "eval.csv missing" in run.problems
 
 
-def test_tolerant_readers_on_bad_files(tmp_path: Path) -> None:
+def test_unreadable_files_are_reported_not_fatal(tmp_path: Path) -> None:
     run_dir = make_run(tmp_path, "car_following", "pi1", 0, files=())
     (run_dir / RUN_FILES.outcome).write_text("{not json")
     (run_dir / RUN_FILES.ayss).write_text("h_m,indicator,indicator_name\n1.0,-2.0,x\nnan,1,x\n")
     (run_dir / RUN_FILES.eval_table).write_text("step,other\n1,2\n")
     run = load_run(run_dir)
     assert run.case == "car_following" and run.vut == "pi1" and run.seed == 0
-    assert run.outcome is None and run.eval_curve is None
-    assert run.ayss is not None and len(run.ayss) == 1 and run.ayss.n_dropped == 1
+    assert run.outcome is None and run.eval_curve is None and run.ayss is None
     text = " | ".join(run.problems)
     assert "outcome.json unreadable" in text and "eval.csv unreadable" in text
-    assert "config.yaml missing" in text and "unknown indicator_name 'x'" in text
+    assert "ayss.csv unreadable" in text and "missing column(s)" in text
+    assert "config.yaml missing" in text
+
+
+def test_ayss_of_the_other_case_is_reported(tmp_path: Path) -> None:
+    run_dir = make_run(tmp_path, "car_following", "pi1", 0, files=("config",))
+    _write_ayss(run_dir / RUN_FILES.ayss, "cut_in", "pi1", np.random.default_rng(0), 10)
+    run = load_run(run_dir)
+    assert run.ayss is not None and len(run.ayss) == 10
+    assert any("belongs to cut_in, not car_following" in p for p in run.problems)
 
 
 def test_find_run_dirs_skips_the_report_folder(tmp_path: Path) -> None:

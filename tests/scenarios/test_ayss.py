@@ -14,6 +14,7 @@ from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.cut_in import FIRST_SPEED_ACTION, LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.errors import ActionError, ConfigError
+from sumo_ayss.run_folder import AYSS_SCHEMA, read_table, write_table
 from sumo_ayss.scenarios.ayss import (
     car_following_indicator,
     cut_in_mask,
@@ -22,7 +23,6 @@ from sumo_ayss.scenarios.ayss import (
     sample_observations,
     ttc_s,
 )
-from sumo_ayss.scenarios.tables import AYSS_SCHEMA, read_table, write_table
 from sumo_ayss.sim.actuator import pov_acceleration
 
 # --------------------------------------------------------------------------- hand cases

@@ -17,6 +17,12 @@ from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.evaluate import evaluate_run, main
+from sumo_ayss.run_folder import (
+    AYSS_SCHEMA,
+    OUTCOME_SCHEMA,
+    read_table,
+    table_from_rows,
+)
 from sumo_ayss.scenarios.outcome import (
     MeanInterval,
     Proportion,
@@ -25,12 +31,6 @@ from sumo_ayss.scenarios.outcome import (
     wilson_interval,
 )
 from sumo_ayss.scenarios.rollout import Policy
-from sumo_ayss.scenarios.tables import (
-    AYSS_SCHEMA,
-    OUTCOME_SCHEMA,
-    read_table,
-    table_from_rows,
-)
 from sumo_ayss.train import train
 from tests.helpers import tiny_experiment
 

@@ -9,12 +9,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sumo_ayss.errors import AyssError
-from sumo_ayss.scenarios.tables import (
+from sumo_ayss.errors import AyssError, TableError
+from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     OUTCOME_SCHEMA,
     Table,
-    TableError,
     read_json,
     read_table,
     schema_markdown,

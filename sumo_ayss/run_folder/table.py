@@ -1,17 +1,8 @@
-"""Schemas, writers and validating readers of the evaluation tables (CSV) and summaries (JSON).
-
-Two tables leave the evaluation stages, one row per item, as plain CSV that a person can open
-in any spreadsheet (stdlib :mod:`csv`, no pandas):
-
-* :data:`OUTCOME_SCHEMA` — ``<run>/outcome.csv``, one row per outcome episode (paper
-  Tables II and III): the initial condition, the return, whether it crashed or changed lanes,
-  the headway at the last step.
-* :data:`AYSS_SCHEMA` — ``<run>/ayss.csv``, one row per kept adversarial-yet-safe sample of
-  the Monte Carlo stage (paper Fig. 4 and 6): the sampled observation, the SPCP's action,
-  TTC and the aggressiveness indicator.
+"""Schema'd CSV tables: typed columns, an exact on-disk encoding, one writer, one reader.
 
 Every column has a name, a dtype, a unit and a meaning (:class:`Column`);
-:func:`schema_markdown` prints them as a Markdown table for the docs. Encoding on disk:
+:func:`schema_markdown` prints them as a Markdown table for the docs. Encoding on disk
+(stdlib :mod:`csv`, no pandas; a person can open the file in any spreadsheet):
 
 * ``float``: Python's ``repr`` of the float64 value (shortest text that reads back to the
   same number), ``inf`` / ``-inf`` / ``nan`` for non-finite values. A column accepts NaN only
@@ -19,22 +10,18 @@ Every column has a name, a dtype, a unit and a meaning (:class:`Column`);
 * ``int``: decimal integer. ``bool``: ``0`` / ``1`` (``true`` / ``false`` accepted on read).
 * ``str``: the text; ``choices`` restricts it to a fixed set.
 
-Files are written atomically (temporary file in the same folder, then :func:`os.replace`), so
-a reader never sees half a table. :func:`read_table` checks the header (missing and extra
-columns), every cell's dtype, NaN / inf where they are not allowed, and the choices, and
-raises :data:`TableError` naming the file, column and row.
+:func:`write_table` writes atomically (temporary file in the same folder, then
+:func:`os.replace`), so a reader never sees half a table. :func:`read_table` checks the header
+(missing and extra columns), every cell's dtype, NaN / inf where they are not allowed, and
+the choices, and raises :class:`~sumo_ayss.errors.TableError` naming the file, column and row.
 
-:data:`TableError` is ``sumo_ayss.errors.TableError`` when that module defines it, otherwise a
-local subclass of both :class:`~sumo_ayss.errors.CheckpointError` and :class:`ValueError`
-(catch it by this module's name, or as ``CheckpointError`` / ``ValueError``).
+The schemas of the run folder's tables are in :mod:`sumo_ayss.run_folder.schemas`.
 """
 
 from __future__ import annotations
 
 import csv
 import io
-import json
-import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,38 +30,20 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-import sumo_ayss.errors as _errors
 from sumo_ayss.atomic import atomic_write_text
-from sumo_ayss.errors import AyssError, CheckpointError
+from sumo_ayss.errors import TableError
 
 __all__ = [
-    "AYSS_SCHEMA",
-    "INDICATOR_ACCEL",
-    "INDICATOR_DELTA_V_BAR",
-    "INDICATOR_NAMES",
-    "OUTCOME_SCHEMA",
     "Column",
     "Table",
-    "TableError",
     "TableSchema",
-    "atomic_write_text",
-    "read_json",
     "read_table",
     "schema_markdown",
     "table_from_rows",
-    "write_json",
     "write_table",
 ]
 
 Dtype = Literal["int", "float", "bool", "str"]
-
-
-class _FallbackTableError(CheckpointError, ValueError):
-    """A table or summary file is missing, malformed, or does not match its schema."""
-
-
-#: Raised when a table does not match its schema (see the module docstring).
-TableError: type[AyssError] = getattr(_errors, "TableError", _FallbackTableError)
 
 _NUMPY_DTYPE: dict[str, type] = {"int": np.int64, "float": np.float64, "bool": np.bool_}
 _TRUE = frozenset({"1", "true", "True", "TRUE"})
@@ -141,110 +110,6 @@ def schema_markdown(schema: TableSchema) -> str:
         note = f" ({'; '.join(extra)})" if extra else ""
         lines.append(f"| `{c.name}` | {c.dtype} | {c.unit} | {c.meaning}{note} |")
     return "\n".join(lines) + "\n"
-
-
-#: ``<run>/outcome.csv``: one row per episode of the outcome stage (paper Tables II, III).
-OUTCOME_SCHEMA = TableSchema(
-    "outcome",
-    (
-        Column("scenario", "int", "-", "index of the initial condition in the scenario set"),
-        Column("v_pov0_mps", "float", "m/s", "POV speed at the start of the episode"),
-        Column("v_vut0_mps", "float", "m/s", "VUT speed at the start of the episode"),
-        Column(
-            "gap0_m",
-            "float",
-            "m",
-            "initial longitudinal gap, POV rear bumper minus VUT front bumper",
-        ),
-        Column("episode_return", "float", "-", "undiscounted sum of the rewards R of the episode"),
-        Column("collided", "bool", "-", "the episode ended in a collision"),
-        Column(
-            "lane_changed",
-            "bool",
-            "-",
-            "the POV started a lane change (cut-in); always 0 in car-following",
-        ),
-        Column(
-            "final_headway_m",
-            "float",
-            "m",
-            "headway h after the last step (POV rear minus VUT front; < 0 = overlap)",
-        ),
-        Column("n_steps", "int", "-", "decisions taken (25 for a full 5 s episode)"),
-    ),
-)
-
-#: Aggressiveness indicator of car-following: POV acceleration [m/s²], < 0 brakes.
-INDICATOR_ACCEL = "pov_accel_mps2"
-#: Aggressiveness indicator of cut-in: Δv̄ [m/s], < 0 closes in.
-INDICATOR_DELTA_V_BAR = "delta_v_bar_mps"
-#: Allowed values of ``ayss.csv``'s ``indicator_name``.
-INDICATOR_NAMES = (INDICATOR_ACCEL, INDICATOR_DELTA_V_BAR)
-
-#: ``<run>/ayss.csv``: one row per kept adversarial-yet-safe sample (paper Fig. 4 and 6).
-AYSS_SCHEMA = TableSchema(
-    "ayss",
-    (
-        Column("sample", "int", "-", "index of the draw in the seed's Monte Carlo sample"),
-        Column("v_pov_mps", "float", "m/s", "sampled POV speed (observation)"),
-        Column("v_vut_mps", "float", "m/s", "sampled VUT speed (observation)"),
-        Column(
-            "h_m",
-            "float",
-            "m",
-            "sampled headway, POV rear bumper minus VUT front bumper (observation)",
-        ),
-        Column(
-            "same_lane",
-            "int",
-            "-",
-            "same-lane flag of the observation: 1 in car-following, 0 in cut-in",
-        ),
-        Column("action", "int", "-", "the SPCP's (greedy) action index"),
-        Column(
-            "target_speed_mps",
-            "float",
-            "m/s",
-            "target speed the action asks for (cut-in lane change: the POV keeps v_pov)",
-        ),
-        Column(
-            "ttc_s",
-            "float",
-            "s",
-            "time to collision h / (v_vut - v_pov) when closing, +inf otherwise",
-            allow_inf=True,
-        ),
-        Column(
-            "indicator_name",
-            "str",
-            "-",
-            "pov_accel_mps2 (car-following) or delta_v_bar_mps (cut-in)",
-            choices=INDICATOR_NAMES,
-        ),
-        Column(
-            "indicator",
-            "float",
-            "m/s² or m/s",
-            "aggressiveness: POV acceleration (< 0 brakes) or Δv̄ (< 0 closes in); "
-            "smaller = more aggressive",
-        ),
-        Column(
-            "h_after_m",
-            "float",
-            "m",
-            "cut-in: headway after the 1-step scenario in SUMO; NaN in car-following",
-            nullable=True,
-        ),
-        Column(
-            "delta_v_bar_before_mps",
-            "float",
-            "m/s",
-            "cut-in: Δv̄ at the sampled state, before the action acts (no lateral speed); "
-            "NaN in car-following",
-            nullable=True,
-        ),
-    ),
-)
 
 
 # --------------------------------------------------------------------------- table object
@@ -469,53 +334,5 @@ def _parse_column(col: Column, texts: Sequence[str], path: Path) -> npt.NDArray[
     raise TableError(f"{path}: column {col.name!r}: values do not parse as {col.dtype}")
 
 
-def _cell_error(path: Path, col: Column, row: int, text: str) -> AyssError:
+def _cell_error(path: Path, col: Column, row: int, text: str) -> TableError:
     return TableError(f"{path}: column {col.name!r}, row {row}: expected {col.dtype}, got {text!r}")
-
-
-# --------------------------------------------------------------------------- JSON summaries
-
-
-def _jsonable(obj: Any) -> Any:
-    """Plain JSON types: numpy scalars/arrays to Python, tuples to lists, NaN/inf to None."""
-    if isinstance(obj, Mapping):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, np.generic):
-        return _jsonable(obj.item())
-    if isinstance(obj, Path):
-        return str(obj)
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
-
-
-def write_json(path: str | Path, data: Mapping[str, Any]) -> None:
-    """Write a summary as indented, key-sorted JSON, atomically.
-
-    Non-finite floats (NaN, ±inf) are written as ``null`` (strict JSON has no NaN); numpy
-    scalars and arrays become Python numbers and lists; paths become strings.
-    """
-    text = json.dumps(_jsonable(data), indent=2, sort_keys=True, allow_nan=False)
-    atomic_write_text(path, text + "\n")
-
-
-def read_json(path: str | Path) -> dict[str, Any]:
-    """Read a summary written by :func:`write_json`.
-
-    Raises:
-        TableError: If the file is missing, not JSON, or not a JSON object.
-    """
-    path = Path(path)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise TableError(f"{path}: summary file not found") from None
-    except json.JSONDecodeError as exc:
-        raise TableError(f"{path}: not valid JSON ({exc})") from None
-    if not isinstance(data, dict):
-        raise TableError(f"{path}: expected a JSON object, got {type(data).__name__}")
-    return data

@@ -1,54 +1,11 @@
-"""Replayable scenarios: an AYSS sample or an outcome episode of a run, as SUMO files.
-
-    python -m sumo_ayss.replay export runs/cut_in/pi1/seed_0 --ayss-row 12 --out scen/ayss12
-    python -m sumo_ayss.replay export runs/cut_in/pi1/seed_0 --outcome-row 3 --out scen/ep3
-    python -m sumo_ayss.replay scen/ayss12              # sumo-gui (needs a display)
-    python -m sumo_ayss.replay scen/ayss12 --headless   # sumo; writes and checks replayed.fcd.xml
-
-**Export** re-runs the scenario in the run's own env (its ``config.yaml``: case, VUT, ODD,
-actuator, SUMO options; SUMO seed = the run's seed, as in evaluation) with the run's SPCP
-(``spcp.zip``, greedy), records both vehicles at every SUMO step, and writes into ``--out``:
-
-======================  ====================================================================
-``network.net.xml``     copy of the run's road network
-``vtypes.add.xml``      vehicle types: the run's VUT (``vut_<name>``) and the POV (``pov``)
-``trajectory.fcd.xml``  the recorded trajectory in SUMO's FCD format (vehicles ``vut``,
-                        ``pov``); file time ``t = τ + dt`` (see below)
-``scenario.sumocfg``    replays the trajectory with SUMO's fcd-replay device
-``gui.settings.xml``    sumo-gui's view (centred on the scenario) and real-time delay
-``scenario.json``       where it came from (run, table row), the initial condition, the
-                        SPCP's actions, rewards and headways per decision, and whether the
-                        re-run reproduced the row (action, return, collision)
-``README.md``           how to replay
-======================  ====================================================================
-
-Which scenario: ``--ayss-row K`` is data row ``K`` (0-based) of the run's ``ayss.csv``: the
-sampled observation ``(v_pov_mps, v_vut_mps, h_m)`` is the initial condition and the
-scenario is the AYSS's ``d = 1`` decision (``--decisions N`` continues with the SPCP for up
-to ``N`` decisions). ``--outcome-row K`` is data row ``K`` of ``outcome.csv``: the initial
-condition ``(v_pov0_mps, v_vut0_mps, gap0_m)`` and the whole episode.
-
-**Replay mechanism**: SUMO's native fcd-replay device (:mod:`sumo_ayss.sim.export`), so
-the scenario plays in an unmodified ``sumo-gui -c scenario.sumocfg``, with no Python. Its
-first record only inserts the vehicles (upstream, standing, as the env does); the
-scenario's initial state is at ``t = dt`` and scenario time ``τ`` is file time ``τ + dt``.
-In the replay both vehicles follow the recording exactly: positions and speeds match it
-within :data:`POSITION_TOL_M` and :data:`SPEED_TOL_MPS` (what ``--headless`` checks).
-Neither vehicle's model acts in a replay: it shows what happened, it does not re-simulate.
-No routes file is written: the device builds each vehicle's route from the trajectory, and
-a routes file defining the same vehicle ids is refused by SUMO ("Another vehicle with the
-id 'pov' exists").
-"""
+"""Export one scenario of a run (an AYSS sample or an outcome episode) as SUMO files (see
+:mod:`sumo_ayss.replay`)."""
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import json
 import math
-import os
-import subprocess
-import sys
 import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -59,40 +16,38 @@ import numpy as np
 
 from sumo_ayss.atomic import atomic_copy, atomic_write_text
 from sumo_ayss.catalog import controller_imports, vtypes_xml
-from sumo_ayss.cli import prog
 from sumo_ayss.config import EnvConfig, to_dict
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.errors import AyssError, CheckpointError, ConfigError, SimulationError
+from sumo_ayss.errors import CheckpointError, ConfigError, SimulationError
 from sumo_ayss.paths import portable_path
+from sumo_ayss.replay.playback import (
+    GUI_FILE,
+    NET_FILE,
+    POSITION_TOL_M,
+    SCENARIO_FILE,
+    SPEED_TOL_MPS,
+    SUMOCFG_FILE,
+    TRAJECTORY_FILE,
+    VTYPES_FILE,
+)
+from sumo_ayss.run_folder import (
+    AYSS_CSV,
+    AYSS_SCHEMA,
+    OUTCOME_CSV,
+    OUTCOME_SCHEMA,
+    RunFolder,
+    read_table,
+)
 from sumo_ayss.scenarios.rollout import Policy
-from sumo_ayss.scenarios.tables import AYSS_SCHEMA, OUTCOME_SCHEMA, read_table
 from sumo_ayss.sim import export
 from sumo_ayss.sim.network import network_path
 
-__all__ = [
-    "POSITION_TOL_M",
-    "SPEED_TOL_MPS",
-    "ExportResult",
-    "ReplayCheck",
-    "compare_trajectories",
-    "export_scenario",
-    "main",
-    "replay_headless",
-    "replay_in_gui",
-]
+__all__ = ["ExportResult", "export_scenario"]
 
-#: A replayed position may differ from the recorded one by this much [m] (Euclidean).
-POSITION_TOL_M = 1e-3
-#: A replayed speed may differ from the recorded one by this much [m/s].
-SPEED_TOL_MPS = 1e-3
 #: The reset must reproduce a row's state to this tolerance [m/s, m] (float32 rows).
 _RESET_TOL = 1e-3
-
-NET_FILE, VTYPES_FILE, TRAJECTORY_FILE = "network.net.xml", "vtypes.add.xml", "trajectory.fcd.xml"
-SUMOCFG_FILE, SCENARIO_FILE, REPLAYED_FILE = "scenario.sumocfg", "scenario.json", "replayed.fcd.xml"
-GUI_FILE = "gui.settings.xml"
 
 Kind = Literal["ayss", "outcome"]
 
@@ -114,42 +69,18 @@ class ExportResult:
     info: dict[str, Any]
 
 
-@dataclass(frozen=True)
-class ReplayCheck:
-    """Replayed vs. recorded trajectory.
-
-    Attributes:
-        n_points: Vehicle records compared (every vehicle at every ``τ >= 0``).
-        max_position_error_m: Largest Euclidean distance between replayed and recorded
-            front-bumper positions [m].
-        max_speed_error_mps: Largest absolute speed difference [m/s].
-        missing: Recorded (time, vehicle) pairs absent from the replay.
-    """
-
-    n_points: int
-    max_position_error_m: float
-    max_speed_error_mps: float
-    missing: tuple[tuple[float, str], ...]
-
-    @property
-    def ok(self) -> bool:
-        """Within :data:`POSITION_TOL_M` and :data:`SPEED_TOL_MPS`, nothing missing."""
-        return (
-            not self.missing
-            and self.n_points > 0
-            and self.max_position_error_m <= POSITION_TOL_M
-            and self.max_speed_error_mps <= SPEED_TOL_MPS
-        )
-
-
 # --------------------------------------------------------------------------- export
 
 
 def _row(run_dir: Path, kind: Kind, index: int) -> dict[str, Any]:
-    name, schema = ("ayss.csv", AYSS_SCHEMA) if kind == "ayss" else ("outcome.csv", OUTCOME_SCHEMA)
-    path = run_dir / name
+    folder = RunFolder(run_dir)
+    path, schema = (
+        (folder.ayss_csv, AYSS_SCHEMA) if kind == "ayss" else (folder.outcome_csv, OUTCOME_SCHEMA)
+    )
     if not path.is_file():
-        raise CheckpointError(f"{run_dir}: no {name} (run `python -m sumo_ayss.evaluate` first)")
+        raise CheckpointError(
+            f"{run_dir}: no {path.name} (run `python -m sumo_ayss.evaluate` first)"
+        )
     table = read_table(path, schema)
     if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < len(table):
         raise ConfigError(
@@ -384,7 +315,7 @@ def _info(
     return {
         "source": {
             "run_dir": portable_path(run.run_dir),
-            "table": "ayss.csv" if kind == "ayss" else "outcome.csv",
+            "table": AYSS_CSV if kind == "ayss" else OUTCOME_CSV,
             "row": index,
             "values": {k: _json_value(v) for k, v in row.items()},
             "spcp_step": run.spcp_step,
@@ -434,172 +365,3 @@ def _readme(info: dict[str, Any]) -> str:
         f"inserts them upstream; the scenario starts at t = {info['time_offset_s']:g} s "
         "(scenario time tau = t - that offset). Details: `scenario.json`.\n"
     )
-
-
-# --------------------------------------------------------------------------- replay
-
-
-def compare_trajectories(
-    recorded: Sequence[export.FcdPoint], replayed: Sequence[export.FcdPoint], start_s: float
-) -> ReplayCheck:
-    """Replayed vs. recorded records at every time ``>= start_s`` (the scenario's τ = 0)."""
-    got = {(round(p.time_s, 6), p.vehicle): p for p in replayed}
-    n, pos_err, speed_err, missing = 0, 0.0, 0.0, []
-    for p in recorded:
-        if p.time_s < start_s - 1e-9:
-            continue
-        q = got.get((round(p.time_s, 6), p.vehicle))
-        if q is None:
-            missing.append((p.time_s, p.vehicle))
-            continue
-        n += 1
-        pos_err = max(pos_err, math.hypot(q.x_m - p.x_m, q.y_m - p.y_m))
-        speed_err = max(speed_err, abs(q.speed_mps - p.speed_mps))
-    return ReplayCheck(n, pos_err, speed_err, tuple(missing))
-
-
-def _scenario(scenario_dir: Path) -> tuple[Path, dict[str, Any]]:
-    cfg = scenario_dir / SUMOCFG_FILE
-    info_path = scenario_dir / SCENARIO_FILE
-    if not cfg.is_file() or not info_path.is_file():
-        raise ConfigError(
-            f"{scenario_dir}: not a scenario folder (no {SUMOCFG_FILE} / {SCENARIO_FILE}); "
-            "write one with `python -m sumo_ayss.replay export RUN_DIR --ayss-row K --out DIR`"
-        )
-    return cfg, json.loads(info_path.read_text())
-
-
-def replay_headless(scenario_dir: str | Path, output: str | Path | None = None) -> ReplayCheck:
-    """Replay with the ``sumo`` binary, write the replayed FCD, compare with the recording.
-
-    Args:
-        scenario_dir: A folder written by :func:`export_scenario`.
-        output: Replayed FCD file; default ``<scenario_dir>/replayed.fcd.xml``.
-    """
-    scenario_dir = Path(scenario_dir)
-    cfg, info = _scenario(scenario_dir)
-    out = Path(output) if output is not None else scenario_dir / REPLAYED_FILE
-    export.run_headless(cfg.resolve(), out.resolve())
-    recorded = export.read_fcd(scenario_dir / TRAJECTORY_FILE)
-    return compare_trajectories(recorded, export.read_fcd(out), float(info["time_offset_s"]))
-
-
-def has_display() -> bool:
-    """Whether a GUI window can open here (X11 ``$DISPLAY`` or Wayland)."""
-    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
-
-
-def replay_in_gui(scenario_dir: str | Path, delay_ms: int = 200) -> int:
-    """Open the scenario in ``sumo-gui`` (blocks until the window is closed).
-
-    Returns:
-        sumo-gui's exit status.
-
-    Raises:
-        SimulationError: If there is no display.
-    """
-    scenario_dir = Path(scenario_dir)
-    cfg, _ = _scenario(scenario_dir)
-    if not has_display():
-        raise SimulationError(
-            "no display: $DISPLAY (and $WAYLAND_DISPLAY) is not set, so sumo-gui cannot open a "
-            f"window here. Replay without a window: python -m sumo_ayss.replay {scenario_dir} "
-            "--headless (runs sumo, writes replayed.fcd.xml, checks it against the recording); "
-            f"or copy {scenario_dir} to a machine with a display and run "
-            f"`sumo-gui -c {SUMOCFG_FILE}` in it."
-        )
-    cmd = export.gui_command(cfg.resolve(), delay_ms)
-    return subprocess.run(cmd, check=False, env=export.sumo_env()).returncode
-
-
-# --------------------------------------------------------------------------- CLI
-
-
-def _export_main(argv: Sequence[str]) -> int:
-    parser = argparse.ArgumentParser(
-        prog=prog("python -m sumo_ayss.replay") + " export",
-        description="Write an AYSS sample or an outcome episode of a run as SUMO files.",
-    )
-    parser.add_argument("run_dir", type=Path, help="run folder (config.yaml, spcp.zip, tables)")
-    which = parser.add_mutually_exclusive_group(required=True)
-    which.add_argument("--ayss-row", type=int, help="data row of ayss.csv (0-based)")
-    which.add_argument("--outcome-row", type=int, help="data row of outcome.csv (0-based)")
-    parser.add_argument("--out", type=Path, required=True, help="scenario folder to write")
-    parser.add_argument(
-        "--trust-controller",
-        action="store_true",
-        help="import the run's user-controller VUT (runs code the run folder names)",
-    )
-    parser.add_argument(
-        "--decisions",
-        type=int,
-        default=None,
-        help="SPCP decisions to record (default: 1 for AYSS, the whole episode for outcome)",
-    )
-    args = parser.parse_args(argv)
-    result = export_scenario(
-        args.run_dir,
-        args.out,
-        ayss_row=args.ayss_row,
-        outcome_row=args.outcome_row,
-        decisions=args.decisions,
-        trust_controller=args.trust_controller,
-    )
-    info = result.info
-    print(
-        f"wrote {result.out}: {len(info['decisions'])} decision(s), collision "
-        f"{info['collided']}, reproduces the row: {info['reproduces_row']}"
-    )
-    print(f"replay: python -m sumo_ayss.replay {result.out} [--headless]")
-    return 0
-
-
-def _replay_main(argv: Sequence[str]) -> int:
-    parser = argparse.ArgumentParser(
-        prog=prog("python -m sumo_ayss.replay"),
-        description="Replay a scenario folder in sumo-gui, or headless with sumo. "
-        "`python -m sumo_ayss.replay export ...` writes one.",
-    )
-    parser.add_argument("scenario_dir", type=Path, help="folder written by `... replay export`")
-    parser.add_argument(
-        "--headless",
-        action="store_true",
-        help="replay with sumo (no window), write the replayed FCD and check it",
-    )
-    parser.add_argument(
-        "--output", type=Path, default=None, help="replayed FCD file (default: replayed.fcd.xml)"
-    )
-    parser.add_argument(
-        "--delay-ms",
-        type=int,
-        default=200,
-        help="sumo-gui delay per step [ms] (200 = real time at 0.2 s steps)",
-    )
-    args = parser.parse_args(argv)
-    if not args.headless:
-        return replay_in_gui(args.scenario_dir, args.delay_ms)
-    check = replay_headless(args.scenario_dir, args.output)
-    out = args.output or args.scenario_dir / REPLAYED_FILE
-    print(
-        f"replayed {check.n_points} vehicle records into {out}: max position error "
-        f"{check.max_position_error_m:.2e} m (tolerance {POSITION_TOL_M:g}), max speed error "
-        f"{check.max_speed_error_mps:.2e} m/s (tolerance {SPEED_TOL_MPS:g}), missing "
-        f"{len(check.missing)}: {'OK' if check.ok else 'MISMATCH'}"
-    )
-    return 0 if check.ok else 1
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point: ``export RUN_DIR ...`` or ``SCENARIO_DIR [--headless]``."""
-    args = list(sys.argv[1:] if argv is None else argv)
-    try:
-        if args and args[0] == "export":
-            return _export_main(args[1:])
-        return _replay_main(args)
-    except AyssError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,0 +1,234 @@
+"""The run folder: its layout, its file names and the schema of every file in it.
+
+A run folder ``<out>/<case>/<vut>/seed_<k>/`` (:func:`run_dir_for`) holds, per stage:
+
+======================  ===========================  =========================================
+file                    writer / reader              what
+======================  ===========================  =========================================
+``config.yaml``         write_/read_run_config       configuration (VUT: ``env.vut``), ``seed``
+``command.txt``         write_/read_command          the command line
+``versions.json``       write_/read_versions         Python, platform and package versions
+``seeds.json``          write_/read_seeds            training, SUMO and evaluation seeds
+``eval.csv``            write_/read_eval_table       one row per SPCP candidate
+``checkpoints/``        write_/read_latest,          ``step_XXXXXXXXX/model.zip`` per
+                        write_/read_checkpoint_state candidate; the latest also holds the
+                                                     resume state; ``latest.json`` names it
+``spcp.json``           write_/read_spcp             the selected candidate and why
+``spcp.zip``            (a copy of its model.zip)    the SPCP
+``progress.json``       write_/read_progress         stage, step, rate, for watchers
+``tb/``                 (TensorBoard)                training logs
+``outcome.csv``         write_/read_table            one row per outcome episode
+                        (:data:`OUTCOME_SCHEMA`)
+``outcome.json``        write_/read_outcome_json     rates and means with 95 % intervals
+``ayss.csv``            write_/read_table            one row per kept AYSS sample
+                        (:data:`AYSS_SCHEMA`)
+``ayss.json``           write_/read_ayss_json        filter counts, settings, throughput
+``evaluate.done.json``  write_/read_evaluate_done    the pipeline's evaluation marker
+``job.log``             (logging)                    the pipeline job's log
+======================  ===========================  =========================================
+
+The case folder ``<out>/<case>/`` (:func:`case_dir_for`, :class:`CaseFolder`), one level
+above the case's run folders, holds the cross-play stage's files:
+
+======================  ===========================  =========================================
+``crossplay.csv``       write_/read_table            one row per (VUT, opponent SPCP,
+                        (:data:`CROSSPLAY_SCHEMA`)   scenario)
+``crossplay.json``      write_/read_crossplay_json   settings, opponents, wall time
+======================  ===========================  =========================================
+
+Every file is written atomically (:mod:`sumo_ayss.atomic`). No other module spells one of
+these names or parses one of these files. Imports neither SUMO nor torch.
+"""
+
+from __future__ import annotations
+
+from sumo_ayss.run_folder.crossplay import (
+    CrossplayOpponent,
+    CrossplayRecord,
+    read_crossplay_json,
+    write_crossplay_json,
+)
+from sumo_ayss.run_folder.eval_table import (
+    EVAL_COLUMNS,
+    read_eval_rows,
+    read_eval_table,
+    write_eval_table,
+)
+from sumo_ayss.run_folder.jsonio import read_json, write_json
+from sumo_ayss.run_folder.layout import (
+    AYSS_CSV,
+    AYSS_JSON,
+    CHECKPOINTS_DIR,
+    COMMAND_TXT,
+    CONFIG_YAML,
+    CROSSPLAY_CSV,
+    CROSSPLAY_JSON,
+    EVAL_CSV,
+    EVALUATE_DONE_JSON,
+    JOB_LOG,
+    LATEST_JSON,
+    MODEL_ZIP,
+    OUTCOME_CSV,
+    OUTCOME_JSON,
+    PROGRESS_JSON,
+    REPLAY_PKL,
+    RESUME_FILES,
+    RESUME_MODEL_ZIP,
+    SEEDS_JSON,
+    SPCP_JSON,
+    SPCP_ZIP,
+    STATE_JSON,
+    TB_DIR,
+    TORCH_RNG_PT,
+    VERSIONS_JSON,
+    CaseFolder,
+    RunFolder,
+    case_dir_for,
+    find_run_dirs,
+    is_run_dir,
+    run_dir_for,
+    seed_of_dir,
+)
+from sumo_ayss.run_folder.metadata import (
+    RunConfig,
+    Seeds,
+    SpcpChoice,
+    read_checkpoint_state,
+    read_command,
+    read_evaluate_done,
+    read_json_object,
+    read_latest,
+    read_progress,
+    read_run_config,
+    read_seeds,
+    read_spcp,
+    read_versions,
+    write_checkpoint_state,
+    write_command,
+    write_evaluate_done,
+    write_latest,
+    write_progress,
+    write_run_config,
+    write_seeds,
+    write_spcp,
+    write_versions,
+)
+from sumo_ayss.run_folder.schemas import (
+    AYSS_SCHEMA,
+    CROSSPLAY_SCHEMA,
+    INDICATOR_ACCEL,
+    INDICATOR_DELTA_V_BAR,
+    INDICATOR_NAMES,
+    OUTCOME_SCHEMA,
+)
+from sumo_ayss.run_folder.summaries import (
+    AyssRecord,
+    Estimate,
+    Outcome,
+    OutcomeRecord,
+    OutcomeSubset,
+    StageHeader,
+    read_ayss_json,
+    read_outcome_json,
+    write_ayss_json,
+    write_outcome_json,
+)
+from sumo_ayss.run_folder.table import (
+    Column,
+    Table,
+    TableSchema,
+    read_table,
+    schema_markdown,
+    table_from_rows,
+    write_table,
+)
+
+__all__ = [
+    "AYSS_CSV",
+    "AYSS_JSON",
+    "AYSS_SCHEMA",
+    "CHECKPOINTS_DIR",
+    "COMMAND_TXT",
+    "CONFIG_YAML",
+    "CROSSPLAY_CSV",
+    "CROSSPLAY_JSON",
+    "CROSSPLAY_SCHEMA",
+    "EVALUATE_DONE_JSON",
+    "EVAL_COLUMNS",
+    "EVAL_CSV",
+    "INDICATOR_ACCEL",
+    "INDICATOR_DELTA_V_BAR",
+    "INDICATOR_NAMES",
+    "JOB_LOG",
+    "LATEST_JSON",
+    "MODEL_ZIP",
+    "OUTCOME_CSV",
+    "OUTCOME_JSON",
+    "OUTCOME_SCHEMA",
+    "PROGRESS_JSON",
+    "REPLAY_PKL",
+    "RESUME_FILES",
+    "RESUME_MODEL_ZIP",
+    "SEEDS_JSON",
+    "SPCP_JSON",
+    "SPCP_ZIP",
+    "STATE_JSON",
+    "TB_DIR",
+    "TORCH_RNG_PT",
+    "VERSIONS_JSON",
+    "AyssRecord",
+    "CaseFolder",
+    "Column",
+    "CrossplayOpponent",
+    "CrossplayRecord",
+    "Estimate",
+    "Outcome",
+    "OutcomeRecord",
+    "OutcomeSubset",
+    "RunConfig",
+    "RunFolder",
+    "Seeds",
+    "SpcpChoice",
+    "StageHeader",
+    "Table",
+    "TableSchema",
+    "case_dir_for",
+    "find_run_dirs",
+    "is_run_dir",
+    "read_ayss_json",
+    "read_checkpoint_state",
+    "read_command",
+    "read_crossplay_json",
+    "read_eval_rows",
+    "read_eval_table",
+    "read_evaluate_done",
+    "read_json",
+    "read_json_object",
+    "read_latest",
+    "read_outcome_json",
+    "read_progress",
+    "read_run_config",
+    "read_seeds",
+    "read_spcp",
+    "read_table",
+    "read_versions",
+    "run_dir_for",
+    "schema_markdown",
+    "seed_of_dir",
+    "table_from_rows",
+    "write_ayss_json",
+    "write_checkpoint_state",
+    "write_command",
+    "write_crossplay_json",
+    "write_eval_table",
+    "write_evaluate_done",
+    "write_json",
+    "write_latest",
+    "write_outcome_json",
+    "write_progress",
+    "write_run_config",
+    "write_seeds",
+    "write_spcp",
+    "write_table",
+    "write_versions",
+]

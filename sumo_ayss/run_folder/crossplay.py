@@ -1,0 +1,128 @@
+"""``crossplay.json``: the cross-play stage's record of one case, one writer and one reader.
+
+It lies in the case folder ``<out>/<case>/`` (:class:`~.layout.CaseFolder`), beside
+``crossplay.csv`` (:data:`~.schemas.CROSSPLAY_SCHEMA`, written and read with
+:func:`~.table.write_table` / :func:`~.table.read_table`)::
+
+    {"stage": "crossplay", "case": "cut_in", "n": 200, "seed": 4242,
+     "opponents": [{"vut": "pi1", "seed": 0, "spcp_sha256": "..."}, ...],
+     "vuts": ["pi1", "pi2"], "wall_s": 812.4}
+
+``n`` and ``seed`` are the scenario set (:func:`~sumo_ayss.envs.odd.sample_initial_conditions`)
+and, with the opponents, what a rerun compares before skipping the case.
+
+Imports neither SUMO nor torch.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from sumo_ayss.errors import TableError
+from sumo_ayss.run_folder.jsonio import read_json, write_json
+
+__all__ = ["CrossplayOpponent", "CrossplayRecord", "read_crossplay_json", "write_crossplay_json"]
+
+
+@dataclass(frozen=True)
+class CrossplayOpponent:
+    """One SPCP of the cross-play pool.
+
+    Attributes:
+        vut: The VUT it was trained against.
+        seed: Its training seed.
+        spcp_sha256: SHA-256 of its ``spcp.zip``.
+    """
+
+    vut: str
+    seed: int
+    spcp_sha256: str
+
+
+@dataclass(frozen=True)
+class CrossplayRecord:
+    """``crossplay.json``.
+
+    Attributes:
+        case: The case.
+        n: Scenarios per (VUT, opponent).
+        seed: Seed of the scenario set.
+        opponents: The SPCP pool, in the order of the table.
+        vuts: The VUTs driven against, in the order of the table.
+        wall_s: Wall time of the rollouts, s.
+    """
+
+    case: str
+    n: int
+    seed: int
+    opponents: tuple[CrossplayOpponent, ...]
+    vuts: tuple[str, ...]
+    wall_s: float
+
+    def same_inputs(self, other: CrossplayRecord) -> bool:
+        """Whether ``other`` ran the same scenarios against the same SPCPs (a rerun skips)."""
+        return (self.n, self.seed, self.opponents) == (other.n, other.seed, other.opponents)
+
+
+def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
+    """Write ``crossplay.json``."""
+    write_json(
+        path,
+        {
+            "stage": "crossplay",
+            "case": record.case,
+            "n": record.n,
+            "seed": record.seed,
+            "opponents": [dataclasses.asdict(o) for o in record.opponents],
+            "vuts": list(record.vuts),
+            "wall_s": round(record.wall_s, 3),
+        },
+    )
+
+
+def _field(data: Mapping[str, Any], key: str, kind: type | tuple[type, ...], where: str) -> Any:
+    if key not in data:
+        raise TableError(f"{where}: missing field {key!r}")
+    value = data[key]
+    if isinstance(value, bool) or not isinstance(value, kind):  # no field is a boolean
+        names = " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
+        raise TableError(f"{where}: {key}: expected {names}, got {value!r}")
+    return value
+
+
+def read_crossplay_json(path: Path) -> CrossplayRecord:
+    """Read ``crossplay.json``.
+
+    Raises:
+        TableError: The file is missing, not a JSON object, or a field is missing or of the
+            wrong type; the message names the file and the field.
+    """
+    data = read_json(path)
+    where = str(path)
+    opponents = []
+    for i, item in enumerate(_field(data, "opponents", list, where)):
+        at = f"{where}: opponents[{i}]"
+        if not isinstance(item, Mapping):
+            raise TableError(f"{at}: expected an object, got {item!r}")
+        opponents.append(
+            CrossplayOpponent(
+                _field(item, "vut", str, at),
+                _field(item, "seed", int, at),
+                _field(item, "spcp_sha256", str, at),
+            )
+        )
+    vuts = _field(data, "vuts", list, where)
+    if not all(isinstance(v, str) for v in vuts):
+        raise TableError(f"{where}: vuts: expected a list of names, got {vuts!r}")
+    return CrossplayRecord(
+        case=_field(data, "case", str, where),
+        n=_field(data, "n", int, where),
+        seed=_field(data, "seed", int, where),
+        opponents=tuple(opponents),
+        vuts=tuple(vuts),
+        wall_s=float(_field(data, "wall_s", (int, float), where)),
+    )

@@ -1,0 +1,358 @@
+"""The run folder's small files: one writer and one reader each.
+
+==========================  =============================================================
+``config.yaml``             :func:`write_run_config` / :func:`read_run_config`
+``command.txt``             :func:`write_command` / :func:`read_command`
+``versions.json``           :func:`write_versions` / :func:`read_versions`
+``seeds.json``              :func:`write_seeds` / :func:`read_seeds`
+``spcp.json``               :func:`write_spcp` / :func:`read_spcp`
+``checkpoints/latest.json`` :func:`write_latest` / :func:`read_latest`
+``<checkpoint>/state.json`` :func:`write_checkpoint_state` / :func:`read_checkpoint_state`
+``evaluate.done.json``      :func:`write_evaluate_done` / :func:`read_evaluate_done`
+``progress.json``           :func:`write_progress` / :func:`read_progress`
+==========================  =============================================================
+
+Readers raise :class:`~sumo_ayss.errors.CheckpointError` naming the file and the field;
+callers that tolerate a missing or broken file (the report, the progress display) catch it.
+Imports neither SUMO nor torch.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from sumo_ayss.atomic import atomic_write_json, atomic_write_text
+from sumo_ayss.config import EnvConfig, check_seed, safe_load_yaml, write_yaml
+from sumo_ayss.errors import CheckpointError, ConfigError
+from sumo_ayss.run_folder.layout import PROGRESS_JSON
+
+__all__ = [
+    "RunConfig",
+    "Seeds",
+    "SpcpChoice",
+    "read_checkpoint_state",
+    "read_command",
+    "read_evaluate_done",
+    "read_json_object",
+    "read_latest",
+    "read_progress",
+    "read_run_config",
+    "read_seeds",
+    "read_spcp",
+    "read_versions",
+    "write_checkpoint_state",
+    "write_command",
+    "write_evaluate_done",
+    "write_latest",
+    "write_progress",
+    "write_run_config",
+    "write_seeds",
+    "write_spcp",
+    "write_versions",
+]
+
+
+def read_json_object(path: Path) -> dict[str, Any]:
+    """A JSON object from a run-folder file.
+
+    Raises:
+        CheckpointError: The file is missing, unreadable, not JSON or not an object.
+    """
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        raise CheckpointError(f"{path}: unreadable JSON ({e})") from e
+    if not isinstance(data, dict):
+        raise CheckpointError(f"{path}: expected a JSON object, got {type(data).__name__}")
+    return data
+
+
+# --------------------------------------------------------------------------- config.yaml
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """``config.yaml``: the resolved experiment configuration of a run.
+
+    The file holds ``seed`` and the experiment sections; the VUT is stored once, as
+    ``env.vut``. Folders written before that also have a top-level ``vut`` (the same
+    value); :func:`read_run_config` still reads them.
+
+    Attributes:
+        vut: The run's VUT (the file's ``env.vut``).
+        seed: The training seed (top-level ``seed``), in [0, 2**31 - 1].
+        experiment: The experiment sections (``env``, ``agent``, ``train``, ...), as
+            written by ``ExperimentConfig.to_dict``; rebuild with ``experiment_from_dict``.
+            Its ``env.vut`` is :attr:`vut` once written or read.
+    """
+
+    vut: str
+    seed: int
+    experiment: dict[str, Any]
+
+    def as_dict(self) -> dict[str, Any]:
+        """The file's contents: ``seed``, then the experiment sections, ``env.vut`` set."""
+        experiment = dict(self.experiment)
+        env = experiment.get("env") or {}
+        if not isinstance(env, Mapping):
+            raise ConfigError(f"env must be a mapping, got {type(env).__name__}")
+        experiment["env"] = {**env, "vut": self.vut}
+        return {"seed": self.seed, **experiment}
+
+
+def write_run_config(path: Path, config: RunConfig) -> None:
+    """Write ``config.yaml`` atomically (keys in :meth:`RunConfig.as_dict` order)."""
+    write_yaml(path, config.as_dict())
+
+
+def read_run_config(path: Path) -> RunConfig:
+    """Read ``config.yaml``.
+
+    The VUT is the legacy top-level ``vut`` where a folder has one, else ``env.vut``, else
+    the default VUT (a hand-written file that leaves ``env.vut`` to its default).
+
+    Raises:
+        CheckpointError: ``<path>: unreadable run configuration (...)`` when the file is
+            missing, not YAML, not a mapping, lacks a valid ``seed``, has an ``env`` that
+            is not a mapping, or a VUT that is not a non-empty string.
+    """
+    try:
+        data = safe_load_yaml(path.read_text(encoding="utf-8"), str(path))
+        if not isinstance(data, Mapping):
+            raise ConfigError("top level is not a mapping")
+        data = dict(data)
+        seed = check_seed(data.pop("seed"), f"{path}: seed")
+        env = data.get("env") or {}
+        if not isinstance(env, Mapping):
+            raise ConfigError(f"env must be a mapping, got {type(env).__name__}")
+        legacy = data.pop("vut", None)  # folders written before the VUT was stored once
+        vut = legacy if legacy is not None else env.get("vut", EnvConfig.vut)
+        if not isinstance(vut, str) or not vut:
+            raise ConfigError(f"vut must be a non-empty string, got {vut!r}")
+        data["env"] = {**env, "vut": vut}
+    except (ConfigError, KeyError, OSError, UnicodeDecodeError, yaml.YAMLError) as e:
+        raise CheckpointError(f"{path}: unreadable run configuration ({e})") from e
+    return RunConfig(vut, seed, data)
+
+
+# --------------------------------------------------------------------------- command.txt
+
+
+def write_command(path: Path, command: str) -> None:
+    """Write ``command.txt``: the shell-quoted command line (no trailing newline)."""
+    atomic_write_text(path, command)
+
+
+def read_command(path: Path) -> str:
+    """Read ``command.txt``.
+
+    Raises:
+        CheckpointError: The file is missing or unreadable.
+    """
+    try:
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise CheckpointError(f"{path}: unreadable ({e})") from e
+
+
+# --------------------------------------------------------------------------- versions.json
+
+
+def write_versions(path: Path, versions: Mapping[str, str]) -> None:
+    """Write ``versions.json``: ``{"python": "3.11.2", "torch": "2.4.0", ...}``."""
+    atomic_write_json(path, dict(versions))
+
+
+def read_versions(path: Path) -> dict[str, str]:
+    """Read ``versions.json`` (every value as text).
+
+    Raises:
+        CheckpointError: The file is missing, unreadable or not a JSON object.
+    """
+    return {str(k): str(v) for k, v in read_json_object(path).items()}
+
+
+# --------------------------------------------------------------------------- seeds.json
+
+
+@dataclass(frozen=True)
+class Seeds:
+    """``seeds.json``.
+
+    Attributes:
+        train_seed: The training seed (numpy, torch, SB3).
+        sumo_seed: SUMO's ``--seed`` (the training seed).
+        eval_seed: Seed of the candidate-evaluation scenarios (``train.eval_seed``).
+    """
+
+    train_seed: int
+    sumo_seed: int
+    eval_seed: int
+
+
+def write_seeds(path: Path, seeds: Seeds) -> None:
+    """Write ``seeds.json``."""
+    atomic_write_json(path, dataclasses.asdict(seeds))
+
+
+def read_seeds(path: Path) -> Seeds:
+    """Read ``seeds.json``.
+
+    Raises:
+        CheckpointError: The file is unreadable or a seed is missing or not an integer.
+    """
+    data = read_json_object(path)
+    values = {}
+    for f in dataclasses.fields(Seeds):
+        value = data.get(f.name)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise CheckpointError(f"{path}: {f.name} must be an integer, got {value!r}")
+        values[f.name] = value
+    return Seeds(**values)
+
+
+# --------------------------------------------------------------------------- spcp.json
+
+
+@dataclass(frozen=True)
+class SpcpChoice:
+    """``spcp.json``: the selected SPCP of a run.
+
+    Attributes:
+        step: Training step of the selected candidate.
+        score: Its selection score (NaN if not a number).
+        criterion: Name of the selection criterion.
+        reason: The selection's own sentence.
+        checkpoint: The candidate's model, relative to the run folder.
+    """
+
+    step: int
+    score: float
+    criterion: str
+    reason: str
+    checkpoint: str = ""
+
+
+def write_spcp(path: Path, selection: Any, checkpoint: str, row: Mapping[str, Any]) -> None:
+    """Write ``spcp.json``: the selection's fields, the checkpoint and its ``eval.csv`` row.
+
+    Args:
+        path: ``<run>/spcp.json``.
+        selection: A :class:`sumo_ayss.selection.Selection` (a dataclass).
+        checkpoint: The candidate's model, relative to the run folder.
+        row: The candidate's ``eval.csv`` row.
+    """
+    record = {**dataclasses.asdict(selection), "checkpoint": checkpoint, "row": dict(row)}
+    atomic_write_json(path, record)
+
+
+def read_spcp(path: Path) -> SpcpChoice:
+    """Read ``spcp.json``.
+
+    Raises:
+        CheckpointError: The file is unreadable or ``step`` is missing or not an integer.
+    """
+    data = read_json_object(path)
+    step = data.get("step")
+    if isinstance(step, bool) or not isinstance(step, int):
+        raise CheckpointError(f"{path}: step must be an integer, got {step!r}")
+    score = data.get("score")
+    return SpcpChoice(
+        step=step,
+        score=float(score) if isinstance(score, int | float) else math.nan,
+        criterion=str(data.get("criterion", "")),
+        reason=str(data.get("reason", "")),
+        checkpoint=str(data.get("checkpoint", "")),
+    )
+
+
+# --------------------------------------------------------------------------- checkpoints
+
+
+def write_latest(path: Path, step_dir: Path) -> None:
+    """Write ``checkpoints/latest.json``: ``{"step": 80016, "dir": "step_000080016"}``."""
+    atomic_write_json(path, {"step": int(step_dir.name.split("_")[1]), "dir": step_dir.name})
+
+
+def read_latest(path: Path) -> tuple[int, str]:
+    """Read ``checkpoints/latest.json``: ``(step, folder name)``.
+
+    Raises:
+        CheckpointError: The file is unreadable, ``dir`` does not name a ``step_*`` folder
+            (no path), or ``step`` is not an integer.
+    """
+    data = read_json_object(path)
+    name = data.get("dir")
+    if not isinstance(name, str) or Path(name).name != name or not name.startswith("step_"):
+        raise CheckpointError(f"{path}: 'dir' must name a step_* folder, got {name!r}")
+    step = data.get("step")
+    if isinstance(step, bool) or not isinstance(step, int):
+        raise CheckpointError(f"{path}: 'step' must be an integer, got {step!r}")
+    return step, name
+
+
+def write_checkpoint_state(path: Path, state: Mapping[str, Any]) -> None:
+    """Write a checkpoint's ``state.json`` (counters, env state, RNG states)."""
+    atomic_write_json(path, dict(state))
+
+
+def read_checkpoint_state(path: Path) -> dict[str, Any]:
+    """Read a checkpoint's ``state.json``; it must hold ``num_timesteps`` and ``next_eval``.
+
+    Raises:
+        CheckpointError: The file is unreadable or not a checkpoint state.
+    """
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        raise CheckpointError(f"{path}: unreadable JSON ({e})") from e
+    if not isinstance(data, dict) or not {"num_timesteps", "next_eval"} <= set(data):
+        raise CheckpointError(f"{path}: not a checkpoint state")
+    return data
+
+
+# --------------------------------------------------------------------------- pipeline markers
+
+
+def write_evaluate_done(path: Path, inputs: str) -> None:
+    """Write ``evaluate.done.json``: the fingerprint of the inputs the evaluation used."""
+    atomic_write_json(path, {"inputs": inputs})
+
+
+def read_evaluate_done(path: Path) -> str | None:
+    """The fingerprint in ``evaluate.done.json``; None when the file is missing.
+
+    Raises:
+        CheckpointError: The file exists but is unreadable or not a JSON object.
+    """
+    if not path.is_file():
+        return None
+    inputs = read_json_object(path).get("inputs")
+    return inputs if isinstance(inputs, str) else None
+
+
+def write_progress(run_dir: Path, stage: str, **fields: Any) -> None:
+    """Atomically (re)write ``<run_dir>/progress.json``: ``stage``, ``time`` plus ``fields``.
+
+    Stages: ``train`` (with ``step``, ``total`` in transitions and ``rate_steps_per_s``,
+    transitions per second of wall time since this process started training), ``evaluate``,
+    ``done``. Only watchers (the pipeline's progress display) read it; nothing depends on it.
+    """
+    atomic_write_json(run_dir / PROGRESS_JSON, {"stage": stage, "time": time.time(), **fields})
+
+
+def read_progress(run_dir: Path) -> dict[str, Any] | None:
+    """``<run_dir>/progress.json``, or None when it is missing or unreadable."""
+    try:
+        return read_json_object(run_dir / PROGRESS_JSON)
+    except CheckpointError:
+        return None
