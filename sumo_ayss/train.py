@@ -32,6 +32,11 @@ Run folder ``<out>/<case>/<vut>/seed_<k>/``:
 
 Every file is written atomically (temporary file + rename), and ``latest.json`` is written
 last, so a kill at any moment leaves a resumable folder.
+
+This module is the entry point and the :class:`Trainer`, which composes the pieces in
+:mod:`sumo_ayss.training` (run-folder files, checkpoints, the training env(s) behind one
+collector interface, the step callback); SB3's private state is reached only through
+:mod:`sumo_ayss.agents.sb3_adapter`.
 """
 
 from __future__ import annotations

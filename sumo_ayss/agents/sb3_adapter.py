@@ -51,7 +51,7 @@ def set_rollout_start(
     # SB3 2.9.2: ``collect_rollouts`` predicts from ``self._last_obs`` and stores it as the
     # transition's observation; ``learn`` only resets it when ``reset_num_timesteps`` or it
     # is None (``_setup_learn``), so a value set here survives into the next ``learn``.
-    model._last_obs = obs  # type: ignore[assignment]
+    model._last_obs = obs
     # SB3 2.9.2: ``_last_episode_starts`` is passed to ``predict`` as ``episode_start``
     # (recurrent policies only) and reset to ones by ``_setup_learn``; kept consistent.
     model._last_episode_starts = episode_starts
