@@ -63,7 +63,7 @@ def _imports(body: list[ast.stmt], in_function: bool) -> Iterator[tuple[ast.stmt
                 if isinstance(children, list):
                     stmts = [c for c in children if isinstance(c, ast.stmt)]
                     for child in children:  # except handlers and match cases hold bodies
-                        if isinstance(child, ast.excepthandler | ast.match_case):
+                        if isinstance(child, ast.ExceptHandler | ast.match_case):
                             stmts.extend(child.body)
                     yield from _imports(stmts, in_function)
 
