@@ -26,9 +26,9 @@ PHASES: list[tuple[str, tuple[str, ...]]] = [
     ("candidates: evaluation on the pairs", ("evaluate_on_vec", "run_episodes")),
     (
         "candidates: checkpoint I/O (model.zip, replay.pkl, state, eval.csv)",
-        ("_atomic_model_save", "_save_resume_state", "write_eval_table", "_prune_replays"),
+        ("atomic_model_save", "save_resume_state", "write_eval_table", "_prune_replays"),
     ),
-    ("candidates: cut and restart the pairs", ("_restart_pairs",)),
+    ("candidates: cut and restart the pairs", ("PairsCollector.evaluate",)),
     ("selection + spcp.zip", ("Trainer.select",)),
     ("gradient step: PER sample (sum tree, gather, tensors)", ("PrioritizedReplayBuffer.sample",)),
     ("gradient step: PER priority update", ("update_priorities",)),

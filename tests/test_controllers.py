@@ -354,14 +354,14 @@ def hooked_env(cfg: EnvConfig) -> Any:
                     config.vut_type, config.sim.step_length_s
                 )
 
-        def _start_episode(self, ic: Any) -> Any:
-            out = super()._start_episode(ic)
+        def start_episode(self, ic: Any) -> Any:
+            out = super().start_episode(ic)
             if self._my_ctl is not None:
                 self._my_ctl.start(self._pair)
             return out
 
-        def _command_pov(self) -> None:
-            super()._command_pov()
+        def command_pov(self) -> None:
+            super().command_pov()
             if self._my_ctl is not None:
                 self._my_ctl.before_step(self._pair)
 

@@ -30,6 +30,12 @@ from torch.nn import functional as F
 from sumo_ayss.agents.hparams import DQNHyperParams
 from sumo_ayss.agents.policies import AyssDQNPolicy
 from sumo_ayss.agents.replay import PrioritizedReplayBuffer, PrioritizedReplayBufferSamples
+from sumo_ayss.agents.sb3_adapter import (
+    add_gradient_updates,
+    progress_remaining,
+    update_learning_rate,
+    vec_normalize_env,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -140,7 +146,7 @@ class AyssDQN(DQN):
         """
         hp = self.hparams
         if hp.per_beta_steps is None:
-            fraction = 1.0 - self._current_progress_remaining
+            fraction = 1.0 - progress_remaining(self)
         else:
             fraction = self.num_timesteps / hp.per_beta_steps
         fraction = min(max(fraction, 0.0), 1.0)
@@ -161,7 +167,7 @@ class AyssDQN(DQN):
             batch_size: Minibatch size.
         """
         self.policy.set_training_mode(True)
-        self._update_learning_rate(self.policy.optimizer)
+        update_learning_rate(self, self.policy.optimizer)
         buffer = self.replay_buffer
         per_buffer = buffer if isinstance(buffer, PrioritizedReplayBuffer) else None
         beta = self.per_beta if per_buffer is not None else 1.0
@@ -171,14 +177,15 @@ class AyssDQN(DQN):
         params = self._q_params
         max_norm = float(self.max_grad_norm)
         loss_sum = th.zeros((), device=self.device)
+        normalizer = vec_normalize_env(self)
 
         for _ in range(gradient_steps):
             data: ReplayBufferSamples | PrioritizedReplayBufferSamples
             if per_buffer is not None:
-                data = per_buffer.sample(batch_size, env=self._vec_normalize_env, beta=beta)
+                data = per_buffer.sample(batch_size, env=normalizer, beta=beta)
                 weights, indices = data.weights, data.indices
             else:
-                data = buffer.sample(batch_size, env=self._vec_normalize_env)
+                data = buffer.sample(batch_size, env=normalizer)
             discounts = data.discounts if data.discounts is not None else self.gamma
 
             with th.no_grad():
@@ -208,8 +215,8 @@ class AyssDQN(DQN):
                 per_buffer.update_priorities(indices, td_errors.cpu().numpy())
             loss_sum += loss.detach()
 
-        self._n_updates += gradient_steps
-        self.logger.record("train/n_updates", self._n_updates, exclude="tensorboard")
+        n_updates = add_gradient_updates(self, gradient_steps)
+        self.logger.record("train/n_updates", n_updates, exclude="tensorboard")
         self.logger.record("train/loss", loss_sum.item() / gradient_steps)
         if per_buffer is not None:
             self.logger.record("train/per_beta", beta)

@@ -195,9 +195,9 @@ class CutInEnv(PairEnv):
 
     # ------------------------------------------------------------------ episode phases
 
-    def _start_episode(self, ic: InitialCondition) -> tuple[tuple[float, ...], dict[str, Any]]:
-        """See :meth:`PairEnv._start_episode`; adds the lateral state to ``info``."""
-        values, info = super()._start_episode(ic)
+    def start_episode(self, ic: InitialCondition) -> tuple[tuple[float, ...], dict[str, Any]]:
+        """See :meth:`PairEnv.start_episode`; adds the lateral state to ``info``."""
+        values, info = super().start_episode(ic)
         assert self._pair is not None and self._k is not None
         if self.config.sim.lateral_resolution_m is None:
             # Before the first step: the VUT drives freely. (SUMO's sublane model has no

@@ -8,7 +8,7 @@ last decision, or *terminated* at a collision.
 Paper-fidelity mode (docs/paper_fidelity.md): with ``env.actuator.mode: highway_env`` and/or
 a :class:`~sumo_ayss.hwenv_laws.HighwayEnvIDM` VUT (``hwenv_pi1``/``hwenv_pi2``), the env
 integrates highway-env's laws itself at ``env.actuator.substeps`` sub-steps per SUMO step
-and gives SUMO the exact end state (:meth:`PairEnv._command_hwenv`).
+and gives SUMO the exact end state (:mod:`sumo_ayss.envs.hwenv_actuation`).
 """
 
 from __future__ import annotations
@@ -27,16 +27,10 @@ from gymnasium import spaces
 from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.controllers import ControlledVut
+from sumo_ayss.envs.hwenv_actuation import HighwayEnvLaws
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_condition
 from sumo_ayss.envs.rewards import total_reward
 from sumo_ayss.errors import ActionError, ConfigError
-from sumo_ayss.hwenv_laws import (
-    HighwayEnvIDM,
-    HighwayEnvPov,
-    KinematicState,
-    LateralParams,
-    collision_check,
-)
 from sumo_ayss.sim.actuator import next_speed, pov_acceleration
 from sumo_ayss.sim.network import ROAD_EDGE, ROAD_LENGTH_M, network_path
 from sumo_ayss.sim.pair import PairPlacement, VehiclePair
@@ -92,7 +86,7 @@ class PairKinematics(NamedTuple):
     headway_m: float
 
 
-class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
+class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
     """Base env: one VUT and one POV in the process's SUMO simulation.
 
     Args:
@@ -149,46 +143,12 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         self._vut_control = ControlledVut.from_vehicle_type(
             config.vut_type, self._dt_s, f"env.vuts.{config.vut}.controller"
         )
-        # highway-env's laws (sumo_ayss.hwenv_laws), integrated here at ``substeps`` Euler
-        # sub-steps per SUMO step: the POV in actuator mode highway_env, and a VUT whose
-        # controller is HighwayEnvIDM. None in the default mode (no per-step cost there).
-        self._hw_pov: HighwayEnvPov | None = None
-        if self._actuator.highway_env:
-            act = self._actuator
-            self._hw_pov = HighwayEnvPov(
-                act.time_constant_s,
-                LateralParams(
-                    tau_lateral_s=act.tau_lateral_s,
-                    tau_heading_s=act.tau_heading_s,
-                    length_m=self._pov_length_m,
-                ),
-                act.max_speed_mps,
-            )
-        controller = None if self._vut_control is None else self._vut_control.controller
-        self._hw_vut: HighwayEnvIDM | None = (
-            controller if isinstance(controller, HighwayEnvIDM) else None
-        )
-        self._hw = self._hw_pov is not None or self._hw_vut is not None
-        # Both vehicles on highway-env's laws: collisions are highway-env's too (rotated
-        # bodies checked every sub-step, incl. its one-sub-step look-ahead), not SUMO's.
-        self._hw_collisions = self._hw_pov is not None and self._hw_vut is not None
-        self._hw_collided = False
-        self._hw_impact = False  # highway-env's look-ahead hit: crashed at the next sub-step
-        self._hw_bodies = (
-            (config.vut_type.length_m, config.pov.length_m),
-            (
-                float(config.vut_type.params.get("width", 1.8)),
-                float(config.pov.params.get("width", 1.8)),
-            ),
-        )
-        self._hw_pending: tuple[float | None, float | None] | None = None
-        self._hw_vut_lane_y = 0.0
-        self._hw_vut_lane_w = 0.0
+        self._init_hwenv(config)
         self._decisions = 0
         self._v_pov = 0.0
         self._target = 0.0  # the POV's target speed of the current decision [m/s]
         self._accel = 0.0  # the POV's acceleration in the last SUMO step [m/s²]
-        self._shared = False  # a member of a PairVecEnv (see _join_shared)
+        self._shared = False  # a member of a PairVecEnv (see join_shared)
         self._k: PairKinematics | None = None
         self.initial_condition: InitialCondition | None = None
 
@@ -227,11 +187,11 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         """
         if self._shared:
             raise self._step_error()
-        ic = self._begin_reset(seed, options)
+        ic = self.begin_reset(seed, options)
         pair = self._ensure_sim()
         pair.add()
         pair.session.step()  # inserts the fresh vehicles (they do not move in this step)
-        values, info = self._start_episode(ic)
+        values, info = self.start_episode(ic)
         return np.array(values, dtype=np.float32), info
 
     def step(
@@ -251,16 +211,16 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
                 "step() after the episode ended (terminated at a collision or truncated at "
                 f"env.episode_s = {self.config.episode_s} s); call reset() first"
             )
-        self._begin_decision(action)
+        self.begin_decision(action)
         session = pair.session
         collided = False
         for _ in range(self._substeps):
-            self._command_pov()
+            self.command_pov()
             session.step()
             if pair.collided(session.colliding_ids()):
                 collided = True
                 break
-        values, reward, terminated, truncated, info = self._end_decision(collided)
+        values, reward, terminated, truncated, info = self.end_decision(collided)
         return np.array(values, dtype=np.float32), reward, terminated, truncated, info
 
     def close(self) -> None:
@@ -282,12 +242,13 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
 
     # ------------------------------------------------------------------ episode phases
     #
-    # ``reset`` and ``step`` are built from the phases below, around their SUMO steps. A
-    # :class:`~sumo_ayss.envs.vec_env.PairVecEnv` runs many envs in one simulation by calling
-    # the same phases of each member around one shared SUMO step, so that observation,
-    # reward, termination and the POV's actuator are this code in both.
+    # ``reset`` and ``step`` are built from the phases below, around their SUMO steps: the
+    # public protocol :class:`~sumo_ayss.envs.protocol.EpisodePhases` (order of calls and
+    # units there). A :class:`~sumo_ayss.envs.vec_env.PairVecEnv` runs many envs in one
+    # simulation by calling the same phases of each member around one shared SUMO step, so
+    # that observation, reward, termination and the POV's actuator are this code in both.
 
-    def _begin_reset(self, seed: int | None, options: dict[str, Any] | None) -> InitialCondition:
+    def begin_reset(self, seed: int | None, options: dict[str, Any] | None) -> InitialCondition:
         """Seed the RNG (``seed``) and choose the episode's initial condition.
 
         A ``seed`` also reseeds SUMO: an env that owns its simulation restarts it with SUMO
@@ -335,7 +296,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
                     f"[{low:g}, {high:g}], got {value!r}"
                 )
 
-    def _start_episode(self, ic: InitialCondition) -> tuple[tuple[float, ...], dict[str, Any]]:
+    def start_episode(self, ic: InitialCondition) -> tuple[tuple[float, ...], dict[str, Any]]:
         """Place the pair's fresh vehicles at ``ic``: the reset's observation values and info.
 
         The vehicles must have been added (and, for the single env, inserted by a step).
@@ -360,13 +321,13 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         }
         return self._observation_values(k), info
 
-    def _begin_decision(self, action: SupportsInt) -> None:
+    def begin_decision(self, action: SupportsInt) -> None:
         """Validate and apply ``action`` (lane commands, the POV's target speed)."""
         assert self._k is not None
         self._target = self._apply_action(self._validate_action(action), self._k)
         self._accel = 0.0
 
-    def _command_pov(self) -> None:
+    def command_pov(self) -> None:
         """The actuator's next POV speed, commanded for the coming SUMO step."""
         pair = self._pair
         assert pair is not None
@@ -380,7 +341,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         if self._vut_control is not None:
             self._vut_control.before_step(pair)  # the controller's speed for the coming step
 
-    def _end_decision(
+    def end_decision(
         self, collided: bool
     ) -> tuple[tuple[float, ...], float, bool, bool, dict[str, Any]]:
         """Read SUMO back after the decision's steps.
@@ -425,103 +386,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         }
         return self._observation_values(k), reward, terminated, truncated, info
 
-    # ------------------------------------------------------------------ highway-env laws
-
-    def _start_hwenv(self, pair: VehiclePair, ic: InitialCondition) -> None:
-        """Initialise highway-env's POV / VUT states from the placed vehicles."""
-        (pov_x, pov_y), _ = pair.world_fronts()
-        pov_lane, vut_lane = pair.lanes()
-        self._hw_vut_lane_y = pair.lane_centre_y_m(vut_lane)
-        self._hw_vut_lane_w = pair.lane_width_m(vut_lane)
-        self._hw_pending = None
-        self._hw_collided = self._hw_impact = False
-        if self._hw_pov is not None:
-            state = KinematicState(pov_x - 0.5 * self._pov_length_m, pov_y, 0.0, ic.pov_speed_mps)
-            self._hw_pov.start(state, pair.lane_centre_y_m(pov_lane))
-        if self._hw_vut is not None:
-            self._hw_vut.start(ic.vut_speed_mps)
-
-    def _command_hwenv(self, pair: VehiclePair) -> None:
-        """One SUMO step of highway-env's laws: ``substeps`` Euler sub-steps in Python.
-
-        The POV (mode highway_env) is integrated first (its law ignores the VUT), giving its
-        state at every sub-instant; the VUT's IDM is then re-evaluated at each sub-instant
-        against it, as highway-env's ``Road.act`` / ``Road.step`` do. SUMO receives the
-        end state exactly: the POV by ``moveToXY`` (its speed in SUMO = its longitudinal
-        velocity, the paper's observed v'); a highway-env VUT by the mean of its
-        sub-step speeds (SUMO's Euler update moves it by ``speed · step``, = highway-env's
-        sum of ``speed · dt`` over the sub-steps); both speeds are put back after the step
-        (:meth:`_sync_hwenv_speeds`). With the clipped actuator the POV drives its commanded
-        speed over the whole step (SUMO's Euler), which the VUT sees sub-step by sub-step.
-        """
-        if self._hw_pending is not None:
-            self._sync_hwenv_speeds(pair)
-        n = self._actuator.substeps
-        dt = self._dt_s / n
-        half_pov = 0.5 * self._pov_length_m
-        pov_speed: float | None = None
-        hw_pov = self._hw_pov
-        if hw_pov is not None:
-            hw_pov.target_speed_mps = self._target
-            pov_states = hw_pov.advance(n, dt)
-            end = pov_states[-1]
-            pair.move_pov_xy(end.x_m + half_pov, end.y_m, end.heading_rad)
-            # SUMO holds the POV's longitudinal speed (what the paper's POV observes as v',
-            # "POV longitudinal speed"): speed · cos(heading), = speed outside lane changes.
-            pov_speed = self._v_pov = end.vx_mps
-            self._accel = hw_pov.last_accel_mps2
-        else:
-            actuator = self._actuator
-            accel = self._accel = pov_acceleration(self._v_pov, self._target, actuator)
-            v = self._v_pov = next_speed(self._v_pov, accel, self._dt_s, actuator)
-            pair.command_pov_speed(v)
-            pov_states = []
-            if self._hw_vut is not None:
-                (x, y), _ = pair.world_fronts()
-                x0 = x - half_pov
-                pov_states = [KinematicState(x0 + v * j * dt, y, 0.0, v) for j in range(n)]
-        vut_speed: float | None = None
-        if self._hw_vut is not None and self._vut_control is not None:
-            (_, _), (vx, vy) = pair.world_fronts()
-            _, _, _, v_vut = pair.longitudinal()
-            own = KinematicState(vx - 0.5 * self._hw_vut.length_m, vy, 0.0, v_vut)
-            states = self._hw_vut.advance(
-                own, self._hw_vut_lane_y, self._hw_vut_lane_w, pov_states[:n], dt
-            )
-            mean_speed = (states[-1].x_m - own.x_m) / self._dt_s
-            pair.command_vut_speed(mean_speed)
-            vut_speed = states[-1].speed_mps
-            self._vut_control.last_command_mps2 = (vut_speed - v_vut) / self._dt_s
-            if self._hw_collisions:
-                self._check_hwenv_collisions(states, pov_states[1:], dt)
-        elif self._vut_control is not None:
-            self._vut_control.before_step(pair)
-        self._hw_pending = (pov_speed, vut_speed)
-
-    def _check_hwenv_collisions(
-        self, vut: list[KinematicState], pov: list[KinematicState], dt_s: float
-    ) -> None:
-        """highway-env's collision test after each sub-step (``Road.step``): overlap now,
-        or a look-ahead hit at the previous sub-step (its ``impact``, crashed one later)."""
-        lengths, widths = self._hw_bodies
-        for a, b in zip(vut, pov, strict=True):
-            if self._hw_impact:
-                self._hw_collided = True
-                return
-            hit, will_hit = collision_check(a, b, dt_s, lengths, widths)
-            if hit:
-                self._hw_collided = True
-                return
-            self._hw_impact = will_hit
-
-    def _sync_hwenv_speeds(self, pair: VehiclePair) -> None:
-        """After a SUMO step: give SUMO highway-env's end-of-step speeds (see above)."""
-        pending = self._hw_pending
-        self._hw_pending = None
-        if pending is not None:
-            pair.set_speed_state(*pending)
-
-    def _join_shared(self, pair: VehiclePair, sumo_seed: int) -> None:
+    def join_shared(self, pair: VehiclePair, sumo_seed: int) -> None:
         """Become a member of a vec env: drive ``pair`` in a simulation the env does not own.
 
         The member's own ``reset``/``step`` then refuse to run (each would step every pair of

@@ -10,8 +10,9 @@ each other), and one ``simulationStep`` advances all pairs.
 
 Same code as the single env. Each pair is an ordinary :class:`~sumo_ayss.envs.pair_env.
 PairEnv` (``CarFollowingEnv``/``CutInEnv``) joined to the shared simulation; the vec env
-calls its episode phases (``_begin_decision`` → ``_command_pov`` → shared step →
-``_end_decision``; ``_begin_reset`` → vehicles → ``_start_episode``), exactly the code the
+calls its public episode phases (:class:`~sumo_ayss.envs.protocol.EpisodePhases`, where the
+order of calls is documented: ``begin_decision`` → ``command_pov`` → shared step →
+``end_decision``; ``begin_reset`` → vehicles → ``start_episode``), exactly the code the
 single env's ``step``/``reset`` are made of. Observation, reward, termination, info and the
 POV's actuator are therefore the single env's, not a copy.
 
@@ -73,6 +74,7 @@ from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv, session_vtypes, sumo_seed_of
+from sumo_ayss.envs.protocol import EpisodePhases, StepResult
 from sumo_ayss.errors import ActionError, ConfigError
 from sumo_ayss.sim.network import LANES_OF_CASE, build_parallel_network, parallel_road_edge
 from sumo_ayss.sim.pair import VehiclePair
@@ -80,10 +82,6 @@ from sumo_ayss.sim.session import SumoSession
 
 #: A batch policy: observations ``(n, obs_dim)`` -> actions ``(n,)``.
 Policy = Callable[[npt.NDArray[np.float32]], npt.ArrayLike]
-
-#: One decision's result of one pair: ``(observation values, reward, terminated, truncated,
-#: info)``, as :meth:`PairEnv._end_decision` returns it.
-StepResult = tuple[tuple[float, ...], float, bool, bool, dict[str, Any]]
 
 
 class EpisodeTrace(NamedTuple):
@@ -164,14 +162,14 @@ class PairVecEnv(VecEnv):
             if not self._fixed_sumo_seed:
                 self.sumo_seed = None  # _ensure_sim takes the first seed
         ics = [
-            env._begin_reset(self._seeds[i], self._options[i] or None)
+            env.begin_reset(self._seeds[i], self._options[i] or None)
             for i, env in enumerate(self.envs)
         ]
         self._ensure_sim()
         obs = []
         for i, env in enumerate(self.envs):
             self._pairs[i].add()
-            values, self.reset_infos[i] = env._start_episode(ics[i])  # placing inserts them
+            values, self.reset_infos[i] = env.start_episode(ics[i])  # placing inserts them
             obs.append(values)
         self._reset_seeds()
         self._reset_options()
@@ -364,7 +362,7 @@ class PairVecEnv(VecEnv):
             for i in range(self.num_envs)
         ]
         for env, pair in zip(self.envs, self._pairs, strict=True):
-            env._join_shared(pair, self.sumo_seed)
+            env.join_shared(pair, self.sumo_seed)
 
     def _check_actions(self, actions: npt.ArrayLike) -> list[Any]:
         """One valid action per pair, as Python scalars, or :class:`ActionError`.
@@ -393,37 +391,38 @@ class PairVecEnv(VecEnv):
         """
         session = self._session
         assert session is not None
-        envs, pairs = self.envs, self._pairs
+        envs: Sequence[EpisodePhases] = self.envs  # the phases only (envs/protocol.py)
+        pairs = self._pairs
         for env, action in zip(envs, actions, strict=True):
-            env._begin_decision(action)
+            env.begin_decision(action)
         if self._substeps == 1:  # the usual case (5 Hz decisions, 0.2 s steps), kept lean
             for env in envs:
-                env._command_pov()
+                env.command_pov()
             session.step()
             colliding = session.colliding_ids()
             if colliding:
                 return [
-                    env._end_decision(pair.collided(colliding))
+                    env.end_decision(pair.collided(colliding))
                     for env, pair in zip(envs, pairs, strict=True)
                 ]
-            return [env._end_decision(False) for env in envs]
+            return [env.end_decision(False) for env in envs]
         results: list[StepResult | None] = [None] * len(envs)
         active = list(enumerate(envs))
         for _ in range(self._substeps):
             for _i, env in active:
-                env._command_pov()
+                env.command_pov()
             session.step()
             colliding = session.colliding_ids()
             if colliding:
                 still = []
                 for i, env in active:
                     if pairs[i].collided(colliding):
-                        results[i] = env._end_decision(True)
+                        results[i] = env.end_decision(True)
                     else:
                         still.append((i, env))
                 active = still
         for i, env in active:
-            results[i] = env._end_decision(False)
+            results[i] = env.end_decision(False)
         return results  # type: ignore[return-value]
 
     def _restart(self, i: int, ic: InitialCondition | None) -> tuple[float, ...]:
@@ -434,7 +433,7 @@ class PairVecEnv(VecEnv):
         ``ic`` None: sampled from the pair's RNG (SB3's auto-reset, no seed).
         """
         env = self.envs[i]
-        ic = env._begin_reset(None, None if ic is None else {"initial_condition": ic})
+        ic = env.begin_reset(None, None if ic is None else {"initial_condition": ic})
         self._pairs[i].add()  # the old vehicles go, two fresh ones wait for insertion ...
-        values, self.reset_infos[i] = env._start_episode(ic)  # ... and placing inserts them
+        values, self.reset_infos[i] = env.start_episode(ic)  # ... and placing inserts them
         return values

@@ -327,3 +327,18 @@ def test_lean_learner_is_bitwise_the_reference(dueling: bool) -> None:
     assert isinstance(buffers[0], PrioritizedReplayBuffer)
     assert isinstance(buffers[1], PrioritizedReplayBuffer)
     np.testing.assert_array_equal(buffers[0].priorities(), buffers[1].priorities())
+
+
+def test_checkpoint_loads_with_plain_sb3(tmp_path: Path) -> None:
+    """A saved AyssDQN is a plain SB3 zip: SB3's own ``DQN.load`` gives the same greedy policy."""
+    from stable_baselines3 import DQN
+
+    model = tiny_model()
+    model.learn(total_timesteps=80)
+    model.save(tmp_path / "model.zip")
+    plain = DQN.load(tmp_path / "model.zip")
+    obs = np.linspace(0, 4, 40, dtype=np.float32).reshape(-1, 1)
+    np.testing.assert_array_equal(
+        plain.predict(obs, deterministic=True)[0], model.predict(obs, deterministic=True)[0]
+    )
+    assert plain.num_timesteps == model.num_timesteps == 80

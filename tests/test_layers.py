@@ -1,0 +1,223 @@
+"""Layering of the package, read from the source with :mod:`ast` (nothing is imported).
+
+An import edge ``a -> b`` is an ``import``/``from ... import`` in module ``a`` that names
+module ``b`` of ``sumo_ayss`` (``from sumo_ayss.x import y`` counts as ``a -> sumo_ayss.x.y``
+when ``y`` is a module, else ``a -> sumo_ayss.x``; importing a submodule also runs its
+packages' ``__init__``, counted as edges too, except a module's own ancestor packages: their
+``__init__`` is already running when the module is, and Python resolves a sibling import
+through ``sys.modules`` without it). *Module-level* edges are the imports run when
+``a`` is imported (top level, incl. ``if``/``try`` blocks, but not ``if TYPE_CHECKING:``);
+*function-level* edges are imports inside a function or method body, run when it is called.
+
+An import circle is a strongly connected component of more than one module. Module-level
+circles must not exist; function-level ones (a lazy import that closes a loop) are reported
+by ``python tests/test_layers.py``.
+
+Run as a script it prints the circles of both kinds and the largest modules.
+"""
+
+from __future__ import annotations
+
+import ast
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+PACKAGE = "sumo_ayss"
+ROOT = Path(__file__).resolve().parents[1] / PACKAGE
+#: The largest module allowed [lines].
+MAX_MODULE_LINES = 500
+
+
+def module_files() -> dict[str, Path]:
+    """Dotted module name -> file, for every ``.py`` file of the package."""
+    out = {}
+    for path in sorted(ROOT.rglob("*.py")):
+        parts = list(path.relative_to(ROOT.parent).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts.pop()
+        out[".".join(parts)] = path
+    return out
+
+
+def _is_type_checking(test: ast.expr) -> bool:
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING"
+    )
+
+
+def _imports(body: list[ast.stmt], in_function: bool) -> Iterator[tuple[ast.stmt, bool]]:
+    """Every import statement under ``body`` with whether it runs inside a function."""
+    for node in body:
+        if isinstance(node, ast.Import | ast.ImportFrom):
+            yield node, in_function
+        elif isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            yield from _imports(node.body, True)
+        elif isinstance(node, ast.If) and _is_type_checking(node.test):
+            continue  # annotations only: never run
+        else:
+            for field in ("body", "orelse", "finalbody", "handlers", "cases"):
+                children = getattr(node, field, None)
+                if isinstance(children, list):
+                    stmts = [c for c in children if isinstance(c, ast.stmt)]
+                    for child in children:  # except handlers and match cases hold bodies
+                        if isinstance(child, ast.ExceptHandler | ast.match_case):
+                            stmts.extend(child.body)
+                    yield from _imports(stmts, in_function)
+
+
+def _with_packages(name: str, modules: dict[str, Path]) -> set[str]:
+    """``name`` and the packages above it that are modules of ours (their __init__ runs)."""
+    parts = name.split(".")
+    return {".".join(parts[:i]) for i in range(1, len(parts) + 1)} & set(modules)
+
+
+def import_edges(modules: dict[str, Path]) -> tuple[set[tuple[str, str]], set[tuple[str, str]]]:
+    """(module-level edges, function-level edges) between modules of the package."""
+    top: set[tuple[str, str]] = set()
+    lazy: set[tuple[str, str]] = set()
+    for name, path in modules.items():
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        for node, in_function in _imports(tree.body, False):
+            targets: set[str] = set()
+            if isinstance(node, ast.Import):
+                for alias in node.names:
+                    targets |= _with_packages(alias.name, modules)
+            else:
+                assert isinstance(node, ast.ImportFrom)
+                if node.level:
+                    base = package.split(".")
+                    base = base[: len(base) - node.level + 1]
+                    source = ".".join([*base, node.module] if node.module else base)
+                else:
+                    source = node.module or ""
+                targets |= _with_packages(source, modules)
+                for alias in node.names:
+                    if f"{source}.{alias.name}" in modules:
+                        targets.add(f"{source}.{alias.name}")
+            ancestors = _with_packages(name, modules)  # name itself included
+            for target in targets - ancestors:
+                (lazy if in_function else top).add((name, target))
+    return top, lazy
+
+
+def circles(nodes: set[str], edges: set[tuple[str, str]]) -> list[list[str]]:
+    """Strongly connected components of more than one module (Tarjan), each sorted."""
+    graph: dict[str, list[str]] = {n: [] for n in nodes}
+    for a, b in edges:
+        graph[a].append(b)
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                out.append(sorted(component))
+
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 10 * len(graph) + 100))
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return sorted(out)
+
+
+def module_lines() -> dict[str, int]:
+    """Lines of each module of the package."""
+    return {
+        name: len(path.read_text(encoding="utf-8").splitlines())
+        for name, path in module_files().items()
+    }
+
+
+def test_no_module_level_import_circles() -> None:
+    modules = module_files()
+    top, _ = import_edges(modules)
+    assert circles(set(modules), top) == []
+
+
+def modules_over_limit() -> dict[str, int]:
+    """Modules over :data:`MAX_MODULE_LINES` lines -> their lines, largest first."""
+    lines = sorted(module_lines().items(), key=lambda kv: (-kv[1], kv[0]))
+    return {name: n for name, n in lines if n > MAX_MODULE_LINES}
+
+
+def _over_limit_text() -> str:
+    over = modules_over_limit()
+    return ", ".join(f"{name} ({n})" for name, n in over.items()) or "none"
+
+
+@pytest.mark.xfail(
+    strict=False,
+    # Computed when the tests are collected, so that the summary (-ra) names the modules.
+    reason=f"other modules are being split in parallel (issue 14); strict once they are "
+    f"merged. Over {MAX_MODULE_LINES} lines: {_over_limit_text()}",
+)
+def test_no_module_over_500_lines() -> None:
+    too_long = modules_over_limit()
+    for name, n in too_long.items():  # shown with -s, or in the failure once strict
+        print(f"over {MAX_MODULE_LINES} lines: {n:5d} {name}")
+    assert too_long == {}, f"modules over {MAX_MODULE_LINES} lines: {too_long}"
+
+
+def test_the_walker_sees_circles_and_tells_lazy_imports(tmp_path: Path) -> None:
+    """The walker itself, on a hand-made package: a module-level circle, a lazy one, and a
+    sibling import through the package's ``__init__`` (not a circle)."""
+    pkg = tmp_path / "p"
+    pkg.mkdir()
+    files = {
+        "__init__.py": "from p.a import A\n",
+        "a.py": "from p import b\nA = 1\n",
+        "b.py": "import p.a\n",
+        "c.py": "def f():\n    from p.d import D\n",
+        "d.py": "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    import p.a\n"
+        "try:\n    from p.c import f\nexcept ImportError:\n    pass\nD = 1\n",
+    }
+    for name, text in files.items():
+        (pkg / name).write_text(text)
+    modules = {"p": pkg / "__init__.py"} | {f"p.{n[:-3]}": pkg / n for n in files if n[0] != "_"}
+    top, lazy = import_edges(modules)
+    assert top == {("p", "p.a"), ("p.a", "p.b"), ("p.b", "p.a"), ("p.d", "p.c")}
+    assert lazy == {("p.c", "p.d")}
+    assert circles(set(modules), top) == [["p.a", "p.b"]]
+    assert circles(set(modules), top | lazy) == [["p.a", "p.b"], ["p.c", "p.d"]]
+
+
+def main() -> None:
+    """Print the import circles (module-level and with function-level imports) and sizes."""
+    modules = module_files()
+    top, lazy = import_edges(modules)
+    print(f"{len(modules)} modules, {len(top)} module-level and {len(lazy)} function-level edges")
+    for title, edges in (("module-level", top), ("module- and function-level", top | lazy)):
+        found = circles(set(modules), edges)
+        print(f"import circles, {title} imports: {len(found)}")
+        for component in found:
+            print("   ", " <-> ".join(component))
+    print(f"modules over {MAX_MODULE_LINES} lines:")
+    for name, n in modules_over_limit().items():
+        print(f"    {n:5d} {name}")
+
+
+if __name__ == "__main__":
+    main()
