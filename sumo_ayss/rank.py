@@ -28,11 +28,12 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from sumo_ayss.analysis.case import CaseAnalysis, analyse_case, exposure_sentence
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.errors import AyssError, ConfigError
 
 if TYPE_CHECKING:
-    from sumo_ayss.report.document import CaseAnalysis, ReportOptions
+    from sumo_ayss.report.options import ReportOptions
 
 RANKING_COLUMNS = [
     "case",
@@ -51,9 +52,9 @@ RANKING_COLUMNS = [
 
 
 def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> list[CaseAnalysis]:
-    """The report's analysis of every case among ``run_dirs`` (see :func:`analyse_case`)."""
-    from sumo_ayss.report.document import ReportOptions, analyse_case
+    """The analysis of every case among ``run_dirs`` (see :func:`analyse_case`)."""
     from sumo_ayss.report.load import group_runs, load_run
+    from sumo_ayss.report.options import ReportOptions
 
     options = options or ReportOptions()
     groups = group_runs([load_run(d) for d in run_dirs])
@@ -67,8 +68,6 @@ def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
     Exposure mode: the score is E, the mean episode reward per SPCP (lower = safer).
     Paper mode: the AYSS safety index (higher = safer).
     """
-    from sumo_ayss.report.document import exposure_sentence
-
     rows: list[dict[str, Any]] = []
     for a in analyses:
         if a.mode == "exposure":
