@@ -52,7 +52,11 @@ RANKING_COLUMNS = [
 
 
 def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> list[CaseAnalysis]:
-    """The analysis of every case among ``run_dirs`` (see :func:`analyse_case`)."""
+    """The analysis of every case among ``run_dirs`` (see :func:`analyse_case`).
+
+    Safety indices that the pipeline's report already computed in this process for the
+    same samples and settings are reused, not bootstrapped again.
+    """
     from sumo_ayss.report.load import group_runs, load_run
     from sumo_ayss.report.options import ReportOptions
 

@@ -1,22 +1,17 @@
 """The report: run folders in, ``report.html`` + ``summary.md`` + PNG figures out.
 
-:func:`write_report` reads run folders, groups them by (case, VUT), pools seeds, draws the
-figures (:mod:`.figures`), computes the safety index of every VUT and the pairwise verdicts
-(:mod:`sumo_ayss.analysis.ranking`), and writes into one folder:
+:func:`write_report` reads run folders (:mod:`.load`), checks that they may be pooled
+(:mod:`.checks`), analyses each case (:func:`sumo_ayss.analysis.case.analyse_case`: safety
+indices, verdicts, exposure ranking, premise), composes the sections (:mod:`.sections`) into
+one list of blocks (:mod:`.blocks`) and renders it twice (:mod:`.render`):
 
 * ``report.html`` — one self-contained file: figures embedded as base64 PNG, inline CSS, no
   JavaScript, no network; it opens offline;
 * ``summary.md`` — the same tables and verdicts, figures linked by relative path;
-* the PNG figures themselves.
+* the PNG figures themselves (:mod:`.figures`).
 
-Both documents are rendered from the same list of blocks (:class:`Heading`,
-:class:`Paragraph`, :class:`Callout`, :class:`FigureBlock`, :class:`Table`,
-:class:`BulletList`), so they cannot disagree.
-
-Significance rule: a difference between two VUTs is called significant only when BOTH the
-hierarchical-bootstrap interval of the difference of their safety indices excludes 0 AND
-the seed-level Welch t-test on the per-seed indices gives p < 0.05 (with three seeds the
-bootstrap alone is anti-conservative, see :func:`sumo_ayss.analysis.ranking.safety_index`).
+Nothing here computes a number that a verdict rests on: the statistics and the significance
+rule (:mod:`sumo_ayss.analysis.significance`) live in :mod:`sumo_ayss.analysis`.
 """
 
 from __future__ import annotations
