@@ -96,19 +96,19 @@ def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
             continue
         pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
         order = [r.name for r in a.ranking]
-        for i, r in enumerate(a.ranking):
+        for i, ranked in enumerate(a.ranking):
             nxt_name = order[i + 1] if i + 1 < len(order) else None
-            pair = pairs.get((r.name, nxt_name)) if nxt_name else None
+            pair = pairs.get((ranked.name, nxt_name)) if nxt_name else None
             rows.append(
                 {
                     "case": a.case,
                     "mode": a.mode,
-                    "rank": r.rank,
-                    "vut": r.name,
-                    "score": r.point,
-                    "lo": r.lo,
-                    "hi": r.hi,
-                    "n_seeds": r.n_seeds,
+                    "rank": ranked.rank,
+                    "vut": ranked.name,
+                    "score": ranked.point,
+                    "lo": ranked.lo,
+                    "hi": ranked.hi,
+                    "n_seeds": ranked.n_seeds,
                     "unit": f"{a.info.indicator.unit} (higher = safer)",
                     "p_vs_next": pair.verdict.p_seed_welch if pair else "",
                     "significant_vs_next": pair.significant if pair else "",
