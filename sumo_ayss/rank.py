@@ -28,12 +28,13 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from sumo_ayss.analysis.case import CaseAnalysis, analyse_case, exposure_sentence
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.run_folder import OUTCOME_JSON, RunFolder
 
 if TYPE_CHECKING:
-    from sumo_ayss.report.document import CaseAnalysis, ReportOptions
+    from sumo_ayss.report.options import ReportOptions
 
 RANKING_COLUMNS = [
     "case",
@@ -52,9 +53,13 @@ RANKING_COLUMNS = [
 
 
 def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> list[CaseAnalysis]:
-    """The report's analysis of every case among ``run_dirs`` (see :func:`analyse_case`)."""
-    from sumo_ayss.report.document import ReportOptions, analyse_case
+    """The analysis of every case among ``run_dirs`` (see :func:`analyse_case`).
+
+    Safety indices that the pipeline's report already computed in this process for the
+    same samples and settings are reused, not bootstrapped again.
+    """
     from sumo_ayss.report.load import group_runs, load_run
+    from sumo_ayss.report.options import ReportOptions
 
     options = options or ReportOptions()
     groups = group_runs([load_run(d) for d in run_dirs])
@@ -68,8 +73,6 @@ def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
     Exposure mode: the score is E, the mean episode reward per SPCP (lower = safer).
     Paper mode: the AYSS safety index (higher = safer).
     """
-    from sumo_ayss.report.document import exposure_sentence
-
     rows: list[dict[str, Any]] = []
     for a in analyses:
         if a.mode == "exposure":
@@ -94,19 +97,19 @@ def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
             continue
         pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
         order = [r.name for r in a.ranking]
-        for i, r in enumerate(a.ranking):
+        for i, ranked in enumerate(a.ranking):
             nxt_name = order[i + 1] if i + 1 < len(order) else None
-            pair = pairs.get((r.name, nxt_name)) if nxt_name else None
+            pair = pairs.get((ranked.name, nxt_name)) if nxt_name else None
             rows.append(
                 {
                     "case": a.case,
                     "mode": a.mode,
-                    "rank": r.rank,
-                    "vut": r.name,
-                    "score": r.point,
-                    "lo": r.lo,
-                    "hi": r.hi,
-                    "n_seeds": r.n_seeds,
+                    "rank": ranked.rank,
+                    "vut": ranked.name,
+                    "score": ranked.point,
+                    "lo": ranked.lo,
+                    "hi": ranked.hi,
+                    "n_seeds": ranked.n_seeds,
                     "unit": f"{a.info.indicator.unit} (higher = safer)",
                     "p_vs_next": pair.verdict.p_seed_welch if pair else "",
                     "significant_vs_next": pair.significant if pair else "",

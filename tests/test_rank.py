@@ -54,3 +54,23 @@ def test_exposure_mode_ranks_by_outcome_reward_and_checks_a_known_order(tmp_path
     _, md = write_ranking(rows, tmp_path, [check], ["cautious", "pi2", "pi1"])
     assert "Kendall tau = 1.00" in md.read_text()
     assert (tmp_path / "order_check.json").is_file()
+
+
+def test_rank_reuses_the_reports_bootstrap(tmp_path, monkeypatch):
+    """After the report analysed the runs, rank draws no bootstrap again: same indices."""
+    import sumo_ayss.analysis.case as case_mod
+    from sumo_ayss.report import write_report
+
+    dirs = _three_vuts(tmp_path, monkeypatch)
+    options = ReportOptions(mode="paper", n_boot=300)
+    write_report([tmp_path], tmp_path / "report", options=options)
+    calls = []
+    real = case_mod.vut_safety_index
+    monkeypatch.setattr(
+        case_mod, "vut_safety_index", lambda *a, **k: calls.append(1) or real(*a, **k)
+    )
+    first = analyse(dirs, options)
+    assert calls == [], "rank recomputed a safety index the report had computed"
+    second = analyse(dirs, ReportOptions(mode="paper", n_boot=300, rng_seed=1))
+    assert len(calls) == 3, "another bootstrap seed must give new indices"
+    assert first[0].indices["pi1"].point == second[0].indices["pi1"].point

@@ -358,3 +358,19 @@ def test_report_imports_neither_torch_nor_libsumo() -> None:
         "sys.exit(str(bad) if bad else 0)"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_report_has_no_import_fallbacks() -> None:
+    """A figure is never dropped silently because an import failed."""
+    import ast
+
+    import sumo_ayss.report
+
+    root = Path(sumo_ayss.report.__file__).parent
+    for path in sorted(root.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ExceptHandler) and node.type is not None:
+                names = {n.id for n in ast.walk(node.type) if isinstance(n, ast.Name)}
+                assert not names & {"ImportError", "ModuleNotFoundError"}, (
+                    f"{path.name}:{node.lineno} catches an ImportError"
+                )
