@@ -168,7 +168,11 @@ def test_jobs_carry_the_config_parsed_once_and_it_pickles(
     ("extra", "match"),
     [
         ({"expected_order": ["pi1"]}, r"expected_order must list exactly the grid's VUTs"),
-        ({"report": {"mode": "fancy"}}, r"report\.mode must be one of \['exposure', 'paper'\]"),
+        ({"report": {"mode": "fancy"}}, r"report\.mode must be one of \['crossplay', 'exposure', 'paper'\]"),
+        (
+            {"report": {"crossplay_blocks": "seeds"}},
+            r"report\.crossplay_blocks must be one of \['seed', 'opponent'\], got 'seeds'",
+        ),
         (
             {"report": {"premise_reward": -1}},
             r"report\.premise_reward must be a finite number >= 0",

@@ -4,8 +4,9 @@
 :class:`sumo_ayss.report.load.Run`) into a :class:`CaseAnalysis`: the paper mode (AYSS
 safety index per VUT, hierarchical bootstrap, pairwise verdicts under
 :func:`~.significance.pair_verdict`), the exposure mode (seed-level ranking of the mean
-episode reward the SPCPs extract) and the premise check. Both the report and
-:mod:`sumo_ayss.rank` read it; nothing here draws or renders.
+episode reward the SPCPs extract), the cross-play mode (the case folder's ``crossplay.csv``
+when the cross-play stage wrote one, :mod:`.crossplay`) and the premise check. Both the
+report and :mod:`sumo_ayss.rank` read it; nothing here draws or renders.
 """
 
 from __future__ import annotations
@@ -17,11 +18,18 @@ import zlib
 from collections import OrderedDict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Literal, Protocol
 
 import numpy as np
 
 from sumo_ayss.analysis.cases import CaseInfo, case_info
+from sumo_ayss.analysis.crossplay import (
+    CrossplayMatrix,
+    crossplay_sentence,
+    rank_crossplay,
+    read_crossplay,
+)
 from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.analysis.premise import Premise, premise_check
 from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex, rank, safety_index
@@ -33,9 +41,11 @@ from sumo_ayss.analysis.seeds import (
     verdict_sentence,
 )
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.errors import ConfigError, TableError
+from sumo_ayss.run_folder import CaseFolder
 
 __all__ = [
+    "CROSSPLAY_COMMAND",
     "EXPOSURE_SCORE",
     "CaseAnalysis",
     "CaseOptions",
@@ -43,6 +53,7 @@ __all__ = [
     "exposure_sentence",
     "premise_sentence",
     "run_label",
+    "seed_ranking_line",
     "vut_safety_index",
 ]
 
@@ -75,6 +86,9 @@ class CaseOptions(Protocol):
 
     @property
     def mode(self) -> str: ...
+
+    @property
+    def crossplay_blocks(self) -> str: ...
 
     @property
     def premise_tolerances(self) -> Mapping[str, float]: ...
@@ -187,13 +201,23 @@ class CaseAnalysis:
         headline_kind: ``"safer"``, ``"none"`` or ``"warning"``.
         ranking_line: ``"pi2 > pi1"`` (``>`` significant under the rule, ``≈`` not).
         problems: Missing or unreadable files, one sentence each.
-        mode: The analysis mode of ``headline``, ``ranking_line`` and :attr:`ranked`.
+        mode: The analysis mode asked for (``report.mode``).
+        ranking_mode: The mode ``headline`` and ``ranking_line`` come from: ``mode``, or
+            ``"exposure"`` in cross-play mode without a cross-play table (the headline
+            says so first).
         exposure_rows: Exposure-mode ranking, safest first.
         exposure_pairs: Exposure-mode comparisons of every pair (A ranked above B).
         exposure_scores: ``{vut: {seed: E}}``, the per-seed exposures behind the ranking.
         premise: Whether the SPCPs reached the same overall outcome, or None.
         paper_headline: The paper-mode headline (also when ``mode`` is exposure).
         paper_ranking_line: The paper-mode ranking line.
+        crossplay: The case's cross-play matrix, or None (see ``crossplay_missing``).
+        crossplay_rows: Cross-play ranking, safest first (empty without a table).
+        crossplay_pairs: Cross-play comparisons of every pair (A ranked above B).
+        crossplay_blocks: Block unit of the cross-play test (``"seed"`` or ``"opponent"``).
+        crossplay_path: The ``crossplay.csv`` read, or None.
+        crossplay_missing: Why there is no cross-play ranking, one sentence; "" when there
+            is one.
     """
 
     case: str
@@ -213,7 +237,17 @@ class CaseAnalysis:
     premise: Premise | None = None
     paper_headline: str = ""
     paper_ranking_line: str = ""
+    ranking_mode: str = "exposure"
+    crossplay: CrossplayMatrix | None = None
+    crossplay_rows: list[SeedRankRow] = field(default_factory=list)
+    crossplay_pairs: list[SeedComparison] = field(default_factory=list)
+    crossplay_blocks: str = "seed"
+    crossplay_path: Path | None = None
+    crossplay_missing: str = ""
 
+
+CROSSPLAY_COMMAND = "python -m sumo_ayss.crossplay <config>"
+"""The command that writes a case's cross-play table."""
 
 EXPOSURE_SCORE = "extract {amount} {more_less} reward per episode"
 """How an exposure difference reads in a verdict sentence."""
@@ -249,6 +283,53 @@ def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
             for key in metrics:
                 metrics[key].setdefault(vut, []).append(getattr(r.outcome, key).value)
     out.premise = premise_check(metrics, tolerances=options.premise_tolerances, level=options.level)
+
+
+def _crossplay(out: CaseAnalysis, options: CaseOptions) -> None:
+    """Cross-play ranking from the case folder's ``crossplay.csv``, or why there is none.
+
+    The case folder is the parent of the VUT folders of the case's runs. A table whose VUTs
+    or opponents are not exactly this case's VUTs and runs (an older grid, a failed job) is
+    not used: the reason is recorded instead.
+    """
+    out.crossplay_blocks = options.crossplay_blocks
+    if len(out.runs) < 2:
+        only = next(iter(out.runs), "?")
+        out.crossplay_missing = (
+            f"no cross-play for this case: its runs here are of one VUT only ({only}), and "
+            "cross-play compares two or more"
+        )
+        return
+    case_dirs = sorted({Path(r.path).parent.parent for rs in out.runs.values() for r in rs})
+    if len(case_dirs) != 1:
+        out.crossplay_missing = (
+            "no cross-play table for this case: its runs lie in several case folders ("
+            + ", ".join(map(str, case_dirs))
+            + "), and a cross-play table covers one grid"
+        )
+        return
+    path = CaseFolder(case_dirs[0]).crossplay_csv
+    if not path.is_file():
+        out.crossplay_missing = f"no cross-play table for this case (run {CROSSPLAY_COMMAND})"
+        return
+    try:
+        m = read_crossplay(path)
+    except (TableError, ConfigError) as exc:
+        out.crossplay_missing = f"the cross-play table is unreadable ({exc})"
+        out.problems.append(f"{path}: {exc}")
+        return
+    opponents = {(v, int(r.seed)) for v, rs in out.runs.items() for r in rs if r.seed is not None}
+    if set(m.vuts) != set(out.runs) or set(m.opponents) != opponents:
+        out.crossplay_missing = (
+            f"the cross-play table {path} is not of these runs (VUTs {', '.join(m.vuts)}; "
+            f"{len(m.opponents)} opponents, this case has {len(opponents)} runs with a seed); "
+            f"run {CROSSPLAY_COMMAND} again once every job is done"
+        )
+        return
+    out.crossplay, out.crossplay_path = m, path
+    out.crossplay_rows, out.crossplay_pairs = rank_crossplay(
+        m, blocks=options.crossplay_blocks, level=options.level, alpha=options.welch_alpha
+    )
 
 
 def exposure_sentence(c: SeedComparison) -> str:
@@ -341,10 +422,40 @@ def analyse_case(
         if out.headline_kind == "safer":
             out.headline_kind = "warning"
     out.paper_headline, out.paper_ranking_line = out.headline, out.ranking_line
-    out.mode = options.mode
+    _crossplay(out, options)
+    out.mode = out.ranking_mode = options.mode
     if options.mode == "exposure":
         _exposure_headline(out)
+    elif options.mode == "crossplay":
+        _crossplay_headline(out)
     return out
+
+
+def seed_ranking_line(rows: Sequence[SeedRankRow]) -> str:
+    """``"a > b ≈ c"``: ``>`` where a row differs significantly from the next."""
+    if not rows:
+        return ""
+    return rows[0].name + "".join(
+        (" > " if prev.significant_vs_next else " ≈ ") + row.name
+        for prev, row in itertools.pairwise(rows)
+    )
+
+
+def _crossplay_headline(out: CaseAnalysis) -> None:
+    """Headline and ranking line of the cross-play mode; without a table, the exposure
+    mode's, after a sentence that says so."""
+    rows = out.crossplay_rows
+    if len(rows) < 2 or rows[0].vs_next is None:
+        _exposure_headline(out)
+        out.ranking_mode = "exposure"
+        reason = out.crossplay_missing or "the cross-play table ranks fewer than two VUTs"
+        out.headline = f"[crossplay mode] {reason}. Shown instead, labelled: {out.headline}"
+        out.headline_kind = "warning"
+        return
+    top = rows[0].vs_next
+    out.headline = crossplay_sentence(top, out.crossplay_blocks)
+    out.headline_kind = "safer" if top.significant else "none"
+    out.ranking_line = seed_ranking_line(rows)
 
 
 def _exposure_headline(out: CaseAnalysis) -> None:
@@ -362,10 +473,7 @@ def _exposure_headline(out: CaseAnalysis) -> None:
     if out.info.exposure_caution:
         out.headline += " " + out.info.exposure_caution
         out.headline_kind = "warning"
-    out.ranking_line = rows[0].name + "".join(
-        (" > " if prev.significant_vs_next else " ≈ ") + row.name
-        for prev, row in itertools.pairwise(rows)
-    )
+    out.ranking_line = seed_ranking_line(rows)
 
 
 def _headline(out: CaseAnalysis) -> None:

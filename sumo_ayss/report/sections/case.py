@@ -12,13 +12,14 @@ from pathlib import Path
 
 import numpy as np
 
-from sumo_ayss.analysis.case import CaseAnalysis, premise_sentence
+from sumo_ayss.analysis.case import CaseAnalysis, premise_sentence, seed_ranking_line
 from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragraph, Table
 from sumo_ayss.report.discriminability import discriminability_blocks
 from sumo_ayss.report.options import ReportOptions
 from sumo_ayss.report.sections.common import display_path
+from sumo_ayss.report.sections.crossplay import crossplay_blocks
 from sumo_ayss.report.sections.outcome import exposure_blocks, outcome_blocks, premise_blocks
 from sumo_ayss.report.sections.paper import paper_blocks
 
@@ -45,14 +46,17 @@ def case_blocks(
     blocks += paper_blocks(a, colors, out_dir, options)
     case_dirs = list(dict.fromkeys(r.path.parent.parent for rs in a.runs.values() for r in rs))
     blocks += discriminability_blocks(case, list(a.runs), case_dirs, out_dir, colors)
+    blocks += crossplay_blocks(a, colors, out_dir, options)
     return blocks
 
 
 def verdict_lines(a: CaseAnalysis, options: ReportOptions) -> tuple[str, ...]:
-    """The verdict callout: the mode's headline and ranking, the premise, the other mode."""
+    """The verdict callout: the mode's headline and ranking, the premise, the other modes."""
     lines = [a.headline]
     if a.ranking_line:
-        lines.append(f"Ranking ({a.mode} mode), safest first: {a.ranking_line}")
+        lines.append(f"Ranking ({a.ranking_mode} mode), safest first: {a.ranking_line}")
+    if a.ranking_mode == "crossplay" and a.exposure_rows:
+        lines.append(f"Ranking (exposure mode), safest first: {seed_ranking_line(a.exposure_rows)}")
     lines.append(premise_sentence(a.premise, options))
     if a.mode != "paper":
         paper = a.paper_headline

@@ -172,7 +172,7 @@ def premise_blocks(a: CaseAnalysis, options: ReportOptions) -> list[Block]:
 def exposure_blocks(
     a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
-    blocks: list[Block] = [Heading("(f) Exposure ranking (default mode)", 3)]
+    blocks: list[Block] = [Heading("(f) Exposure ranking", 3)]
     blocks.append(Paragraph(MODES["exposure"]))
     if not a.exposure_rows:
         return [*blocks, Paragraph("No exposure: no outcome summaries in this case yet.")]
