@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import functools
 import logging
 import os
 import sys
@@ -239,13 +240,17 @@ def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> l
                 seed=DEFAULT_OUTCOME_SEED,
                 n_envs=DEFAULT_N_ENVS,
                 trust_controller=True,  # the pipeline's own runs, from the user's configs
-                progress=lambda line, case=case: logger.info("cross-play %s: %s", case, line),
+                progress=functools.partial(_crossplay_progress, case),
             )
         except AyssError as e:  # never fatal: the report says the table is missing
             logger.warning("cross-play of %s failed: %s", case, e)
             continue
         written.append(csv_path)
     return written
+
+
+def _crossplay_progress(case: str, line: str) -> None:
+    logger.info("cross-play %s: %s", case, line)
 
 
 def write_discriminability(cfg: PipelineConfig) -> None:

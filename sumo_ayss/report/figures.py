@@ -482,7 +482,7 @@ def crossplay_figure(
     rows = [list(vuts).index(v) for v in order]
     seeds = sorted({s for _, s in opponents})
     with style():
-        fig = Figure(figsize=(3.4 + 1.6 * max(1, len(order)), 4.6), layout="constrained")
+        fig = Figure(figsize=(5.0 + 1.6 * max(1, len(order)), 4.6), layout="constrained")
         ax = fig.subplots()
         for j, (vut, seed) in enumerate(opponents):
             ls, marker = seed_style(seeds.index(seed))
@@ -499,7 +499,7 @@ def crossplay_figure(
         ax.set_xticks(range(len(order)), [f"#{k + 1} {v}" for k, v in enumerate(order)])
         ax.set_xlim(-0.4, len(order) - 0.6 + 0.2)
         ax.set_xlabel("VUT driven against, safest first (cross-play ranking)")
-        ax.set_ylabel("mean episode reward the opponent extracts (reward/episode)")
+        ax.set_ylabel("reward extracted (mean reward/episode)")
         ax.set_title(title)
         ax.grid(axis="y", alpha=0.3)
         ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))

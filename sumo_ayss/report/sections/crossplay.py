@@ -62,7 +62,7 @@ def crossplay_blocks(
         m.vuts,
         colors,
         out_dir / f"{a.case}_crossplay_by_opponent.png",
-        title=f"{a.info.title}: reward each opponent SPCP extracts per VUT (lower = safer)",
+        title=f"{a.info.title}: cross-play, reward per opponent (lower = safer)",
     )
     where = display_path(a.crossplay_path, out_dir) if a.crossplay_path is not None else ""
     blocks.append(
