@@ -35,14 +35,12 @@ from sumo_ayss.catalog import controller_imports
 from sumo_ayss.cli import prog
 from sumo_ayss.errors import AyssError, CheckpointError, TableError
 from sumo_ayss.run_folder import (
-    CROSSPLAY_SCHEMA,
     CaseFolder,
     CrossplayOpponent,
     CrossplayRecord,
     RunFolder,
     case_dir_for,
     read_crossplay_json,
-    read_table,
     run_dir_for,
     write_crossplay_json,
     write_table,
@@ -124,13 +122,9 @@ def run_case(
 
 def read_matrix(csv_path: Path) -> Any:
     """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of a ``crossplay.csv``."""
-    from sumo_ayss.analysis.crossplay import crossplay_matrix
+    from sumo_ayss.analysis.crossplay import read_crossplay
 
-    t = read_table(csv_path, CROSSPLAY_SCHEMA)
-    c = t.columns
-    return crossplay_matrix(
-        c["vut"], c["opponent_vut"], c["opponent_seed"], c["episode_return"], c["collided"]
-    )
+    return read_crossplay(csv_path)
 
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:

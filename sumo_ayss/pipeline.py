@@ -8,7 +8,10 @@ when the output is not a terminal, one log line per job event (started, each SPC
 candidate, training finished, done, failed) with the grid's counts and ETA.
 
 Each job (case, VUT, seed) trains (or resumes) its SPCP candidates, selects the SPCP, runs
-the outcome episodes and the Monte Carlo AYSS; then one report covers the whole grid. Jobs
+the outcome episodes and the Monte Carlo AYSS. In cross-play mode (``report.mode:
+crossplay``, the default) every SPCP of a case with two or more VUTs then drives against
+every VUT of the case (:func:`run_crossplay_stage`, :mod:`sumo_ayss.crossplay`); then one
+report covers the whole grid. Jobs
 run in parallel processes (one SUMO per process: libsumo holds one simulation each), or as
 Ray tasks. Every stage writes atomically and is skipped when its output exists and was made
 from the same inputs, so rerunning after a crash or Ctrl-C continues where it stopped. A
@@ -29,7 +32,7 @@ Pipeline YAML (every key optional)::
     evaluate: {n_outcome: 200, n_ayss: 100000}  # n_ayss: shorthand for ayss.n_samples
     #   ayss: {h_m: [0, 5], seed: 4242, ...}   # Monte Carlo (sumo_ayss.config.AyssConfig)
     vuts: {}                    # extra VUTs (name: vehicle type) added to every experiment
-    report: {mode: exposure, n_boot: 2000}  # sumo_ayss.report.options.ReportOptions
+    report: {mode: crossplay, crossplay_blocks: seed, n_boot: 2000}  # report.options
     expected_order: []          # a known safety order, safest first (validation studies)
     workers: 0                  # 0 = as many as cores
     retries: 1
@@ -39,6 +42,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import functools
 import logging
 import os
 import sys
@@ -60,7 +64,7 @@ logger = logging.getLogger("sumo_ayss.pipeline")  # also when run as __main__
 Backend = Literal["local", "ray"]
 
 
-__all__ = ["load_pipeline", "main", "plan_jobs", "run_pipeline"]
+__all__ = ["load_pipeline", "main", "plan_jobs", "run_crossplay_stage", "run_pipeline"]
 
 
 def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
@@ -188,12 +192,65 @@ def run_pipeline(
         )
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
     report = None
+    if finished and cfg.report.mode == "crossplay":
+        run_crossplay_stage(cfg, statuses)
     if finished:
         write_discriminability(cfg)
         from sumo_ayss.report import write_report
 
         report = write_report(finished, cfg.out / "report", options=cfg.report)
     return statuses, report
+
+
+def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> list[Path]:
+    """Cross-play of every case of the grid with two or more VUTs; the tables written.
+
+    Every SPCP of the case drives against every VUT on the outcome scenarios
+    (``evaluate.n_outcome`` of the outcome seed), :func:`sumo_ayss.crossplay.run_case`; a
+    case already cross-played with the same SPCPs and settings is skipped. A case with one
+    VUT has no cross-play; a case with a failed job is skipped with a warning (its report
+    then says that the cross-play table is missing); a failure of the stage itself is
+    logged, never fatal.
+    """
+    from sumo_ayss.crossplay import DEFAULT_N_ENVS, run_case
+    from sumo_ayss.run_folder import case_dir_for
+    from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
+
+    if len(cfg.grid.vuts) < 2:
+        logger.info("cross-play skipped: the grid has one VUT (cross-play compares two or more)")
+        return []
+    written = []
+    for case in cfg.grid.cases:
+        jobs = [s for s in statuses if s.spec.case == case]
+        failed = [s.spec.name for s in jobs if s.state != "done"]
+        if failed:
+            logger.warning(
+                "cross-play of %s skipped: %d job(s) not done (%s); the report says the "
+                "cross-play table is missing",
+                case,
+                len(failed),
+                ", ".join(failed),
+            )
+            continue
+        try:
+            csv_path = run_case(
+                [s.spec.run_dir for s in jobs],
+                case_dir_for(cfg.out, case),
+                n=cfg.evaluate.n_outcome,
+                seed=DEFAULT_OUTCOME_SEED,
+                n_envs=DEFAULT_N_ENVS,
+                trust_controller=True,  # the pipeline's own runs, from the user's configs
+                progress=functools.partial(_crossplay_progress, case),
+            )
+        except AyssError as e:  # never fatal: the report says the table is missing
+            logger.warning("cross-play of %s failed: %s", case, e)
+            continue
+        written.append(csv_path)
+    return written
+
+
+def _crossplay_progress(case: str, line: str) -> None:
+    logger.info("cross-play %s: %s", case, line)
 
 
 def write_discriminability(cfg: PipelineConfig) -> None:

@@ -5,16 +5,26 @@
 The config is a pipeline YAML (:mod:`sumo_ayss.pipeline`) whose ``grid.vuts`` lists the
 VUTs to rank (catalog models from the experiments' ``env.vuts`` or the pipeline's own
 ``vuts`` section). After the grid (resumable: finished jobs are skipped), this writes
-``<out>/ranking.csv`` and ``<out>/ranking.md`` (per case: rank, VUT, score with its
-interval, seeds, and the verdict against the next VUT) and the HTML report, and prints the
-table. With ``expected_order`` (a known safety order, e.g. a ladder), it also writes
-``<out>/order_check.json``: Kendall's τ of the ranking against it, whether the two ends
-differ significantly, and how many adjacent pairs do.
+``<out>/ranking.csv`` and ``<out>/ranking.md`` (per case and mode: rank, VUT, score with
+its interval, seeds or blocks, and the verdict against the next VUT) and the HTML report,
+and prints the table. With ``expected_order`` (a known safety order, e.g. a ladder), it also
+writes ``<out>/order_check.json``: per case and mode, Kendall's τ of the ranking against it,
+whether the two ends differ significantly, and how many adjacent pairs do.
 
-The score depends on the report's mode (``report.mode``, :data:`sumo_ayss.report.options.MODES`):
-``exposure`` (default) ranks by the mean episode reward the SPCP extracts (lower = safer),
-comparing VUTs by a paired t-test over shared seeds; ``paper`` ranks by the paper's AYSS
-aggressiveness index (:func:`sumo_ayss.analysis.ranking.safety_index`).
+The mode (``report.mode`` or ``--mode``, :data:`sumo_ayss.report.options.MODES`) decides which
+rows come first and which ranking the report's verdicts use; the rows of every other mode
+available for a case follow, each tagged with its mode:
+
+* ``crossplay`` (default): the pipeline then runs every SPCP of a case against every VUT
+  (:mod:`sumo_ayss.crossplay`) and ranks by the mean episode reward the pooled SPCPs extract
+  (lower = safer), a paired t-test over training-seed blocks; available wherever
+  ``<out>/<case>/crossplay.csv`` exists;
+* ``exposure`` (always available): the mean episode reward each VUT's own SPCPs extract
+  (lower = safer), a paired t-test over shared seeds;
+* ``paper`` (computed in paper mode only, the AYSS bootstrap is slow): the paper's AYSS
+  aggressiveness index (:func:`sumo_ayss.analysis.ranking.safety_index`).
+
+``--no-run`` ranks existing run folders and never runs cross-play.
 """
 
 from __future__ import annotations
@@ -28,12 +38,14 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from sumo_ayss.analysis.case import CaseAnalysis, analyse_case, exposure_sentence
+from sumo_ayss.analysis.crossplay import crossplay_sentence
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.run_folder import OUTCOME_JSON, RunFolder
 
 if TYPE_CHECKING:
-    from sumo_ayss.report.document import CaseAnalysis, ReportOptions
+    from sumo_ayss.report.options import ReportOptions
 
 RANKING_COLUMNS = [
     "case",
@@ -52,9 +64,13 @@ RANKING_COLUMNS = [
 
 
 def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> list[CaseAnalysis]:
-    """The report's analysis of every case among ``run_dirs`` (see :func:`analyse_case`)."""
-    from sumo_ayss.report.document import ReportOptions, analyse_case
+    """The analysis of every case among ``run_dirs`` (see :func:`analyse_case`).
+
+    Safety indices that the pipeline's report already computed in this process for the
+    same samples and settings are reused, not bootstrapped again.
+    """
     from sumo_ayss.report.load import group_runs, load_run
+    from sumo_ayss.report.options import ReportOptions
 
     options = options or ReportOptions()
     groups = group_runs([load_run(d) for d in run_dirs])
@@ -62,74 +78,128 @@ def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> l
     return [analyse_case(case, runs, options, paper=paper) for case, runs in groups.items()]
 
 
-def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
-    """Ranking rows of every case (safest first within a case), in each analysis's mode.
+#: The modes in the order their rows follow the chosen mode's.
+MODE_ORDER = ("crossplay", "exposure", "paper")
 
-    Exposure mode: the score is E, the mean episode reward per SPCP (lower = safer).
-    Paper mode: the AYSS safety index (higher = safer).
+
+def available_modes(a: CaseAnalysis) -> list[str]:
+    """The modes with a ranking for this case, the analysis's own mode first.
+
+    Cross-play needs the case's ``crossplay.csv``; exposure needs outcome summaries; paper
+    needs the safety indices (computed in paper mode).
     """
-    from sumo_ayss.report.document import exposure_sentence
+    have = {
+        "crossplay": bool(a.crossplay_rows),
+        "exposure": bool(a.exposure_rows),
+        "paper": bool(a.ranking),
+    }
+    return sorted((m for m in MODE_ORDER if have[m]), key=lambda m: m != a.mode)
 
-    rows: list[dict[str, Any]] = []
-    for a in analyses:
-        if a.mode == "exposure":
-            for r in a.exposure_rows:
-                nxt = r.vs_next
-                rows.append(
-                    {
-                        "case": a.case,
-                        "mode": a.mode,
-                        "rank": r.rank,
-                        "vut": r.name,
-                        "score": r.mean,
-                        "lo": r.lo,
-                        "hi": r.hi,
-                        "n_seeds": r.n_seeds,
-                        "unit": "reward/episode (lower = safer)",
-                        "p_vs_next": nxt.p if nxt else "",
-                        "significant_vs_next": nxt.significant if nxt else "",
-                        "vs_next": exposure_sentence(nxt) if nxt else "",
-                    }
-                )
-            continue
-        pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
-        order = [r.name for r in a.ranking]
-        for i, r in enumerate(a.ranking):
-            nxt_name = order[i + 1] if i + 1 < len(order) else None
-            pair = pairs.get((r.name, nxt_name)) if nxt_name else None
-            rows.append(
-                {
-                    "case": a.case,
-                    "mode": a.mode,
-                    "rank": r.rank,
-                    "vut": r.name,
-                    "score": r.point,
-                    "lo": r.lo,
-                    "hi": r.hi,
-                    "n_seeds": r.n_seeds,
-                    "unit": f"{a.info.indicator.unit} (higher = safer)",
-                    "p_vs_next": pair.verdict.p_seed_welch if pair else "",
-                    "significant_vs_next": pair.significant if pair else "",
-                    "vs_next": pair.sentence if pair else "",
-                }
-            )
+
+def _seed_rows(a: CaseAnalysis, mode: str) -> list[dict[str, Any]]:
+    """Rows of a seed-level ranking (exposure or cross-play)."""
+    if mode == "crossplay":
+        ranked, unit = a.crossplay_rows, "reward/episode, pooled SPCPs (lower = safer)"
+    else:
+        ranked, unit = a.exposure_rows, "reward/episode (lower = safer)"
+    rows = []
+    for r in ranked:
+        nxt = r.vs_next
+        if nxt is None:
+            sentence = ""
+        elif mode == "crossplay":
+            sentence = crossplay_sentence(nxt, a.crossplay_blocks)
+        else:
+            sentence = exposure_sentence(nxt)
+        rows.append(
+            {
+                "case": a.case,
+                "mode": mode,
+                "rank": r.rank,
+                "vut": r.name,
+                "score": r.mean,
+                "lo": r.lo,
+                "hi": r.hi,
+                "n_seeds": r.n_seeds,
+                "unit": unit,
+                "p_vs_next": nxt.p if nxt else "",
+                "significant_vs_next": nxt.significant if nxt else "",
+                "vs_next": sentence,
+            }
+        )
     return rows
 
 
-def order_check(a: CaseAnalysis, expected: Sequence[str]) -> dict[str, Any] | None:
-    """How one case's ranking compares with a known order (safest first).
+def _paper_rows(a: CaseAnalysis) -> list[dict[str, Any]]:
+    pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
+    order = [r.name for r in a.ranking]
+    rows = []
+    for i, ranked in enumerate(a.ranking):
+        nxt_name = order[i + 1] if i + 1 < len(order) else None
+        pair = pairs.get((ranked.name, nxt_name)) if nxt_name else None
+        rows.append(
+            {
+                "case": a.case,
+                "mode": "paper",
+                "rank": ranked.rank,
+                "vut": ranked.name,
+                "score": ranked.point,
+                "lo": ranked.lo,
+                "hi": ranked.hi,
+                "n_seeds": ranked.n_seeds,
+                "unit": f"{a.info.indicator.unit} (higher = safer)",
+                "p_vs_next": pair.verdict.p_seed_welch if pair else "",
+                "significant_vs_next": pair.significant if pair else "",
+                "vs_next": pair.sentence if pair else "",
+            }
+        )
+    return rows
+
+
+def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
+    """Ranking rows of every case, for every mode available (:func:`available_modes`: the
+    analysis's mode first), safest first within a (case, mode); ``mode`` tags each row.
+
+    Cross-play mode: X, the mean episode reward of the pooled SPCPs (lower = safer).
+    Exposure mode: E, the mean episode reward per SPCP (lower = safer).
+    Paper mode: the AYSS safety index (higher = safer).
+    """
+    rows: list[dict[str, Any]] = []
+    for a in analyses:
+        for mode in available_modes(a):
+            rows += _paper_rows(a) if mode == "paper" else _seed_rows(a, mode)
+    return rows
+
+
+def order_check(
+    a: CaseAnalysis, expected: Sequence[str], mode: str | None = None
+) -> dict[str, Any] | None:
+    """How one case's ranking in one mode compares with a known order (safest first).
+
+    Args:
+        a: The case's analysis.
+        expected: The known order, safest first.
+        mode: The mode whose ranking is checked; default the analysis's mode.
 
     Returns:
-        ``{"case", "mode", "order", "tau", "ends_significant", "ends_p",
+        ``{"case", "mode", "order", "expected", "tau", "ends_significant", "ends_p",
         "significant_adjacent", "adjacent"}`` (Kendall τ of the ranking against the known
         order; whether the expected safest and least safe VUT differ significantly, in the
-        right direction; significant adjacent pairs of the ranking), or None when the
-        case's VUTs are not exactly the expected ones.
+        right direction; significant adjacent pairs of the ranking), or None when the mode
+        has no ranking for this case or the case's VUTs are not exactly the expected ones.
     """
-    if a.mode == "exposure":
-        order = [r.name for r in a.exposure_rows]
-        sig = [bool(r.significant_vs_next) for r in a.exposure_rows[:-1]]
-        ends = {frozenset((c.name_a, c.name_b)): c for c in a.exposure_pairs}
+    mode = mode or a.mode
+    if mode not in available_modes(a):
+        return None
+    if mode in ("exposure", "crossplay"):
+        ranked, compared = (
+            (a.exposure_rows, a.exposure_pairs)
+            if mode == "exposure"
+            else (a.crossplay_rows, a.crossplay_pairs)
+        )
+        order = [r.name for r in ranked]
+        sig = [bool(r.significant_vs_next) for r in ranked[:-1]]
+        ends = {frozenset((c.name_a, c.name_b)): c for c in compared}
     else:
         order = [r.name for r in a.ranking]
         sig = [bool(r.significant_vs_next) for r in a.ranking[:-1]]
@@ -142,7 +212,7 @@ def order_check(a: CaseAnalysis, expected: Sequence[str]) -> dict[str, Any] | No
         and end_cmp.significant
         and end_cmp.name_a == expected[0]  # ranked above, i.e. found safer
     )
-    if a.mode == "paper":
+    if mode == "paper":
         pair = next(
             (
                 p
@@ -154,14 +224,25 @@ def order_check(a: CaseAnalysis, expected: Sequence[str]) -> dict[str, Any] | No
         ends_ok = pair is not None and pair.safer == expected[0]
     return {
         "case": a.case,
-        "mode": a.mode,
+        "mode": mode,
         "order": order,
+        "expected": list(expected),
         "tau": kendall_tau(order, list(expected)),
         "ends_significant": ends_ok,
         "ends_p": end_cmp.p if end_cmp is not None else math.nan,
         "significant_adjacent": sum(sig),
         "adjacent": len(sig),
     }
+
+
+def order_checks(analyses: Sequence[CaseAnalysis], expected: Sequence[str]) -> list[dict[str, Any]]:
+    """:func:`order_check` of every (case, mode) available, the analysis's mode first."""
+    return [
+        c
+        for a in analyses
+        for mode in available_modes(a)
+        if (c := order_check(a, expected, mode)) is not None
+    ]
 
 
 def write_ranking(
@@ -229,12 +310,17 @@ def main(argv: Sequence[str] | None = None) -> None:
         "--seeds", type=int, nargs="+", default=None, help="replace grid.seeds (e.g. 100 101 102)"
     )
     parser.add_argument(
-        "--mode", choices=list(MODES), default=None, help="replace report.mode (default exposure)"
+        "--mode",
+        choices=list(MODES),
+        default=None,
+        help="replace report.mode (default crossplay: every SPCP against every VUT, run "
+        "after the grid; rows of every other mode available follow)",
     )
     parser.add_argument(
         "--no-run",
         action="store_true",
-        help=f"rank the grid's existing run folders (with {OUTCOME_JSON}) without running jobs",
+        help=f"rank the grid's existing run folders (with {OUTCOME_JSON}) without running jobs "
+        "or cross-play (cross-play rows appear where <out>/<case>/crossplay.csv exists)",
     )
     parser.add_argument("--no-live", action="store_true", help="no live table (log lines)")
     args = parser.parse_args(argv)
@@ -261,7 +347,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     except KeyboardInterrupt:
         print("interrupted: no job runs any more; rerun the same command to resume", flush=True)
         sys.exit(130)
-    checks = [c for a in analyses if (c := order_check(a, cfg.expected_order)) is not None]
+    checks = order_checks(analyses, cfg.expected_order)
     _, md = write_ranking(ranking_rows(analyses), cfg.out, checks, cfg.expected_order)
     print(md.read_text())
     if args.no_run:

@@ -77,6 +77,33 @@ def test_failing_job_is_retried_then_reported_others_complete(tmp_path: Path) ->
     # Discriminability of the grid's VUTs (a property of the VUTs, not of the runs).
     record = json.loads((cfg.out / "car_following" / "discriminability.json").read_text())
     assert record["vuts"] == ["pi1", "pi2"] and record["pairs"][0]["share"] > 0
+    # Cross-play mode (the default): skipped for the case with a failed job, and said so.
+    assert not (cfg.out / "car_following" / "crossplay.csv").exists()
+    text = report.read_text(encoding="utf-8")
+    assert "[crossplay mode] no cross-play" in text and "Cross-play table missing" in text
+
+
+@pytest.mark.sumo
+def test_crossplay_mode_runs_the_crossplay_stage_and_reports_it(tmp_path: Path) -> None:
+    cfg = load_pipeline(write_configs(tmp_path, [0]))
+    assert cfg.report.mode == "crossplay" and cfg.report.crossplay_blocks == "seed"
+    statuses, report = run_pipeline(cfg, live=False)
+    assert all(s.state == "done" for s in statuses)
+    case = cfg.out / "car_following"
+    record = json.loads((case / "crossplay.json").read_text())
+    assert record["n"] == 10 and record["seed"] == 4242
+    assert [(o["vut"], o["seed"]) for o in record["opponents"]] == [("pi1", 0), ("pi2", 0)]
+    assert (case / "crossplay.csv").is_file()
+    assert report is not None
+    text = report.read_text(encoding="utf-8")
+    verdicts = text.split('id="inputs"')[0]
+    assert "[crossplay mode]" in verdicts and "Ranking (crossplay mode), safest first" in verdicts
+    assert "no cross-play table" not in text
+    assert "(i) Cross-play ranking" in text and "Ranking by cross-play exposure X" in text
+    assert (report.parent / "car_following_crossplay_by_opponent.png").is_file()
+    before = (case / "crossplay.csv").stat().st_mtime_ns
+    run_pipeline(cfg, live=False)  # a rerun skips every finished stage, cross-play included
+    assert (case / "crossplay.csv").stat().st_mtime_ns == before
 
 
 @pytest.mark.sumo
@@ -168,7 +195,14 @@ def test_jobs_carry_the_config_parsed_once_and_it_pickles(
     ("extra", "match"),
     [
         ({"expected_order": ["pi1"]}, r"expected_order must list exactly the grid's VUTs"),
-        ({"report": {"mode": "fancy"}}, r"report\.mode must be one of \['exposure', 'paper'\]"),
+        (
+            {"report": {"mode": "fancy"}},
+            r"report\.mode must be one of \['crossplay', 'exposure', 'paper'\]",
+        ),
+        (
+            {"report": {"crossplay_blocks": "seeds"}},
+            r"report\.crossplay_blocks must be one of \['seed', 'opponent'\], got 'seeds'",
+        ),
         (
             {"report": {"premise_reward": -1}},
             r"report\.premise_reward must be a finite number >= 0",

@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
-from sumo_ayss.rank import analyse, order_check, ranking_rows, write_ranking
+import pytest
+import yaml
+
+from sumo_ayss.config import PROJECT_ROOT
+from sumo_ayss.rank import analyse, main, order_check, ranking_rows, write_ranking
 from sumo_ayss.report.options import ReportOptions
-from tests.report.test_report import EXPOSURE, OFFSET, make_run
+from tests.report.test_report import EXPOSURE, OFFSET, make_crossplay, make_run
 
 
 def _three_vuts(tmp_path: Path, monkeypatch) -> list[Path]:
@@ -21,7 +26,9 @@ def _three_vuts(tmp_path: Path, monkeypatch) -> list[Path]:
 
 def test_paper_mode_ranking_of_three_vuts_is_ordered_with_intervals(tmp_path, monkeypatch):
     dirs = _three_vuts(tmp_path, monkeypatch)
-    rows = ranking_rows(analyse(dirs, ReportOptions(mode="paper", n_boot=400)))
+    all_rows = ranking_rows(analyse(dirs, ReportOptions(mode="paper", n_boot=400)))
+    assert [r["mode"] for r in all_rows] == ["paper"] * 3 + ["exposure"] * 3  # chosen first
+    rows = all_rows[:3]
     assert [r["vut"] for r in rows] == ["cautious", "pi2", "pi1"]
     assert [r["rank"] for r in rows] == [1, 2, 3]
     for r in rows:
@@ -37,7 +44,7 @@ def test_paper_mode_ranking_of_three_vuts_is_ordered_with_intervals(tmp_path, mo
 
 def test_exposure_mode_ranks_by_outcome_reward_and_checks_a_known_order(tmp_path, monkeypatch):
     dirs = _three_vuts(tmp_path, monkeypatch)
-    analyses = analyse(dirs, ReportOptions(n_boot=200))
+    analyses = analyse(dirs, ReportOptions(mode="exposure", n_boot=200))
     rows = ranking_rows(analyses)
     assert [r["vut"] for r in rows] == ["cautious", "pi2", "pi1"]
     assert all(r["mode"] == "exposure" for r in rows)
@@ -54,3 +61,65 @@ def test_exposure_mode_ranks_by_outcome_reward_and_checks_a_known_order(tmp_path
     _, md = write_ranking(rows, tmp_path, [check], ["cautious", "pi2", "pi1"])
     assert "Kendall tau = 1.00" in md.read_text()
     assert (tmp_path / "order_check.json").is_file()
+
+
+def test_rank_reuses_the_reports_bootstrap(tmp_path, monkeypatch):
+    """After the report analysed the runs, rank draws no bootstrap again: same indices."""
+    import sumo_ayss.analysis.case as case_mod
+    from sumo_ayss.report import write_report
+
+    dirs = _three_vuts(tmp_path, monkeypatch)
+    options = ReportOptions(mode="paper", n_boot=300)
+    write_report([tmp_path], tmp_path / "report", options=options)
+    calls = []
+    real = case_mod.vut_safety_index
+    monkeypatch.setattr(
+        case_mod, "vut_safety_index", lambda *a, **k: calls.append(1) or real(*a, **k)
+    )
+    first = analyse(dirs, options)
+    assert calls == [], "rank recomputed a safety index the report had computed"
+    second = analyse(dirs, ReportOptions(mode="paper", n_boot=300, rng_seed=1))
+    assert len(calls) == 3, "another bootstrap seed must give new indices"
+    assert first[0].indices["pi1"].point == second[0].indices["pi1"].point
+
+
+def test_rank_no_run_checks_the_known_order_in_every_mode_available(tmp_path, monkeypatch, capsys):
+    """``rank --no-run`` on existing folders: a row set and an order check per (case, mode);
+    cross-play rows where the case's crossplay.csv exists, and no cross-play is run."""
+    _three_vuts(tmp_path / "runs", monkeypatch)
+    expected = ["cautious", "pi2", "pi1"]
+    pipe = tmp_path / "pipe.yaml"
+    pipe.write_text(
+        yaml.safe_dump(
+            {
+                "grid": {"cases": ["car_following"], "vuts": expected, "seeds": [0, 1, 2]},
+                "experiments": {
+                    "car_following": str(PROJECT_ROOT / "configs" / "car_following.yaml")
+                },
+                "vuts": {"cautious": {"model": "IDM", "params": {"minGap": 12.0}}},
+                "out": "runs",
+                "expected_order": expected,
+            }
+        )
+    )
+    with pytest.raises(SystemExit) as done:  # no crossplay.csv yet: exposure only
+        main([str(pipe), "--no-run", "--no-live"])
+    assert done.value.code == 0
+    checks = json.loads((tmp_path / "runs" / "order_check.json").read_text())["cases"]
+    assert [c["mode"] for c in checks] == ["exposure"]
+    assert not (tmp_path / "runs" / "car_following" / "crossplay.csv").exists()
+    make_crossplay(tmp_path / "runs" / "car_following", expected, [0, 1, 2])
+    with pytest.raises(SystemExit):
+        main([str(pipe), "--no-run", "--no-live", "--mode", "paper"])
+    checks = json.loads((tmp_path / "runs" / "order_check.json").read_text())["cases"]
+    assert [c["mode"] for c in checks] == ["paper", "crossplay", "exposure"]
+    for c in checks:
+        assert c["case"] == "car_following" and c["order"] == expected and c["tau"] == 1.0
+        assert {"ends_significant", "ends_p", "significant_adjacent", "adjacent"} <= set(c)
+    with (tmp_path / "runs" / "ranking.csv").open() as f:
+        modes = [line.split(",")[1] for line in f.readlines()[1:]]
+    assert modes == ["paper"] * 3 + ["crossplay"] * 3 + ["exposure"] * 3
+    main_md = (tmp_path / "runs" / "ranking.md").read_text()
+    assert "| car_following | crossplay | 1 | cautious |" in main_md
+    assert "[crossplay mode] cautious is safer than pi2" in main_md
+    capsys.readouterr()

@@ -4,8 +4,14 @@ Depends on numpy and the standard library only (no SUMO, no torch), so reports a
 use it on any machine.
 
 * :mod:`.metrics` — time to collision, Δv̄.
-* :mod:`.stats` — Student t intervals, binned means, hierarchical bootstrap.
-* :mod:`.ranking` — safety index per VUT, pairwise verdicts, rankings.
+* :mod:`.validate`, :mod:`.student_t`, :mod:`.stats`, :mod:`.bootstrap` — argument checks,
+  Student t, intervals and binned means, hierarchical bootstraps.
+* :mod:`.safety_index`, :mod:`.verdict`, :mod:`.ranking` — safety index per VUT, pairwise
+  verdicts, rankings; :mod:`.significance` — the report's two-test rule.
+* :mod:`.seeds`, :mod:`.premise` — seed-level (exposure) ranking, the premise check.
+* :mod:`.case` — everything above for one case's runs (:func:`.case.analyse_case`);
+  :mod:`.cases` names each case's indicator.
+* :mod:`.formatting` — how numbers, intervals and p-values read in sentences and tables.
 """
 
 from __future__ import annotations

@@ -28,12 +28,14 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import numpy.typing as npt
 
 from sumo_ayss.analysis.seeds import SeedComparison, SeedRankRow, SeedScores, rank_seeds
 from sumo_ayss.errors import ConfigError
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, read_table
 
 __all__ = [
     "BLOCKS",
@@ -41,6 +43,7 @@ __all__ = [
     "crossplay_matrix",
     "crossplay_sentence",
     "rank_crossplay",
+    "read_crossplay",
 ]
 
 #: Block units of the paired test: training seeds (default) or single opponents.
@@ -130,6 +133,20 @@ def crossplay_matrix(
             f"every VUT (per-cell counts {int(counts.min())}..{int(counts.max())})"
         )
     return CrossplayMatrix(vuts, opps, sums / counts, crashes / counts, int(counts[0, 0]))
+
+
+def read_crossplay(csv_path: Path) -> CrossplayMatrix:
+    """The :class:`CrossplayMatrix` of a case folder's ``crossplay.csv``.
+
+    Raises:
+        TableError: If the file is missing or does not match
+            :data:`~sumo_ayss.run_folder.CROSSPLAY_SCHEMA`.
+        ConfigError: If the design is not complete and balanced (:func:`crossplay_matrix`).
+    """
+    c = read_table(csv_path, CROSSPLAY_SCHEMA).columns
+    return crossplay_matrix(
+        c["vut"], c["opponent_vut"], c["opponent_seed"], c["episode_return"], c["collided"]
+    )
 
 
 def rank_crossplay(

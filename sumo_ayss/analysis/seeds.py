@@ -28,6 +28,7 @@ from typing import Literal
 
 import numpy as np
 
+from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
 from sumo_ayss.analysis.stats import check_level, mean_ci, student_t_sf, t_quantile
 from sumo_ayss.errors import ConfigError
 
@@ -284,23 +285,6 @@ def kendall_tau(order: Sequence[str], truth: Sequence[str]) -> float:
     return (concordant - discordant) / (concordant + discordant)
 
 
-def _fmt_num(x: float) -> str:
-    return f"{x:.2f}".replace("-", "−")
-
-
-def _fmt_ci(lo: float, hi: float) -> str:
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        return "interval undefined"
-    sep = "–" if lo >= 0 and hi >= 0 else " to "
-    return f"{_fmt_num(lo)}{sep}{_fmt_num(hi)}"
-
-
-def _fmt_p(p: float) -> str:
-    if not math.isfinite(p):
-        return "p undefined"
-    return "p < 0.001" if p < 0.001 else f"p = {p:.3f}"
-
-
 def verdict_sentence(
     c: SeedComparison, *, higher_is_safer: bool, score: str, unit: str, mode: str
 ) -> str:
@@ -326,8 +310,9 @@ def verdict_sentence(
     # stated amount: of B - A when B scores higher, of A - B otherwise.
     b_higher = c.difference < 0
     lo, hi = (-c.hi, -c.lo) if b_higher else (c.lo, c.hi)
-    stats = f"{pct} CI {_fmt_ci(lo, hi)}; {how}, {_fmt_p(c.p)}"
-    amount = f"{abs(c.difference):.2f}" + (f" {unit}" if unit else "")
+    ci = fmt_interval(lo, hi, missing="interval undefined")
+    stats = f"{pct} CI {ci}; {how}, p {fmt_p(c.p, undefined='undefined')}"
+    amount = fmt_num(abs(c.difference), minus="-", missing="nan") + (f" {unit}" if unit else "")
     what = score.format(amount=amount, more_less="more" if b_higher else "less")
     if c.significant and (c.difference > 0) == higher_is_safer:
         return (

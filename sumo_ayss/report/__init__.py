@@ -8,7 +8,8 @@ From a pipeline::
 
     html_path = write_report([Path("runs")], Path("runs/report"))
 
-Imports neither SUMO nor torch (the reward-shape figure loads :mod:`sumo_ayss.plots` lazily).
+Imports neither SUMO nor torch. The statistics live in :mod:`sumo_ayss.analysis`
+(:mod:`sumo_ayss.analysis.case`); this package composes sections and renders them.
 """
 
 from __future__ import annotations
@@ -20,15 +21,15 @@ _LAZY = {
     "DEFAULT_TITLE": "sumo_ayss.report.document",
     "HTML_NAME": "sumo_ayss.report.document",
     "MARKDOWN_NAME": "sumo_ayss.report.document",
-    "PairVerdict": "sumo_ayss.report.document",
+    "PairVerdict": "sumo_ayss.analysis.significance",
     "Report": "sumo_ayss.report.document",
-    "analyse_case": "sumo_ayss.report.document",
+    "analyse_case": "sumo_ayss.analysis.case",
     "build_report": "sumo_ayss.report.document",
-    "pair_verdict": "sumo_ayss.report.document",
-    "render_html": "sumo_ayss.report.document",
-    "render_markdown": "sumo_ayss.report.document",
-    "significance_rule": "sumo_ayss.report.document",
-    "vut_safety_index": "sumo_ayss.report.document",
+    "pair_verdict": "sumo_ayss.analysis.significance",
+    "render_html": "sumo_ayss.report.render",
+    "render_markdown": "sumo_ayss.report.render",
+    "significance_rule": "sumo_ayss.analysis.significance",
+    "vut_safety_index": "sumo_ayss.analysis.case",
     "write_report": "sumo_ayss.report.document",
     "RUN_FILES": "sumo_ayss.report.load",
     "Run": "sumo_ayss.report.load",

@@ -23,7 +23,8 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from sumo_ayss.report import figures
+from sumo_ayss.report import figstyle
+from sumo_ayss.report.blocks import Block, FigureBlock, Heading, Paragraph, Table
 
 logger = logging.getLogger(__name__)
 
@@ -72,8 +73,8 @@ def discriminability_figure(
     ve = np.asarray(record["v_edges_mps"], dtype=float)
     hc, vc = 0.5 * (he[:-1] + he[1:]), 0.5 * (ve[:-1] + ve[1:])
     thr = record.get("threshold_mps2", 0.1)
-    colors = {**figures.vut_colors(list(record["vuts"])), **(colors or {})}
-    with figures._style():
+    colors = {**figstyle.vut_colors(list(record["vuts"])), **(colors or {})}
+    with figstyle.style():
         fig = Figure(figsize=(15, 4.4), layout="constrained")
         ax_h, ax_v, ax_m = fig.subplots(1, 3)
         # Pairs (and VUTs) that coincide draw on top of each other: earlier lines are drawn
@@ -85,7 +86,7 @@ def discriminability_figure(
                 "marker": _MARKERS[i % len(_MARKERS)],
                 "ms": 3 + 3 * (n - i) / n,
                 "lw": 1.2 + 2.8 * (n - 1 - i) / max(1, n - 1),
-                "ls": figures._LINESTYLES[(i // len(_MARKERS)) % len(figures._LINESTYLES)],
+                "ls": figstyle.LINESTYLES[(i // len(_MARKERS)) % len(figstyle.LINESTYLES)],
                 "alpha": 0.85,
             }
             ax_h.plot(hc, 100 * _series(p["share_by_h"]), label=label, **style)
@@ -114,7 +115,7 @@ def discriminability_figure(
         ax_m.set_ylabel("mean VUT acceleration [m/s²]")
         ax_m.set_title("Mean one-step response per VUT")
         ax_m.legend(loc="best", title="VUT (box mean, m/s²)")
-        return figures._save(fig, path)
+        return figstyle.save(fig, path)
 
 
 def _pct(x: float | None) -> str:
@@ -140,7 +141,7 @@ def discriminability_blocks(
     case_dirs: Sequence[Path],
     out_dir: Path,
     colors: Mapping[str, str] | None = None,
-) -> list[Any]:
+) -> list[Block]:
     """The report blocks of the section, for a case with >= 2 VUTs (else none).
 
     Args:
@@ -152,9 +153,8 @@ def discriminability_blocks(
         colors: ``{vut: colour}`` of the report.
 
     Returns:
-        Heading, paragraph(s), figure and tables (``sumo_ayss.report.document`` blocks).
+        Heading, paragraph(s), figure and tables (:mod:`sumo_ayss.report.blocks`).
     """
-    from sumo_ayss.report.document import FigureBlock, Heading, Paragraph, Table
 
     if len(vuts) < 2:
         return []

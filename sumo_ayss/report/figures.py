@@ -6,21 +6,17 @@ pyplot's global state or backend.
 Every function draws one PNG file and returns its path. Colours are per VUT and the same in
 every figure of a report (:func:`vut_colors`); seeds are told apart by line style and
 marker. The statistics come from :mod:`sumo_ayss.analysis`; nothing here computes a verdict.
-This module imports neither SUMO nor torch (:func:`reward_shapes_figure` imports
-:mod:`sumo_ayss.plots` lazily, see there).
+This module imports neither SUMO nor torch: the reward shapes come from
+:mod:`sumo_ayss.envs.rewards`, which is pure numpy.
 """
 
 from __future__ import annotations
 
-import logging
 import math
-from collections.abc import Iterator, Mapping, Sequence
-from contextlib import contextmanager
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-import matplotlib as mpl
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
@@ -28,16 +24,16 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import FuncFormatter
 from numpy.typing import NDArray
 
-from sumo_ayss.analysis import DELTA_V_BAR, POV_ACCELERATION, Indicator, binned_mean_ci
+from sumo_ayss.analysis import binned_mean_ci
 from sumo_ayss.analysis.ranking import SafetyIndex
 from sumo_ayss.analysis.seeds import SeedRankRow
 from sumo_ayss.config import RewardConfig
+from sumo_ayss.plots import plot_reward_shapes
+from sumo_ayss.report.figstyle import DPI, no_data, save, seed_style, style, vut_colors
 from sumo_ayss.report.load import Run
 
 __all__ = [
-    "CASES",
     "DPI",
-    "CaseInfo",
     "indicator_figure",
     "learning_curves_figure",
     "reward_shapes_figure",
@@ -46,167 +42,20 @@ __all__ = [
     "vut_colors",
 ]
 
-logger = logging.getLogger(__name__)
-
-DPI = 100
-"""Resolution of every PNG: 100 dpi makes a 11-inch-wide figure 1100 px, i.e. 100 % zoom."""
-
-#: VUT colours in order of first use: the paper draws π1 green and π2 orange.
-_PALETTE = (
-    "#2ca02c",
-    "#ff7f0e",
-    "#1f77b4",
-    "#d62728",
-    "#9467bd",
-    "#8c564b",
-    "#e377c2",
-    "#17becf",
-    "#bcbd22",
-    "#7f7f7f",
-)
-_LINESTYLES = ("-", "--", ":", "-.")
-_MARKERS = ("o", "s", "^", "D", "v", "P", "X")
-
-
-@dataclass(frozen=True)
-class CaseInfo:
-    """How a case is named and drawn.
-
-    Attributes:
-        title: Section title, e.g. ``"One-lane car-following"``.
-        indicator: Naming of its aggressiveness indicator for verdict sentences.
-        axis_label: Matplotlib axis label of the indicator, with unit.
-        symbol: The indicator's symbol in text (HTML / Markdown).
-        paper_figure: The paper figure the indicator plot reproduces.
-        paper_table: The paper table the outcome table reproduces.
-        exposure_caution: Empty when exposure mode recovered known safety orders in this
-            case (results/ladders); otherwise the caution every exposure verdict carries.
-    """
-
-    title: str
-    indicator: Indicator
-    axis_label: str
-    symbol: str
-    paper_figure: str
-    paper_table: str
-    exposure_caution: str = ""
-
-
-CASES: Mapping[str, CaseInfo] = {
-    "car_following": CaseInfo(
-        title="One-lane car-following",
-        indicator=POV_ACCELERATION,
-        axis_label="POV acceleration implied by the SPCP's action [m/s²]",
-        symbol="POV acceleration",
-        paper_figure="Fig. 4",
-        paper_table="Table II",
-    ),
-    "cut_in": CaseInfo(
-        title="Two-lane cut-in",
-        indicator=DELTA_V_BAR,
-        axis_label=r"$\Delta\bar{v}$ [m/s]",
-        symbol="Δv̄",
-        paper_figure="Fig. 6",
-        paper_table="Table III",
-        exposure_caution=(
-            "Caution: in cut-in, exposure mode has NOT recovered a known safety order: on the "
-            "minGap ladder (results/ladders) the SPCPs extracted more reward from the VUTs "
-            "with larger gaps, not less (docs/ranking.md). Treat this verdict as unvalidated."
-        ),
-    ),
-}
-
-
-def case_info(case: str) -> CaseInfo:
-    """The :class:`CaseInfo` of ``case``; a generic one for an unknown case name."""
-    if case in CASES:
-        return CASES[case]
-    return CaseInfo(
-        title=case,
-        indicator=Indicator(),
-        axis_label="aggressiveness indicator",
-        symbol="indicator",
-        paper_figure="—",
-        paper_table="—",
-    )
-
-
-def vut_colors(vuts: Sequence[str]) -> dict[str, str]:
-    """One colour per VUT, in the order given (the report passes all VUTs sorted).
-
-    Args:
-        vuts: VUT names; duplicates keep their first colour.
-
-    Returns:
-        ``{vut: hex colour}``; the palette repeats after ten VUTs.
-    """
-    colors: dict[str, str] = {}
-    for vut in vuts:
-        if vut not in colors:
-            colors[vut] = _PALETTE[len(colors) % len(_PALETTE)]
-    return colors
-
-
-def seed_style(position: int) -> tuple[str, str]:
-    """``(linestyle, marker)`` of the ``position``-th seed of a VUT (0-based)."""
-    return _LINESTYLES[position % len(_LINESTYLES)], _MARKERS[position % len(_MARKERS)]
-
-
-@contextmanager
-def _style() -> Iterator[None]:
-    """Readable defaults for every report figure."""
-    with mpl.rc_context(
-        {
-            "font.size": 10,
-            "axes.titlesize": 11,
-            "axes.titleweight": "bold",
-            "axes.labelsize": 10,
-            "legend.fontsize": 8.5,
-            "axes.grid": True,
-            "grid.alpha": 0.3,
-            "axes.spines.top": False,
-            "axes.spines.right": False,
-            "figure.facecolor": "white",
-            "savefig.facecolor": "white",
-        }
-    ):
-        yield
-
-
-def _save(fig: Figure, path: Path) -> Path:
-    from sumo_ayss.atomic import atomic_write_with
-
-    # a bare Figure renders PNG with Agg; no pyplot state. Atomic: a reader never sees half.
-    atomic_write_with(path, lambda tmp: fig.savefig(tmp, dpi=DPI))
-    return path
-
-
-def _no_data(ax: Axes, text: str) -> None:
-    ax.text(0.5, 0.5, text, ha="center", va="center", transform=ax.transAxes, color="0.4")
-
-
 # --------------------------------------------------------------------------- reward shapes
 
 
-def reward_shapes_figure(reward: RewardConfig, path: Path) -> Path | None:
+def reward_shapes_figure(reward: RewardConfig, path: Path) -> Path:
     """Draws the reward shapes with :func:`sumo_ayss.plots.plot_reward_shapes`.
-
-    ``sumo_ayss.plots`` is imported here, not at module level: through
-    ``sumo_ayss.envs`` it loads libsumo, which the rest of the report does not need.
 
     Args:
         reward: The runs' reward configuration.
         path: PNG file to write.
 
     Returns:
-        ``path``, or None if the plotting module cannot be imported on this machine.
+        ``path``.
     """
-    try:
-        from sumo_ayss.plots import plot_reward_shapes
-    except ImportError as exc:  # e.g. libsumo not installed where the report is made
-        logger.warning("reward-shape figure skipped: %s", exc)
-        return None
-    with _style():
+    with style():
         return plot_reward_shapes(reward, path)
 
 
@@ -252,7 +101,7 @@ def learning_curves_figure(
     if has_lc:
         panels.append(("lane_change_rate", "lane-change rate [%]", 100.0))
     widths = {2: 11.0, 3: 13.0}
-    with _style():
+    with style():
         fig = Figure(figsize=(widths[len(panels)], 4.4), layout="constrained")
         axes = fig.subplots(
             1,
@@ -276,10 +125,10 @@ def learning_curves_figure(
         if has_lc:
             axes[2].set_title("Lane-change rate")
         if not drawn:
-            _no_data(axes[0], "no eval.csv in these runs yet")
+            no_data(axes[0], "no eval.csv in these runs yet")
         axes[0].legend(handles=_run_legend(runs_by_vut, colors), loc="best", ncol=2)
         fig.suptitle(title, fontsize=12, fontweight="bold")
-        return _save(fig, path)
+        return save(fig, path)
 
 
 def _draw_curve(ax: Axes, run: Run, column: str, scale: float, color: str, pos: int) -> bool:
@@ -373,7 +222,7 @@ def indicator_figure(
     width = float(np.min(np.diff(edges)))
     pct = f"{100 * level:g} %"
     in_range: list[tuple[str, str, int]] = []  # (vut, run label, samples in the bin range)
-    with _style():
+    with style():
         fig = Figure(figsize=(12.0, 6.8), layout="constrained")
         grid = fig.add_gridspec(2, 2, height_ratios=[3.0, 1.0])
         ax_pool = fig.add_subplot(grid[0, 0])
@@ -434,10 +283,10 @@ def indicator_figure(
             )
             ax_nseed.grid(axis="x", visible=False)
         else:
-            _no_data(ax_pool, "no AYSS samples (ayss.csv) in these runs yet")
+            no_data(ax_pool, "no AYSS samples (ayss.csv) in these runs yet")
             ax_nseed.set_axis_off()
         fig.suptitle(title, fontsize=12, fontweight="bold")
-        return _save(fig, path)
+        return save(fig, path)
 
 
 # --------------------------------------------------------------------------- safety index
@@ -466,7 +315,7 @@ def safety_index_figure(
         ``path``.
     """
     order = sorted(indices, key=lambda v: (indices[v].point, v))  # bottom to top
-    with _style():
+    with style():
         fig = Figure(figsize=(10.0, 1.6 + 0.75 * max(1, len(order))), layout="constrained")
         ax = fig.subplots()
         rng = np.random.default_rng(0)
@@ -523,14 +372,14 @@ def safety_index_figure(
         )
         fig.suptitle(title, fontsize=12, fontweight="bold")
         if not order:
-            _no_data(ax, "no safety index: no AYSS samples yet")
+            no_data(ax, "no safety index: no AYSS samples yet")
         else:
             ax.legend(loc="lower right", fontsize=8.5)
             xmin, xmax = ax.get_xlim()
             pad = 0.08 * (xmax - xmin) if math.isfinite(xmax - xmin) else 0.0
             ax.set_xlim(xmin - pad, xmax + pad)
         ax.grid(axis="y", visible=False)
-        return _save(fig, path)
+        return save(fig, path)
 
 
 # --------------------------------------------------------------------------- per-seed scores
@@ -564,7 +413,7 @@ def seed_scores_figure(
     """
     names = [r.name for r in rows]
     seeds = sorted({s for v in names for s in scores[v]})
-    with _style():
+    with style():
         fig = Figure(figsize=(2.2 + 1.6 * max(1, len(names)), 4.6), layout="constrained")
         ax = fig.subplots()
         for seed in seeds:
@@ -600,4 +449,58 @@ def seed_scores_figure(
         ax.set_ylabel(ylabel)
         ax.set_title(title)
         ax.grid(axis="y", alpha=0.3)
-        return _save(fig, path)
+        return save(fig, path)
+
+
+def crossplay_figure(
+    order: Sequence[str],
+    opponents: Sequence[tuple[str, int]],
+    returns: NDArray[np.float64],
+    vuts: Sequence[str],
+    colors: Mapping[str, str],
+    path: Path,
+    *,
+    title: str,
+) -> Path:
+    """Cross-play: one line per opponent SPCP across the VUTs, in ranking order.
+
+    Args:
+        order: VUTs safest first (the x axis).
+        opponents: ``(trained-against VUT, training seed)`` of each opponent (columns of
+            ``returns``).
+        returns: ``returns[i, j]`` = mean episode reward opponent j extracts from VUT
+            ``vuts[i]``.
+        vuts: The VUTs of the rows of ``returns``.
+        colors: ``{vut: colour}``; an opponent is drawn in its trained-against VUT's colour,
+            one line style per seed.
+        path: PNG file to write.
+        title: Figure title.
+
+    Returns:
+        ``path``.
+    """
+    rows = [list(vuts).index(v) for v in order]
+    seeds = sorted({s for _, s in opponents})
+    with style():
+        fig = Figure(figsize=(5.0 + 1.6 * max(1, len(order)), 4.6), layout="constrained")
+        ax = fig.subplots()
+        for j, (vut, seed) in enumerate(opponents):
+            ls, marker = seed_style(seeds.index(seed))
+            ax.plot(
+                range(len(order)),
+                [float(returns[i, j]) for i in rows],
+                color=colors.get(vut, "C0"),
+                ls=ls,
+                marker=marker,
+                ms=5,
+                lw=1.4,
+                label=f"SPCP of {vut}, seed {seed}",
+            )
+        ax.set_xticks(range(len(order)), [f"#{k + 1} {v}" for k, v in enumerate(order)])
+        ax.set_xlim(-0.4, len(order) - 0.6 + 0.2)
+        ax.set_xlabel("VUT driven against, safest first (cross-play ranking)")
+        ax.set_ylabel("reward extracted (mean reward/episode)")
+        ax.set_title(title)
+        ax.grid(axis="y", alpha=0.3)
+        ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
+        return save(fig, path)

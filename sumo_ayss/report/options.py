@@ -14,14 +14,23 @@ from sumo_ayss.validation import check_choice, check_int, check_number, require
 if TYPE_CHECKING:
     import numpy as np
 
-__all__ = ["MODES", "ReportOptions"]
+__all__ = ["CROSSPLAY_BLOCKS", "DEFAULT_MODE", "MODES", "ReportOptions"]
 
 
 # --------------------------------------------------------------------------- options
 
 MODES: Mapping[str, str] = {
+    "crossplay": (
+        "Cross-play mode (default): every SPCP of a case drives against every VUT of the case "
+        "on the same outcome scenarios; a VUT's score X is the mean episode reward this pooled "
+        "population of opponents extracts from it, and a lower X is a safer VUT. A difference "
+        "between two VUTs is read within each opponent, so the search noise of one SPCP "
+        "cancels; two VUTs are compared by a paired t-test over training-seed blocks (block s "
+        "= the mean over seed s's opponents; report.crossplay_blocks: opponent makes every "
+        "opponent a block); significant when p < alpha."
+    ),
     "exposure": (
-        "Exposure mode (default): a VUT's score is the adversarial exposure E, the mean "
+        "Exposure mode: a VUT's score is the adversarial exposure E, the mean "
         "episode reward its SPCP extracts over the common outcome scenarios (the same "
         "scenarios for every VUT and seed); a lower E is a safer VUT, because the same "
         "adversarial-yet-safe reward paid for fewer or less close near-misses. Each training "
@@ -38,6 +47,12 @@ MODES: Mapping[str, str] = {
 }
 """The analysis modes of a report, with their description."""
 
+DEFAULT_MODE = "crossplay"
+"""The mode of a report and a ranking unless ``report.mode`` says otherwise."""
+
+CROSSPLAY_BLOCKS = ("seed", "opponent")
+"""Block units of cross-play's paired test (:data:`sumo_ayss.analysis.crossplay.BLOCKS`)."""
+
 
 @dataclass(frozen=True)
 class ReportOptions:
@@ -52,7 +67,10 @@ class ReportOptions:
         welch_alpha: The seed-level Welch p-value must be below this for significance.
         rng_seed: Root seed of the bootstraps; each (case, VUT) gets its own stream.
         mode: Which analysis gives the verdicts and the ranking (see :data:`MODES`):
-            ``"exposure"`` (default) or ``"paper"``. Both are computed and shown.
+            ``"crossplay"`` (default), ``"exposure"`` or ``"paper"``. Every mode available
+            is computed and shown; cross-play needs the case's ``crossplay.csv``.
+        crossplay_blocks: Block unit of cross-play's paired test: ``"seed"`` (default,
+            training seeds) or ``"opponent"`` (every opponent SPCP its own block).
         premise_reward: Tolerance on the spread of the VUTs' mean episode reward for the
             premise check ("same overall outcome"), reward per episode.
         premise_crash_rate: Tolerance on the spread of crash rates, fraction.
@@ -68,7 +86,8 @@ class ReportOptions:
     n_boot: int = 2000
     welch_alpha: float = 0.05
     rng_seed: int = 0
-    mode: Literal["exposure", "paper"] = "exposure"
+    mode: Literal["crossplay", "exposure", "paper"] = "crossplay"
+    crossplay_blocks: Literal["seed", "opponent"] = "seed"
     premise_reward: float = 1.0
     premise_crash_rate: float = 0.02
     premise_final_headway_m: float = 2.0
@@ -76,6 +95,7 @@ class ReportOptions:
     def __post_init__(self) -> None:
         s = self.SECTION
         check_choice(f"{s}.mode", self.mode, list(MODES))
+        check_choice(f"{s}.crossplay_blocks", self.crossplay_blocks, list(CROSSPLAY_BLOCKS))
         for name in ("premise_reward", "premise_crash_rate", "premise_final_headway_m"):
             value = getattr(self, name)
             require(

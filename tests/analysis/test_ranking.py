@@ -252,3 +252,25 @@ def test_importing_analysis_loads_no_sumo_or_torch() -> None:
         [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=60
     )
     assert out.stdout.strip() == "", f"importing sumo_ayss.analysis loaded {out.stdout}"
+
+
+#: Packages of the project that analysis/ must not import: it reads tables, nothing more.
+FORBIDDEN_LAYERS = ("sumo_ayss.report", "sumo_ayss.sim", "sumo_ayss.envs", "sumo_ayss.agents")
+
+
+def _imported_modules(path: Path) -> set[str]:
+    mods = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            mods |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            mods.add(node.module)
+    return mods
+
+
+@pytest.mark.parametrize("path", sorted(ANALYSIS_DIR.glob("*.py")), ids=lambda p: p.name)
+def test_analysis_imports_no_report_sim_envs_or_agents(path: Path) -> None:
+    bad = sorted(
+        m for m in _imported_modules(path) if m == "sumo_ayss" or m.startswith(FORBIDDEN_LAYERS)
+    )
+    assert not bad, f"{path.name} imports {bad}"

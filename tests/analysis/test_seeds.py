@@ -155,7 +155,7 @@ def test_paper_mode_rule_false_positive_rate_is_at_most_nominal():
     :func:`sumo_ayss.analysis.ranking.safety_index`); the Welch condition bounds the rule.
     """
     from sumo_ayss.analysis.ranking import POV_ACCELERATION, safety_index
-    from sumo_ayss.report.document import pair_verdict
+    from sumo_ayss.analysis.significance import pair_verdict
 
     rng = np.random.default_rng(11)
     n_rep, hits, boot_hits = 300, 0, 0

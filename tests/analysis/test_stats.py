@@ -207,3 +207,25 @@ def test_welch_t_test_known_case() -> None:
     assert all(math.isnan(v) for v in welch_t_test([1.0, 1.0], [2.0, 2.0]))
     with pytest.raises(ConfigError):
         welch_t_test([1.0], [1.0, 2.0])
+
+
+def test_binned_mean_bootstrap_reproduces_the_generic_bootstrap() -> None:
+    """Same draws, same order of summation: the replicates are equal bit for bit."""
+    from sumo_ayss.analysis.bootstrap import binned_mean_bootstrap
+
+    gen = np.random.default_rng(3)
+    used = np.array([True, True, False, True])
+    bins = [gen.choice([0, 1, 3], size=n) for n in (40, 7, 23)]
+    values = [gen.normal(size=b.size) for b in bins]
+    groups = [np.column_stack([b.astype(np.float64), v]) for b, v in zip(bins, values, strict=True)]
+
+    def statistic(rows: np.ndarray) -> float:
+        idx = rows[:, 0].astype(np.int64)
+        counts = np.bincount(idx, minlength=used.size)
+        sums = np.bincount(idx, weights=rows[:, 1], minlength=used.size)
+        keep = used & (counts > 0)
+        return float(np.mean(sums[keep] / counts[keep]))
+
+    generic = hierarchical_bootstrap(groups, statistic, n_boot=300, rng=11)
+    fast = binned_mean_bootstrap(bins, values, used, n_boot=300, rng=11)
+    np.testing.assert_array_equal(fast, generic)

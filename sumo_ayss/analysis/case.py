@@ -1,0 +1,503 @@
+"""Statistics of one case: safety indices, rankings, verdicts and headlines per mode.
+
+:func:`analyse_case` turns the runs of one case (any objects shaped like
+:class:`sumo_ayss.report.load.Run`) into a :class:`CaseAnalysis`: the paper mode (AYSS
+safety index per VUT, hierarchical bootstrap, pairwise verdicts under
+:func:`~.significance.pair_verdict`), the exposure mode (seed-level ranking of the mean
+episode reward the SPCPs extract), the cross-play mode (the case folder's ``crossplay.csv``
+when the cross-play stage wrote one, :mod:`.crossplay`) and the premise check. Both the
+report and :mod:`sumo_ayss.rank` read it; nothing here draws or renders.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import logging
+import zlib
+from collections import OrderedDict
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal, Protocol
+
+import numpy as np
+
+from sumo_ayss.analysis.cases import CaseInfo, case_info
+from sumo_ayss.analysis.crossplay import (
+    CrossplayMatrix,
+    crossplay_sentence,
+    rank_crossplay,
+    read_crossplay,
+)
+from sumo_ayss.analysis.formatting import fmt_num
+from sumo_ayss.analysis.premise import Premise, premise_check
+from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex, rank, safety_index
+from sumo_ayss.analysis.seeds import (
+    SeedComparison,
+    SeedRankRow,
+    SeedScores,
+    rank_seeds,
+    verdict_sentence,
+)
+from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
+from sumo_ayss.errors import ConfigError, TableError
+from sumo_ayss.run_folder import CaseFolder
+
+__all__ = [
+    "CROSSPLAY_COMMAND",
+    "EXPOSURE_SCORE",
+    "CaseAnalysis",
+    "CaseOptions",
+    "analyse_case",
+    "exposure_sentence",
+    "premise_sentence",
+    "run_label",
+    "seed_ranking_line",
+    "vut_safety_index",
+]
+
+logger = logging.getLogger(__name__)
+
+
+class CaseOptions(Protocol):
+    """The statistical settings read here (e.g. :class:`sumo_ayss.report.options.ReportOptions`)."""
+
+    @property
+    def h_max_m(self) -> float: ...
+
+    @property
+    def h_range(self) -> tuple[float, float]: ...
+
+    @property
+    def index_bins(self) -> int: ...
+
+    @property
+    def level(self) -> float: ...
+
+    @property
+    def welch_alpha(self) -> float: ...
+
+    @property
+    def n_boot(self) -> int: ...
+
+    @property
+    def rng_seed(self) -> int: ...
+
+    @property
+    def mode(self) -> str: ...
+
+    @property
+    def crossplay_blocks(self) -> str: ...
+
+    @property
+    def premise_tolerances(self) -> Mapping[str, float]: ...
+
+
+Run = Any
+"""A run as :func:`sumo_ayss.report.load.load_run` returns it (read by attribute: ``case``,
+``vut``, ``seed``, ``problems``, ``ayss`` with ``indicator`` and ``h``, ``outcome`` with
+``mean_return``, ``crash_rate`` and ``mean_final_headway_m`` estimates)."""
+
+
+def run_label(run: Run) -> str:
+    """``"<case>/<vut>/seed_<k>"`` of a run, for problem lists."""
+    return f"{run.case}/{run.vut}/seed_{run.seed if run.seed is not None else '?'}"
+
+
+def _vut_rng(options: CaseOptions, case: str, vut: str) -> np.random.Generator:
+    """A bootstrap stream per (case, VUT), stable whatever other VUTs are in the report."""
+    return np.random.default_rng([options.rng_seed, zlib.crc32(f"{case}/{vut}".encode())])
+
+
+_INDEX_CACHE: OrderedDict[tuple[Any, ...], SafetyIndex | None] = OrderedDict()
+_INDEX_CACHE_SIZE = 16
+"""Safety indices of the last VUTs analysed in this process, keyed by their AYSS samples and
+settings: the pipeline's report and then :mod:`sumo_ayss.rank` analyse the same runs, and
+the bootstrap is the slow part, so rank reuses the report's indices instead of redrawing them
+(the same draws would give the same index anyway, see :func:`_vut_rng`)."""
+
+
+def _samples_digest(runs: Sequence[Run]) -> str:
+    """A digest of the AYSS samples of ``runs``, in order (seeds without samples skipped)."""
+    digest = hashlib.blake2b(digest_size=16)
+    for r in runs:
+        if r.ayss is None or len(r.ayss) == 0:
+            continue
+        for values in (r.ayss.indicator, r.ayss.h):
+            arr = np.ascontiguousarray(values, dtype=np.float64)
+            digest.update(f"{arr.size};".encode())
+            digest.update(arr.tobytes())
+    return digest.hexdigest()
+
+
+def _case_vut_index(
+    case: str, vut: str, runs: Sequence[Run], options: CaseOptions
+) -> SafetyIndex | None:
+    """:func:`vut_safety_index` on the (case, VUT) stream, reused within the process."""
+    key = (
+        case,
+        vut,
+        _samples_digest(runs),
+        tuple(options.h_range),
+        options.index_bins,
+        options.level,
+        options.n_boot,
+        options.rng_seed,
+    )
+    if key in _INDEX_CACHE:
+        _INDEX_CACHE.move_to_end(key)
+        return _INDEX_CACHE[key]
+    idx = vut_safety_index(runs, options, _vut_rng(options, case, vut))
+    _INDEX_CACHE[key] = idx
+    while len(_INDEX_CACHE) > _INDEX_CACHE_SIZE:
+        _INDEX_CACHE.popitem(last=False)
+    return idx
+
+
+def vut_safety_index(
+    runs: Sequence[Run], options: CaseOptions, rng: np.random.Generator | int | None = None
+) -> SafetyIndex | None:
+    """Safety index of one VUT from the AYSS samples of its runs (one seed per run).
+
+    Args:
+        runs: The VUT's runs; those without AYSS samples are skipped.
+        options: Headway range, bins, level and bootstrap size.
+        rng: Bootstrap generator or seed.
+
+    Returns:
+        The :class:`SafetyIndex`, or None if no run has a sample in the headway range.
+    """
+    seeds = [r.ayss for r in runs if r.ayss is not None and len(r.ayss) > 0]
+    if not seeds:
+        return None
+    try:
+        return safety_index(
+            [s.indicator for s in seeds],
+            [s.h for s in seeds],
+            options.h_range,
+            n_bins=options.index_bins,
+            level=options.level,
+            n_boot=options.n_boot,
+            rng=rng,
+        )
+    except ConfigError as exc:  # e.g. no sample in the headway range
+        logger.warning("no safety index: %s", exc)
+        return None
+
+
+@dataclass
+class CaseAnalysis:
+    """Statistics of one case.
+
+    Attributes:
+        case: Case name.
+        info: Naming and units of the case.
+        runs: ``{vut: runs sorted by seed}``.
+        indices: ``{vut: safety index}`` for VUTs with AYSS samples.
+        ranking: VUTs safest first (point estimate).
+        pairs: Verdicts of every pair, in ranking order (A ranked above B).
+        headline: The verdict sentence of the top-ranked pair, or why there is none.
+        headline_kind: ``"safer"``, ``"none"`` or ``"warning"``.
+        ranking_line: ``"pi2 > pi1"`` (``>`` significant under the rule, ``≈`` not).
+        problems: Missing or unreadable files, one sentence each.
+        mode: The analysis mode asked for (``report.mode``).
+        ranking_mode: The mode ``headline`` and ``ranking_line`` come from: ``mode``, or
+            ``"exposure"`` in cross-play mode without a cross-play table (the headline
+            says so first).
+        exposure_rows: Exposure-mode ranking, safest first.
+        exposure_pairs: Exposure-mode comparisons of every pair (A ranked above B).
+        exposure_scores: ``{vut: {seed: E}}``, the per-seed exposures behind the ranking.
+        premise: Whether the SPCPs reached the same overall outcome, or None.
+        paper_headline: The paper-mode headline (also when ``mode`` is exposure).
+        paper_ranking_line: The paper-mode ranking line.
+        crossplay: The case's cross-play matrix, or None (see ``crossplay_missing``).
+        crossplay_rows: Cross-play ranking, safest first (empty without a table).
+        crossplay_pairs: Cross-play comparisons of every pair (A ranked above B).
+        crossplay_blocks: Block unit of the cross-play test (``"seed"`` or ``"opponent"``).
+        crossplay_path: The ``crossplay.csv`` read, or None.
+        crossplay_missing: Why there is no cross-play ranking, one sentence; "" when there
+            is one.
+    """
+
+    case: str
+    info: CaseInfo
+    runs: dict[str, list[Run]]
+    indices: dict[str, SafetyIndex] = field(default_factory=dict)
+    ranking: list[RankedVut] = field(default_factory=list)
+    pairs: list[PairVerdict] = field(default_factory=list)
+    headline: str = ""
+    headline_kind: Literal["safer", "none", "warning"] = "warning"
+    ranking_line: str = ""
+    problems: list[str] = field(default_factory=list)
+    mode: str = "exposure"
+    exposure_rows: list[SeedRankRow] = field(default_factory=list)
+    exposure_pairs: list[SeedComparison] = field(default_factory=list)
+    exposure_scores: dict[str, dict[int, float]] = field(default_factory=dict)
+    premise: Premise | None = None
+    paper_headline: str = ""
+    paper_ranking_line: str = ""
+    ranking_mode: str = "exposure"
+    crossplay: CrossplayMatrix | None = None
+    crossplay_rows: list[SeedRankRow] = field(default_factory=list)
+    crossplay_pairs: list[SeedComparison] = field(default_factory=list)
+    crossplay_blocks: str = "seed"
+    crossplay_path: Path | None = None
+    crossplay_missing: str = ""
+
+
+CROSSPLAY_COMMAND = "python -m sumo_ayss.crossplay <config>"
+"""The command that writes a case's cross-play table."""
+
+EXPOSURE_SCORE = "extract {amount} {more_less} reward per episode"
+"""How an exposure difference reads in a verdict sentence."""
+
+
+def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
+    """Exposure-mode ranking and the premise check, from the runs' outcome summaries."""
+    scores = []
+    for vut, members in out.runs.items():
+        values = {
+            r.seed: r.outcome.mean_return.value
+            for r in members
+            if r.seed is not None and r.outcome is not None and r.outcome.mean_return.known
+        }
+        if values:
+            scores.append(SeedScores(vut, values))
+        else:
+            out.problems.append(f"{vut}: no outcome summary with a seed, so no exposure")
+    out.exposure_scores = {sc.name: dict(sc.values) for sc in scores}
+    if scores:
+        out.exposure_rows, out.exposure_pairs = rank_seeds(
+            scores, higher_is_safer=False, level=options.level, alpha=options.welch_alpha
+        )
+    metrics: dict[str, dict[str, list[float]]] = {
+        "mean_return": {},
+        "crash_rate": {},
+        "mean_final_headway_m": {},
+    }
+    for vut, members in out.runs.items():
+        for r in members:
+            if r.outcome is None:
+                continue
+            for key in metrics:
+                metrics[key].setdefault(vut, []).append(getattr(r.outcome, key).value)
+    out.premise = premise_check(metrics, tolerances=options.premise_tolerances, level=options.level)
+
+
+def _crossplay(out: CaseAnalysis, options: CaseOptions) -> None:
+    """Cross-play ranking from the case folder's ``crossplay.csv``, or why there is none.
+
+    The case folder is the parent of the VUT folders of the case's runs. A table whose VUTs
+    or opponents are not exactly this case's VUTs and runs (an older grid, a failed job) is
+    not used: the reason is recorded instead.
+    """
+    out.crossplay_blocks = options.crossplay_blocks
+    if len(out.runs) < 2:
+        only = next(iter(out.runs), "?")
+        out.crossplay_missing = (
+            f"no cross-play for this case: its runs here are of one VUT only ({only}), and "
+            "cross-play compares two or more"
+        )
+        return
+    case_dirs = sorted({Path(r.path).parent.parent for rs in out.runs.values() for r in rs})
+    if len(case_dirs) != 1:
+        out.crossplay_missing = (
+            "no cross-play table for this case: its runs lie in several case folders ("
+            + ", ".join(map(str, case_dirs))
+            + "), and a cross-play table covers one grid"
+        )
+        return
+    path = CaseFolder(case_dirs[0]).crossplay_csv
+    if not path.is_file():
+        out.crossplay_missing = f"no cross-play table for this case (run {CROSSPLAY_COMMAND})"
+        return
+    try:
+        m = read_crossplay(path)
+    except (TableError, ConfigError) as exc:
+        out.crossplay_missing = f"the cross-play table is unreadable ({exc})"
+        out.problems.append(f"{path}: {exc}")
+        return
+    opponents = {(v, int(r.seed)) for v, rs in out.runs.items() for r in rs if r.seed is not None}
+    if set(m.vuts) != set(out.runs) or set(m.opponents) != opponents:
+        out.crossplay_missing = (
+            f"the cross-play table {path} is not of these runs (VUTs {', '.join(m.vuts)}; "
+            f"{len(m.opponents)} opponents, this case has {len(opponents)} runs with a seed); "
+            f"run {CROSSPLAY_COMMAND} again once every job is done"
+        )
+        return
+    out.crossplay, out.crossplay_path = m, path
+    out.crossplay_rows, out.crossplay_pairs = rank_crossplay(
+        m, blocks=options.crossplay_blocks, level=options.level, alpha=options.welch_alpha
+    )
+
+
+def exposure_sentence(c: SeedComparison) -> str:
+    """The exposure-mode verdict sentence of one comparison."""
+    return verdict_sentence(
+        c, higher_is_safer=False, score=EXPOSURE_SCORE, unit="", mode="exposure"
+    )
+
+
+def premise_sentence(premise: Premise | None, options: CaseOptions) -> str:
+    """One sentence: did the SPCPs reach the same overall outcome?"""
+    if premise is None or not premise.metrics:
+        return "Premise check: needs outcome summaries of at least two VUTs."
+    parts = []
+    for m in premise.metrics:
+        unit = f" {m.spec.unit}" if m.spec.unit else ""
+        parts.append(
+            f"{m.spec.name} spread {fmt_num(m.spread * m.spec.scale)}{unit} "
+            f"(tolerance {fmt_num(m.tolerance * m.spec.scale)}{unit}"
+            f"{'' if m.met else ', exceeded'})"
+        )
+    if premise.met:
+        return (
+            "Premise met: the SPCPs of all VUTs reached the same overall outcome within the "
+            "stated tolerances (" + "; ".join(parts) + ")."
+        )
+    return (
+        "Premise NOT met: the SPCPs of different VUTs did not reach the same overall outcome ("
+        + "; ".join(parts)
+        + "), so a comparison of their aggressiveness (paper mode) is confounded by the "
+        "difference in outcome."
+    )
+
+
+def analyse_case(
+    case: str, runs: dict[str, list[Run]], options: CaseOptions, *, paper: bool = True
+) -> CaseAnalysis:
+    """Safety index per VUT, ranking, pairwise verdicts and the headline of one case.
+
+    Args:
+        case: Case name.
+        runs: ``{vut: runs}``.
+        options: Statistical settings.
+        paper: Compute the paper mode (AYSS safety indices and their bootstrap, the slow
+            part); the report always does, a ranking in exposure mode need not.
+
+    Returns:
+        The :class:`CaseAnalysis`.
+    """
+    info = case_info(case)
+    out = CaseAnalysis(case=case, info=info, runs=runs)
+    for members in runs.values():
+        for run in members:
+            out.problems += [f"{run_label(run)}: {p}" for p in run.problems]
+    for vut, members in runs.items() if paper else ():
+        idx = _case_vut_index(case, vut, members, options)
+        if idx is not None:
+            out.indices[vut] = idx
+        else:
+            out.problems.append(
+                f"{vut}: no AYSS sample with h in [0, {options.h_max_m:g}] m, so no safety index"
+            )
+    if out.indices:
+        out.ranking = rank(out.indices, level=options.level)
+    order = [r.name for r in out.ranking]
+    for i, a in enumerate(order):
+        for b in order[i + 1 :]:
+            try:
+                out.pairs.append(
+                    pair_verdict(
+                        out.indices[a],
+                        out.indices[b],
+                        name_a=a,
+                        name_b=b,
+                        indicator=info.indicator,
+                        level=options.level,
+                        welch_alpha=options.welch_alpha,
+                    )
+                )
+            except ConfigError as exc:
+                out.problems.append(f"{a} vs {b}: not comparable ({exc})")
+    _headline(out)
+    out.headline = "[paper mode] " + out.headline
+    _exposure(out, options)
+    if out.premise is not None and out.premise.metrics and not out.premise.met:
+        out.headline += (
+            " Confounded: the SPCPs did not reach the same overall outcome (premise check), "
+            "so this aggressiveness comparison does not isolate the VUTs' safety."
+        )
+        if out.headline_kind == "safer":
+            out.headline_kind = "warning"
+    out.paper_headline, out.paper_ranking_line = out.headline, out.ranking_line
+    _crossplay(out, options)
+    out.mode = out.ranking_mode = options.mode
+    if options.mode == "exposure":
+        _exposure_headline(out)
+    elif options.mode == "crossplay":
+        _crossplay_headline(out)
+    return out
+
+
+def seed_ranking_line(rows: Sequence[SeedRankRow]) -> str:
+    """``"a > b ≈ c"``: ``>`` where a row differs significantly from the next."""
+    if not rows:
+        return ""
+    return rows[0].name + "".join(
+        (" > " if prev.significant_vs_next else " ≈ ") + row.name
+        for prev, row in itertools.pairwise(rows)
+    )
+
+
+def _crossplay_headline(out: CaseAnalysis) -> None:
+    """Headline and ranking line of the cross-play mode; without a table, the exposure
+    mode's, after a sentence that says so."""
+    rows = out.crossplay_rows
+    if len(rows) < 2 or rows[0].vs_next is None:
+        _exposure_headline(out)
+        out.ranking_mode = "exposure"
+        reason = out.crossplay_missing or "the cross-play table ranks fewer than two VUTs"
+        out.headline = f"[crossplay mode] {reason}. Shown instead, labelled: {out.headline}"
+        out.headline_kind = "warning"
+        return
+    top = rows[0].vs_next
+    out.headline = crossplay_sentence(top, out.crossplay_blocks)
+    out.headline_kind = "safer" if top.significant else "none"
+    out.ranking_line = seed_ranking_line(rows)
+
+
+def _exposure_headline(out: CaseAnalysis) -> None:
+    """Headline and ranking line of the exposure mode."""
+    rows = out.exposure_rows
+    if len(rows) < 2:
+        out.headline = "[exposure mode] No verdict yet: a verdict needs outcomes of two VUTs."
+        out.headline_kind = "warning"
+        out.ranking_line = rows[0].name if rows else ""
+        return
+    top = rows[0].vs_next
+    assert top is not None
+    out.headline = exposure_sentence(top)
+    out.headline_kind = "safer" if top.significant else "none"
+    if out.info.exposure_caution:
+        out.headline += " " + out.info.exposure_caution
+        out.headline_kind = "warning"
+    out.ranking_line = seed_ranking_line(rows)
+
+
+def _headline(out: CaseAnalysis) -> None:
+    order = [r.name for r in out.ranking]
+    if not order:
+        out.headline = "No verdict yet: no VUT of this case has AYSS samples (ayss.csv)."
+        out.headline_kind = "warning"
+        return
+    if len(order) == 1:
+        out.headline = (
+            f"No verdict yet: only {order[0]} has AYSS samples; a verdict needs two VUTs."
+        )
+        out.headline_kind = "warning"
+        return
+    top = next((p for p in out.pairs if p.verdict.name_a == order[0]), None)
+    if top is None:
+        out.headline = "No verdict: the safety indices of the top two VUTs are not comparable."
+        out.headline_kind = "warning"
+        return
+    out.headline = top.sentence
+    out.headline_kind = "safer" if top.significant else "none"
+    parts = [order[0]]
+    by_pair = {(p.verdict.name_a, p.verdict.name_b): p for p in out.pairs}
+    for a, b in itertools.pairwise(order):
+        pair = by_pair.get((a, b))
+        parts.append((" > " if pair is not None and pair.significant else " ≈ ") + b)
+    out.ranking_line = "".join(parts)

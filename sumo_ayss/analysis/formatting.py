@@ -1,0 +1,75 @@
+"""How numbers, intervals and p-values read in verdict sentences and report tables.
+
+One formatter for every sentence and table cell, so a number reads the same in the
+analysis's verdicts and in the report.
+"""
+
+from __future__ import annotations
+
+import math
+
+__all__ = ["MINUS", "fmt_interval", "fmt_num", "fmt_p", "fmt_prob"]
+
+MINUS = "−"
+"""The typographic minus sign (U+2212) of the report's numbers."""
+
+
+def _finite(value: float | None) -> bool:
+    return value is not None and math.isfinite(value)
+
+
+def fmt_num(value: float | None, digits: int = 2, *, minus: str = MINUS, missing: str = "—") -> str:
+    """``value`` with ``digits`` decimals and ``minus`` as the sign; ``missing`` for NaN/None.
+
+    Examples: ``fmt_num(-1.234)`` is ``"−1.23"``; ``fmt_num(-1.234, minus="-")`` is ``"-1.23"``.
+    """
+    if not _finite(value):
+        return missing
+    return f"{value:.{digits}f}".replace("-", minus)
+
+
+def fmt_interval(
+    lo: float | None,
+    hi: float | None,
+    digits: int = 2,
+    *,
+    minus: str = MINUS,
+    missing: str = "",
+) -> str:
+    """``"0.80–1.60"`` for non-negative bounds, ``"−0.30 to 0.40"`` otherwise.
+
+    Args:
+        lo: Lower bound.
+        hi: Upper bound.
+        digits: Decimals of each bound.
+        minus: Sign of negative bounds.
+        missing: The text when a bound is NaN or None.
+    """
+    if not (_finite(lo) and _finite(hi)):
+        return missing
+    assert lo is not None and hi is not None
+    sep = "–" if lo >= 0 and hi >= 0 else " to "
+    return f"{fmt_num(lo, digits, minus=minus)}{sep}{fmt_num(hi, digits, minus=minus)}"
+
+
+def fmt_p(p: float | None, *, cap_high: bool = False, undefined: str = "n/a") -> str:
+    """A p-value or probability after "p" or "P(…)": ``"= 0.012"``, ``"< 0.001"``.
+
+    Args:
+        p: The probability.
+        cap_high: Write values above 0.999 as ``"> 0.999"``.
+        undefined: The text for NaN or None.
+    """
+    if not _finite(p):
+        return undefined
+    assert p is not None
+    if p < 0.001:
+        return "< 0.001"
+    if cap_high and p > 0.999:
+        return "> 0.999"
+    return f"= {p:.3f}"
+
+
+def fmt_prob(p: float | None) -> str:
+    """A probability for a table cell: ``"0.953"``, ``"< 0.001"``, ``"> 0.999"``, ``"—"``."""
+    return fmt_p(p, cap_high=True, undefined="—").removeprefix("= ")

@@ -1,0 +1,202 @@
+"""Pairwise verdict between two VUTs from their safety indices (numpy and the stdlib only).
+
+:func:`compare` pairs the bootstrap replicates of two :class:`~.safety_index.SafetyIndex`
+and states which VUT is safer, by how much and how sure that is, as one quotable sentence.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sumo_ayss.analysis.bootstrap import bootstrap_ci
+from sumo_ayss.analysis.formatting import fmt_interval, fmt_p
+from sumo_ayss.analysis.safety_index import Indicator, SafetyIndex
+from sumo_ayss.analysis.stats import cohens_d
+from sumo_ayss.analysis.student_t import welch_t_test
+from sumo_ayss.analysis.validate import check_level
+from sumo_ayss.errors import ConfigError
+
+__all__ = ["Verdict", "compare"]
+
+_HYPHEN = "-"
+"""Sign of negative bounds in verdict sentences (ASCII, unlike the report's tables)."""
+
+
+def _fmt_h_range(h_range: tuple[float, float]) -> str:
+    """``"h ≤ 5 m"`` when the range starts at 0, ``"2 m ≤ h ≤ 5 m"`` otherwise."""
+    lo, hi = h_range
+    return f"h ≤ {hi:g} m" if lo == 0.0 else f"{lo:g} m ≤ h ≤ {hi:g} m"
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Which of two VUTs is safer, by how much, and how sure we are.
+
+    Attributes:
+        name_a: Name of VUT A.
+        name_b: Name of VUT B.
+        safer: Name of the safer VUT, or None for "no significant difference".
+        difference: ``index_A - index_B`` in the indicator's unit; positive = A safer. Equal
+            to the mean over bins of ``indicator_B - indicator_A``.
+        diff_lo: Lower percentile-bootstrap bound of ``difference`` at ``level``.
+        diff_hi: Upper bound.
+        level: Confidence level.
+        p_a_safer: Bootstrap probability that A's index exceeds B's (replicates of the two
+            independent bootstraps paired by position; ties count one half).
+        cohens_d: Cohen's d of the pooled per-sample indicator in used bins, oriented so
+            that positive = A safer: ``(mean(y_B) - mean(y_A)) / s_pooled``. It ignores
+            headway and seeds; NaN when undefined.
+        significant: Whether the interval of ``difference`` excludes 0.
+        p_seed_welch: Two-sided p-value of Welch's t-test on the per-seed indices (seeds as
+            the only replication, samples within a seed averaged first). A conservative
+            cross-check of ``significant``, which with few seeds and real between-seed
+            spread is too optimistic (see :func:`safety_index`). NaN with fewer than two
+            seeds on a side or zero spread.
+        n_seeds_a: Seeds behind A's index.
+        n_seeds_b: Seeds behind B's index.
+        h_range: Headway range in m of the two indices.
+        same_bins: Whether both indices average over the same headway bins.
+        indicator: Naming of the indicator for :meth:`sentence`.
+    """
+
+    name_a: str
+    name_b: str
+    safer: str | None
+    difference: float
+    diff_lo: float
+    diff_hi: float
+    level: float
+    p_a_safer: float
+    cohens_d: float
+    significant: bool
+    p_seed_welch: float
+    n_seeds_a: int
+    n_seeds_b: int
+    h_range: tuple[float, float]
+    same_bins: bool
+    indicator: Indicator = field(default_factory=Indicator)
+
+    def sentence(self) -> str:
+        """One quotable sentence stating the verdict and its statistics."""
+        pct = f"{100.0 * self.level:g} %"
+        where = f"adversarial-yet-safe states with {_fmt_h_range(self.h_range)}"
+        if self.safer is None:
+            text = (
+                f"No significant difference in safety between {self.name_a} and "
+                f"{self.name_b}: over {where}, the mean {self.indicator.name} of "
+                f"{self.name_b}'s SPCPs minus {self.name_a}'s is "
+                f"{self.indicator.amount(self.difference)} ({pct} CI "
+                f"{fmt_interval(self.diff_lo, self.diff_hi, minus=_HYPHEN)}; "
+                f"P({self.name_a} safer) {fmt_p(self.p_a_safer, cap_high=True)}; "
+                f"{self.n_seeds_a} vs {self.n_seeds_b} seeds)."
+            )
+        else:
+            text = self._safer_sentence(pct, where)
+        if not self.same_bins:
+            text += " Caution: the two indices average over different headway bins."
+        return text
+
+    def _safer_sentence(self, pct: str, where: str) -> str:
+        """The sentence when one VUT is significantly safer."""
+        a_safer = self.safer == self.name_a
+        other = self.name_b if a_safer else self.name_a
+        diff = self.difference if a_safer else -self.difference
+        lo, hi = (self.diff_lo, self.diff_hi) if a_safer else (-self.diff_hi, -self.diff_lo)
+        p = self.p_a_safer if a_safer else 1.0 - self.p_a_safer
+        n_s, n_o = (self.n_seeds_a, self.n_seeds_b) if a_safer else (self.n_seeds_b, self.n_seeds_a)
+        return (
+            f"{self.safer} is safer than {other}: its SPCPs {self.indicator.phrase(diff)} on "
+            f"average over {where} ({pct} CI {fmt_interval(lo, hi, minus=_HYPHEN)}; "
+            f"P({self.safer} safer) {fmt_p(p, cap_high=True)}; {n_s} vs {n_o} seeds)."
+        )
+
+
+def _check_comparable(a: SafetyIndex, b: SafetyIndex) -> None:
+    """Raises ConfigError unless the two indices can be compared replicate by replicate."""
+    if a.h_range != b.h_range or a.n_bins != b.n_bins:
+        raise ConfigError(
+            f"b: h_range/n_bins differ from a's ({b.h_range}, {b.n_bins} vs {a.h_range}, "
+            f"{a.n_bins})"
+        )
+    if a.replicates.size == 0 or a.replicates.shape != b.replicates.shape:
+        raise ConfigError(
+            f"b: needs as many bootstrap replicates as a ({b.replicates.size} vs "
+            f"{a.replicates.size}); build both with safety_index and the same n_boot"
+        )
+
+
+def _oriented_cohens_d(a: SafetyIndex, b: SafetyIndex) -> float:
+    """Cohen's d of the negated indicators (positive = A safer), NaN if undefined."""
+    ya, yb = a.indicator_samples, b.indicator_samples
+    if ya.size == 0 or yb.size == 0 or ya.size + yb.size < 3:
+        return math.nan
+    return cohens_d(-ya, -yb)
+
+
+def _seed_welch_p(a: SafetyIndex, b: SafetyIndex) -> float:
+    """Welch p-value on the per-seed indices, NaN when undefined."""
+    if len(a.seed_points) < 2 or len(b.seed_points) < 2:
+        return math.nan
+    return welch_t_test(a.seed_points, b.seed_points)[2]
+
+
+def compare(
+    a: SafetyIndex,
+    b: SafetyIndex,
+    *,
+    name_a: str = "A",
+    name_b: str = "B",
+    level: float = 0.95,
+    indicator: Indicator | None = None,
+) -> Verdict:
+    """Decides which of two VUTs is safer from their safety indices.
+
+    The bootstrap replicates of the two (independent) indices are paired by position to form
+    the distribution of ``index_A - index_B``; its percentile interval at ``level`` decides:
+    A is safer if the interval lies above 0, B if below, otherwise there is no significant
+    difference.
+
+    Args:
+        a: Safety index of VUT A (from :func:`safety_index`).
+        b: Safety index of VUT B, same ``h_range``, ``n_bins`` and number of replicates.
+        name_a: Name of VUT A in the verdict.
+        name_b: Name of VUT B; must differ from ``name_a``.
+        level: Confidence level of the interval of the difference, in (0, 1).
+        indicator: Naming for :meth:`Verdict.sentence`; a generic one if None.
+
+    Returns:
+        The :class:`Verdict`.
+
+    Raises:
+        ConfigError: If the indices are not comparable, the names coincide or ``level`` is
+            invalid.
+    """
+    level = check_level(level)
+    if name_a == name_b:
+        raise ConfigError(f"name_b: must differ from name_a ({name_a!r})")
+    _check_comparable(a, b)
+    diffs = a.replicates - b.replicates
+    lo, hi = bootstrap_ci(diffs, level)
+    safer = name_a if lo > 0.0 else name_b if hi < 0.0 else None
+    p_a = float(np.mean(diffs > 0.0) + 0.5 * np.mean(diffs == 0.0))
+    return Verdict(
+        name_a=name_a,
+        name_b=name_b,
+        safer=safer,
+        difference=a.point - b.point,
+        diff_lo=lo,
+        diff_hi=hi,
+        level=level,
+        p_a_safer=p_a,
+        cohens_d=_oriented_cohens_d(a, b),
+        significant=safer is not None,
+        p_seed_welch=_seed_welch_p(a, b),
+        n_seeds_a=a.n_seeds,
+        n_seeds_b=b.n_seeds,
+        h_range=a.h_range,
+        same_bins=a.bins_used == b.bins_used,
+        indicator=indicator if indicator is not None else Indicator(),
+    )

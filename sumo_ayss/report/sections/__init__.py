@@ -1,0 +1,1 @@
+"""The report's sections, each composed from an analysis into :mod:`..blocks`."""

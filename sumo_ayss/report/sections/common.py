@@ -1,0 +1,39 @@
+"""Text helpers shared by the report's sections: estimates, seed lists, relative paths."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+from sumo_ayss.analysis.formatting import fmt_interval, fmt_num
+from sumo_ayss.analysis.ranking import SafetyIndex
+from sumo_ayss.report.load import Estimate, Run
+
+__all__ = ["display_path", "fmt_est", "seed_points_text", "seeds_text"]
+
+
+def fmt_est(e: Estimate | None, digits: int = 2, scale: float = 1.0, unit: str = "") -> str:
+    """``"19.48 (19.30–19.66)"``, ``"1.0 % (0.3–3.6)"``; ``—`` when unknown."""
+    if e is None or not e.known:
+        return "—"
+    ci = fmt_interval(e.lo * scale, e.hi * scale, digits)
+    value = fmt_num(e.value * scale, digits) + (f" {unit}" if unit else "")
+    return f"{value} ({ci})" if ci else value
+
+
+def seed_points_text(members: Sequence[Run], idx: SafetyIndex) -> str:
+    """Per-seed indices, labelled by seed when every seed with samples entered the index."""
+    seeds = [r.seed for r in members if r.ayss is not None and len(r.ayss) > 0]
+    if len(seeds) != len(idx.seed_points):
+        return ", ".join(fmt_num(p) for p in idx.seed_points)
+    return ", ".join(f"s{s}: {fmt_num(p)}" for s, p in zip(seeds, idx.seed_points, strict=True))
+
+
+def seeds_text(members: Sequence[Run]) -> str:
+    return ", ".join(str(r.seed) if r.seed is not None else "?" for r in members)
+
+
+def display_path(path: Path, base: Path) -> str:
+    """``path`` relative to ``base`` (the report folder), so reports carry no machine paths."""
+    return Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()

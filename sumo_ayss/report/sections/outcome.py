@@ -1,0 +1,256 @@
+"""Blocks of the outcome of the SPCPs: (d) outcome table, (e) premise check, (f) exposure."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+from sumo_ayss.analysis.case import CaseAnalysis, exposure_sentence, premise_sentence
+from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p, fmt_prob
+from sumo_ayss.report import figures
+from sumo_ayss.report.blocks import (
+    Block,
+    BulletList,
+    Callout,
+    FigureBlock,
+    Heading,
+    Paragraph,
+    Table,
+)
+from sumo_ayss.report.options import MODES, ReportOptions
+from sumo_ayss.report.reference import PAPER_TABLES
+from sumo_ayss.report.sections.common import fmt_est
+
+__all__ = ["exposure_blocks", "outcome_blocks", "premise_blocks"]
+
+
+def outcome_blocks(a: CaseAnalysis) -> list[Block]:
+    cut_in = a.case == "cut_in"
+    pct = "95 % CI"
+    if cut_in:
+        headers: tuple[str, ...] = (
+            "VUT",
+            "seed",
+            "episodes",
+            "crash rate c [%]",
+            "lane-change rate lc [%]",
+            "r̄_epi (LC, no crash)",
+            "h̄ [m] (LC, no crash)",
+            "episodes LC, no crash",
+            "r̄_epi (all)",
+            "h̄ [m] (all)",
+        )
+    else:
+        headers = ("VUT", "seed", "episodes", "crash rate c [%]", "r̄_epi", "h̄ [m]")
+    rows = []
+    for vut, members in a.runs.items():
+        for run in members:
+            o = run.outcome
+            if o is None:
+                rows.append(
+                    (vut, str(run.seed), "outcome.json missing", *["—"] * (len(headers) - 3))
+                )
+                continue
+            n = str(o.n) if o.n is not None else "—"
+            crash = fmt_est(o.crash_rate, 1, 100.0)
+            if cut_in:
+                sub = o.lane_change_no_collision
+                rows.append(
+                    (
+                        vut,
+                        str(run.seed),
+                        n,
+                        crash,
+                        fmt_est(o.lane_change_rate, 1, 100.0),
+                        fmt_est(sub.mean_return if sub else None),
+                        fmt_est(sub.mean_final_headway_m if sub else None),
+                        str(sub.n) if sub and sub.n is not None else "—",
+                        fmt_est(o.mean_return),
+                        fmt_est(o.mean_final_headway_m),
+                    )
+                )
+            else:
+                rows.append(
+                    (
+                        vut,
+                        str(run.seed),
+                        n,
+                        crash,
+                        fmt_est(o.mean_return),
+                        fmt_est(o.mean_final_headway_m),
+                    )
+                )
+    note = (
+        f"Each cell: estimate ({pct}). c: episodes with a collision; r̄_epi: mean episode "
+        "reward; h̄: mean distance headway at the last step."
+    )
+    if cut_in:
+        note += (
+            " As in the paper, r̄_epi and h̄ are over episodes with a lane change and no collision."
+        )
+    table = Table(
+        f"Overall safety outcome of each SPCP ({a.info.paper_table} equivalent)",
+        headers,
+        tuple(rows),
+        (False,) + (True,) * (len(headers) - 1),
+        note,
+    )
+    blocks: list[Block] = [Heading(f"(d) Outcome of each SPCP ({a.info.paper_table})", 3), table]
+    paper = PAPER_TABLES.get(a.case)
+    if paper:
+        p_headers = ("VUT", "SPCP", "c [%]") + (("lc [%]",) if cut_in else ()) + ("r̄_epi", "h̄ [m]")
+        p_rows = tuple(
+            (p.vut, f"π*{i + 1}", f"{p.crash_pct:.1f}")
+            + ((f"{p.lane_change_pct:.0f}",) if cut_in and p.lane_change_pct is not None else ())
+            + (f"{p.mean_return:.2f}", f"{p.mean_final_headway_m:.2f}")
+            for i, p in enumerate(paper)
+        )
+        blocks.append(
+            Table(
+                f"For reference: the paper's {a.info.paper_table} (highway-env, 200 episodes "
+                "per SPCP)",
+                p_headers,
+                p_rows,
+                (False, False) + (True,) * (len(p_headers) - 2),
+                "The paper's simulator, actuator and episode rewards differ from this testbed's, "
+                "and its seeds are not ours: compare the pattern (similar outcomes for both "
+                "VUTs), not the digits.",
+            )
+        )
+    return blocks
+
+
+def premise_blocks(a: CaseAnalysis, options: ReportOptions) -> list[Block]:
+    blocks: list[Block] = [Heading("(e) Premise check: the same overall outcome?", 3)]
+    premise = a.premise
+    if premise is None or not premise.metrics:
+        return [*blocks, Paragraph(premise_sentence(premise, options))]
+    pct = f"{100 * options.level:g} %"
+    vuts = list(a.runs)
+    rows = []
+    for m in premise.metrics:
+        unit = f" [{m.spec.unit}]" if m.spec.unit else ""
+        cells = []
+        for vut in vuts:
+            if vut not in m.per_vut:
+                cells.append("—")
+                continue
+            mean, lo, hi, _n = m.per_vut[vut]
+            sc = m.spec.scale
+            ci = fmt_interval(lo * sc, hi * sc)
+            cells.append(f"{fmt_num(mean * sc)} ({ci})" if ci else fmt_num(mean * sc))
+        rows.append(
+            (
+                m.spec.name + unit,
+                *cells,
+                fmt_num(m.spread * m.spec.scale),
+                fmt_num(m.tolerance * m.spec.scale),
+                "yes" if m.met else "no",
+            )
+        )
+    blocks.append(
+        Table(
+            "Outcome of the SPCPs per VUT: seed mean (t-interval over seeds)",
+            ("metric", *vuts, "spread (max − min)", "tolerance", "within tolerance"),
+            tuple(rows),
+            (False,) + (True,) * (len(vuts) + 2) + (False,),
+            f"Each VUT: mean over its seeds' SPCPs ({pct} t-interval over seeds; one seed "
+            "gives no interval). Metrics over all outcome episodes. Tolerances are report "
+            "options (premise_reward, premise_crash_rate, premise_final_headway_m).",
+        )
+    )
+    blocks.append(
+        Callout(
+            "Premise",
+            (premise_sentence(premise, options),),
+            "none" if premise.met else "warning",
+        )
+    )
+    return blocks
+
+
+def exposure_blocks(
+    a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
+) -> list[Block]:
+    blocks: list[Block] = [Heading("(f) Exposure ranking", 3)]
+    blocks.append(Paragraph(MODES["exposure"]))
+    if not a.exposure_rows:
+        return [*blocks, Paragraph("No exposure: no outcome summaries in this case yet.")]
+    pct = f"{100 * options.level:g} %"
+    scores = a.exposure_scores
+    path = figures.seed_scores_figure(
+        a.exposure_rows,
+        scores,
+        colors,
+        out_dir / f"{a.case}_exposure_by_seed.png",
+        ylabel="adversarial exposure E (mean episode reward)",
+        title=f"{a.info.title}: exposure per seed (lower = safer)",
+    )
+    blocks.append(
+        FigureBlock(
+            path,
+            f"Exposure E of every seed's SPCP (grey: one line per training seed), safest VUT "
+            f"on the left; diamonds: seed mean with its {pct} t-interval over seeds.",
+        )
+    )
+    rows = []
+    for r in a.exposure_rows:
+        nxt = r.vs_next
+        per_seed = ", ".join(f"s{k}: {fmt_num(v)}" for k, v in scores[r.name].items())
+        rows.append(
+            (
+                str(r.rank),
+                r.name,
+                f"{fmt_num(r.mean)} ({fmt_interval(r.lo, r.hi)})"
+                if fmt_interval(r.lo, r.hi)
+                else fmt_num(r.mean),
+                per_seed,
+                str(r.n_seeds),
+                f"{nxt.test}, p {fmt_p(nxt.p)}" if nxt else "—",
+                ("yes" if nxt.significant else "no") if nxt else "—",
+            )
+        )
+    blocks.append(
+        Table(
+            "Ranking by exposure E (mean episode reward per SPCP), safest first",
+            (
+                "rank",
+                "VUT",
+                f"E ({pct} CI)",
+                "per-seed E",
+                "seeds",
+                "test vs next",
+                "significant vs next",
+            ),
+            tuple(rows),
+            (True, False, True, True, True, False, False),
+        )
+    )
+    p_rows = tuple(
+        (
+            c.name_a,
+            c.name_b,
+            f"{fmt_num(-c.difference)} ({fmt_interval(-c.hi, -c.lo)})",
+            c.test,
+            fmt_prob(c.p),
+            "yes" if c.significant else "no",
+        )
+        for c in a.exposure_pairs
+    )
+    blocks.append(
+        Table(
+            "Pairwise comparisons (A ranked above B)",
+            (
+                "A",
+                "B",
+                f"E_B − E_A ({pct} CI)",
+                "test",
+                "p",
+                f"significant (p < {options.welch_alpha:g})",
+            ),
+            p_rows,
+            (False, False, True, False, True, False),
+        )
+    )
+    blocks.append(BulletList(tuple(exposure_sentence(c) for c in a.exposure_pairs)))
+    return blocks

@@ -1,0 +1,37 @@
+"""One number formatter for sentences and tables: hand-checked tiny cases."""
+
+from __future__ import annotations
+
+import math
+
+from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p, fmt_prob
+
+
+def test_fmt_num() -> None:
+    assert fmt_num(1.234) == "1.23"
+    assert fmt_num(-1.235, 1) == "−1.2"
+    assert fmt_num(-1.234, minus="-") == "-1.23"
+    assert fmt_num(math.nan) == "—"
+    assert fmt_num(None) == "—"
+    assert fmt_num(math.inf, missing="n/a") == "n/a"
+
+
+def test_fmt_interval() -> None:
+    assert fmt_interval(0.8, 1.6) == "0.80–1.60"
+    assert fmt_interval(-0.3, 0.4) == "−0.30 to 0.40"
+    assert fmt_interval(-0.3, 0.4, minus="-") == "-0.30 to 0.40"
+    assert fmt_interval(math.nan, 1.0) == ""
+    assert fmt_interval(None, 1.0, missing="interval undefined") == "interval undefined"
+
+
+def test_fmt_p_and_prob() -> None:
+    assert fmt_p(0.0123) == "= 0.012"
+    assert fmt_p(0.0004) == "< 0.001"
+    assert fmt_p(0.9995) == "= 1.000"
+    assert fmt_p(0.9995, cap_high=True) == "> 0.999"
+    assert fmt_p(math.nan) == "n/a"
+    assert fmt_p(math.nan, undefined="undefined") == "undefined"
+    assert fmt_prob(0.953) == "0.953"
+    assert fmt_prob(0.0001) == "< 0.001"
+    assert fmt_prob(0.9999) == "> 0.999"
+    assert fmt_prob(math.nan) == "—"
