@@ -23,8 +23,6 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
-import pytest
-
 PACKAGE = "sumo_ayss"
 ROOT = Path(__file__).resolve().parents[1] / PACKAGE
 #: The largest module allowed [lines].
@@ -168,12 +166,6 @@ def _over_limit_text() -> str:
     return ", ".join(f"{name} ({n})" for name, n in over.items()) or "none"
 
 
-@pytest.mark.xfail(
-    strict=False,
-    # Computed when the tests are collected, so that the summary (-ra) names the modules.
-    reason=f"other modules are being split in parallel (issue 14); strict once they are "
-    f"merged. Over {MAX_MODULE_LINES} lines: {_over_limit_text()}",
-)
 def test_no_module_over_500_lines() -> None:
     too_long = modules_over_limit()
     for name, n in too_long.items():  # shown with -s, or in the failure once strict

@@ -286,12 +286,8 @@ def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
 
 
 def _crossplay(out: CaseAnalysis, options: CaseOptions) -> None:
-    """Cross-play ranking from the case folder's ``crossplay.csv``, or why there is none.
-
-    The case folder is the parent of the VUT folders of the case's runs. A table whose VUTs
-    or opponents are not exactly this case's VUTs and runs (an older grid, a failed job) is
-    not used: the reason is recorded instead.
-    """
+    """Cross-play ranking from the case folder's ``crossplay.csv`` (the parent of the VUT
+    folders), or why there is none; a table not of exactly these VUTs and runs is not used."""
     out.crossplay_blocks = options.crossplay_blocks
     if len(out.runs) < 2:
         only = next(iter(out.runs), "?")
@@ -302,10 +298,9 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions) -> None:
         return
     case_dirs = sorted({Path(r.path).parent.parent for rs in out.runs.values() for r in rs})
     if len(case_dirs) != 1:
+        folders = ", ".join(map(str, case_dirs))
         out.crossplay_missing = (
-            "no cross-play table for this case: its runs lie in several case folders ("
-            + ", ".join(map(str, case_dirs))
-            + "), and a cross-play table covers one grid"
+            f"no cross-play table: the runs lie in several case folders ({folders})"
         )
         return
     path = CaseFolder(case_dirs[0]).crossplay_csv

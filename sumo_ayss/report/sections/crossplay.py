@@ -8,7 +8,6 @@ from pathlib import Path
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.crossplay import crossplay_sentence
 from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p, fmt_prob
-from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -18,6 +17,7 @@ from sumo_ayss.report.blocks import (
     Paragraph,
     Table,
 )
+from sumo_ayss.report.crossplay_figure import crossplay_figure
 from sumo_ayss.report.options import ReportOptions
 from sumo_ayss.report.sections.common import display_path
 
@@ -55,7 +55,7 @@ def crossplay_blocks(
         ]
     pct = f"{100 * options.level:g} %"
     order = [r.name for r in a.crossplay_rows]
-    path = figures.crossplay_figure(
+    path = crossplay_figure(
         order,
         m.opponents,
         m.returns,

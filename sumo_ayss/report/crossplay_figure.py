@@ -1,0 +1,66 @@
+"""Cross-play figure: the reward each opponent SPCP extracts from every VUT."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+from numpy.typing import NDArray
+
+from sumo_ayss.report.figstyle import save, seed_style, style
+
+
+def crossplay_figure(
+    order: Sequence[str],
+    opponents: Sequence[tuple[str, int]],
+    returns: NDArray[np.float64],
+    vuts: Sequence[str],
+    colors: Mapping[str, str],
+    path: Path,
+    *,
+    title: str,
+) -> Path:
+    """Cross-play: one line per opponent SPCP across the VUTs, in ranking order.
+
+    Args:
+        order: VUTs safest first (the x axis).
+        opponents: ``(trained-against VUT, training seed)`` of each opponent (columns of
+            ``returns``).
+        returns: ``returns[i, j]`` = mean episode reward opponent j extracts from VUT
+            ``vuts[i]``.
+        vuts: The VUTs of the rows of ``returns``.
+        colors: ``{vut: colour}``; an opponent is drawn in its trained-against VUT's colour,
+            one line style per seed.
+        path: PNG file to write.
+        title: Figure title.
+
+    Returns:
+        ``path``.
+    """
+    rows = [list(vuts).index(v) for v in order]
+    seeds = sorted({s for _, s in opponents})
+    with style():
+        fig = Figure(figsize=(5.0 + 1.6 * max(1, len(order)), 4.6), layout="constrained")
+        ax = fig.subplots()
+        for j, (vut, seed) in enumerate(opponents):
+            ls, marker = seed_style(seeds.index(seed))
+            ax.plot(
+                range(len(order)),
+                [float(returns[i, j]) for i in rows],
+                color=colors.get(vut, "C0"),
+                ls=ls,
+                marker=marker,
+                ms=5,
+                lw=1.4,
+                label=f"SPCP of {vut}, seed {seed}",
+            )
+        ax.set_xticks(range(len(order)), [f"#{k + 1} {v}" for k, v in enumerate(order)])
+        ax.set_xlim(-0.4, len(order) - 0.6 + 0.2)
+        ax.set_xlabel("VUT driven against, safest first (cross-play ranking)")
+        ax.set_ylabel("reward extracted (mean reward/episode)")
+        ax.set_title(title)
+        ax.grid(axis="y", alpha=0.3)
+        ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
+        return save(fig, path)
