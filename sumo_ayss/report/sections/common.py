@@ -6,8 +6,10 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_num
+from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_prob
 from sumo_ayss.analysis.ranking import SafetyIndex
+from sumo_ayss.analysis.seeds import SeedComparison
+from sumo_ayss.report.blocks import Table
 from sumo_ayss.report.load import Estimate, Run
 
 __all__ = ["display_path", "fmt_est", "seed_points_text", "seeds_text"]
@@ -37,3 +39,23 @@ def seeds_text(members: Sequence[Run]) -> str:
 def display_path(path: Path, base: Path) -> str:
     """``path`` relative to ``base`` (the report folder), so reports carry no machine paths."""
     return Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()
+
+
+def pairs_table(pairs: Sequence[SeedComparison], score: str, pct: str, alpha: float) -> Table:
+    """The pairwise comparisons of a seed-level ranking (A ranked above B), ``score`` naming
+    the score (``"E"``, ``"X"``), its difference stated as B minus A."""
+    rows = tuple(
+        (
+            c.name_a,
+            c.name_b,
+            f"{fmt_num(-c.difference)} ({fmt_interval(-c.hi, -c.lo)})",
+            c.test,
+            fmt_prob(c.p),
+            "yes" if c.significant else "no",
+        )
+        for c in pairs
+    )
+    significant = f"significant (p < {alpha:g})"
+    head = ("A", "B", f"{score}_B − {score}_A ({pct} CI)", "test", "p", significant)
+    numeric = (False, False, True, False, True, False)
+    return Table("Pairwise comparisons (A ranked above B)", head, rows, numeric)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.crossplay import crossplay_sentence
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p, fmt_prob
+from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -19,7 +19,7 @@ from sumo_ayss.report.blocks import (
 )
 from sumo_ayss.report.crossplay_figure import crossplay_figure
 from sumo_ayss.report.options import ReportOptions
-from sumo_ayss.report.sections.common import display_path
+from sumo_ayss.report.sections.common import display_path, pairs_table
 
 __all__ = ["crossplay_blocks"]
 
@@ -98,32 +98,7 @@ def crossplay_blocks(
             (True, False, True, True, False, False),
         )
     )
-    p_rows = tuple(
-        (
-            c.name_a,
-            c.name_b,
-            f"{fmt_num(-c.difference)} ({fmt_interval(-c.hi, -c.lo)})",
-            c.test,
-            fmt_prob(c.p),
-            "yes" if c.significant else "no",
-        )
-        for c in a.crossplay_pairs
-    )
-    blocks.append(
-        Table(
-            "Pairwise comparisons (A ranked above B)",
-            (
-                "A",
-                "B",
-                f"X_B − X_A ({pct} CI)",
-                "test",
-                "p",
-                f"significant (p < {options.welch_alpha:g})",
-            ),
-            p_rows,
-            (False, False, True, False, True, False),
-        )
-    )
+    blocks.append(pairs_table(a.crossplay_pairs, "X", pct, options.welch_alpha))
     blocks.append(
         BulletList(tuple(crossplay_sentence(c, a.crossplay_blocks) for c in a.crossplay_pairs))
     )

@@ -6,7 +6,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis, exposure_sentence, premise_sentence
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p, fmt_prob
+from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import (
     Block,
@@ -19,7 +19,7 @@ from sumo_ayss.report.blocks import (
 )
 from sumo_ayss.report.options import MODES, ReportOptions
 from sumo_ayss.report.reference import PAPER_TABLES
-from sumo_ayss.report.sections.common import fmt_est
+from sumo_ayss.report.sections.common import fmt_est, pairs_table
 
 __all__ = ["exposure_blocks", "outcome_blocks", "premise_blocks"]
 
@@ -226,31 +226,6 @@ def exposure_blocks(
             (True, False, True, True, True, False, False),
         )
     )
-    p_rows = tuple(
-        (
-            c.name_a,
-            c.name_b,
-            f"{fmt_num(-c.difference)} ({fmt_interval(-c.hi, -c.lo)})",
-            c.test,
-            fmt_prob(c.p),
-            "yes" if c.significant else "no",
-        )
-        for c in a.exposure_pairs
-    )
-    blocks.append(
-        Table(
-            "Pairwise comparisons (A ranked above B)",
-            (
-                "A",
-                "B",
-                f"E_B − E_A ({pct} CI)",
-                "test",
-                "p",
-                f"significant (p < {options.welch_alpha:g})",
-            ),
-            p_rows,
-            (False, False, True, False, True, False),
-        )
-    )
+    blocks.append(pairs_table(a.exposure_pairs, "E", pct, options.welch_alpha))
     blocks.append(BulletList(tuple(exposure_sentence(c) for c in a.exposure_pairs)))
     return blocks
