@@ -308,12 +308,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         sys.exit(f"error: {e}")
     except KeyboardInterrupt:
         print("interrupted: no job runs any more; rerun the same command to resume", flush=True)
-        logging.shutdown()
-        sys.stderr.flush()
-        # Exit now: the workers are already stopped and every result is written atomically;
-        # the process pool's exit handler can otherwise wait on its manager thread for a
-        # killed worker (seen as a rare hang of the interrupted pipeline in the test suite).
-        os._exit(130)
+        sys.exit(130)
     for line in final_messages(statuses, report):
         print(line)
     sys.exit(1 if any(s.state == "failed" for s in statuses) else 0)
