@@ -52,6 +52,16 @@ def _run_dirs(out: Path) -> list[Path]:
     return sorted(out.glob("car_following/*/seed_*"))
 
 
+def _default_sigint() -> None:
+    """In the child before exec: SIGINT back to its default, as for a foreground command.
+
+    A test run started as a background job of a non-interactive shell (``pytest &``) has
+    SIGINT ignored, and an ignored signal stays ignored across exec: Python would then not
+    install its KeyboardInterrupt handler and the pipeline could not be interrupted at all
+    (seen: the SIGINT case hung for 30 s in such runs and passed in the foreground)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _snapshot(out: Path) -> dict[Path, int]:
     return {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()}
 
@@ -60,7 +70,13 @@ def _snapshot(out: Path) -> dict[Path, int]:
 def test_a_signal_stops_running_and_queued_jobs_within_seconds(tmp_path: Path, signum: int) -> None:
     pipe, out = _pipeline(tmp_path, total=50_000)
     cmd = [sys.executable, "-m", "sumo_ayss.pipeline", str(pipe), "--no-live"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc = subprocess.Popen(
+        cmd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        preexec_fn=_default_sigint,
+    )
     try:
         deadline = time.monotonic() + 120
         while not list(out.glob("car_following/*/seed_*/checkpoints")):
@@ -88,7 +104,9 @@ def test_a_signal_stops_running_and_queued_jobs_within_seconds(tmp_path: Path, s
 def test_an_interrupted_pipeline_resumes_to_the_end(tmp_path: Path) -> None:
     pipe, out = _pipeline(tmp_path, total=1500)
     cmd = [sys.executable, "-m", "sumo_ayss.pipeline", str(pipe), "--no-live"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, preexec_fn=_default_sigint
+    )
     try:
         deadline = time.monotonic() + 180
         while True:
