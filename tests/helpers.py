@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
 from typing import Any
 
 #: Small nets that learn fast enough for a few hundred steps.
@@ -26,3 +29,19 @@ TINY_TRAIN: dict[str, Any] = {
 def tiny_experiment() -> dict[str, Any]:
     """A fresh experiment mapping (``agent`` + ``train``) with the tiny learner."""
     return {"agent": dict(TINY_AGENT), "train": dict(TINY_TRAIN)}
+
+
+def modules_loaded_by(code: str) -> set[str]:
+    """Every module in ``sys.modules`` after running ``code`` in a fresh interpreter."""
+    script = f"{code}\nimport json, sys\nprint(json.dumps(sorted(sys.modules)))"
+    out = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True, timeout=120
+    )
+    return set(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def loaded_among(code: str, forbidden: tuple[str, ...] | set[str]) -> list[str]:
+    """The ``forbidden`` modules (exact names, or any submodule of a top-level name) that
+    ``code`` loads in a fresh interpreter."""
+    loaded = modules_loaded_by(code)
+    return sorted(m for m in loaded if m in forbidden or m.split(".")[0] in forbidden)

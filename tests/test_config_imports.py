@@ -2,12 +2,8 @@
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
-
 from sumo_ayss.config import PROJECT_ROOT
+from tests.helpers import loaded_among
 
 HEAVY = ("torch", "libsumo", "traci", "stable_baselines3", "matplotlib")
 
@@ -27,14 +23,5 @@ print(json.dumps(sorted({m.split(".")[0] for m in sys.modules})))
 
 def test_reading_configs_imports_no_heavy_module() -> None:
     """Parse the paper's pipeline and experiments in a fresh interpreter; list its imports."""
-    env = {**os.environ, "PYTHONPATH": str(PROJECT_ROOT)}
-    out = subprocess.run(
-        [sys.executable, "-c", SCRIPT, str(PROJECT_ROOT)],
-        capture_output=True,
-        text=True,
-        check=True,
-        env=env,
-        timeout=120,
-    )
-    loaded = set(json.loads(out.stdout.strip().splitlines()[-1]))
-    assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
+    bad = loaded_among(SCRIPT.replace("sys.argv[1]", repr(str(PROJECT_ROOT))), HEAVY)
+    assert bad == [], bad
