@@ -48,14 +48,15 @@ PHASES: list[tuple[str, tuple[str, ...]]] = [
 def summarise(lines: list[str]) -> tuple[Counter[str], int]:
     """Samples per phase, and the total, from py-spy raw lines ``frame;frame;... count``.
 
-    Only the main thread's samples count (stacks rooted in ``runpy``); the tensorboard
-    writer's thread and stack-less samples are left out.
+    Only the main thread's samples count (stacks rooted in ``runpy``, or in
+    ``multiprocessing``'s ``spawn_main`` for a pipeline worker recorded with ``py-spy record
+    -p <pid>``); the tensorboard writer's thread and stack-less samples are left out.
     """
     counts: Counter[str] = Counter()
     total = 0
     for line in lines:
         line = line.strip()
-        if not line.startswith("_run_module_as_main"):
+        if not line.startswith("_run_module_as_main") and "spawn_main" not in line[:120]:
             continue
         stack, _, count_text = line.rpartition(" ")
         count = int(count_text)
