@@ -46,7 +46,7 @@ def paper_blocks(
         colors,
         out_dir / f"{a.case}_safety_index.png",
         unit=unit,
-        what=info.symbol if a.case != "cut_in" else "Δv̄",
+        what=info.symbol,
         title=f"{info.title}: safety index",
     )
     blocks.append(
