@@ -61,7 +61,7 @@ logger = logging.getLogger(__name__)
 
 
 class CaseOptions(Protocol):
-    """The statistical settings read here (e.g. :class:`sumo_ayss.report.options.ReportOptions`)."""
+    """The statistical settings read here (e.g. :class:`sumo_ayss.config.report.ReportOptions`)."""
 
     @property
     def h_max_m(self) -> float: ...

@@ -15,9 +15,9 @@ from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config.ayss import AyssConfig
 from sumo_ayss.config.env import PROJECT_ROOT, Case
 from sumo_ayss.config.mapping import build
+from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.config.yaml_io import read_yaml
 from sumo_ayss.frozen import FrozenMap
-from sumo_ayss.report.options import ReportOptions
 from sumo_ayss.validation import check_choice, check_seed, require, suggest
 
 

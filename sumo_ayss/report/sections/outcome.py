@@ -8,6 +8,7 @@ from pathlib import Path
 from sumo_ayss.analysis.case import CaseAnalysis, exposure_sentence, premise_sentence
 from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
 from sumo_ayss.cases import OUTCOME_COLUMNS
+from sumo_ayss.config.report import MODES, ReportOptions
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import (
     Block,
@@ -19,7 +20,6 @@ from sumo_ayss.report.blocks import (
     Table,
 )
 from sumo_ayss.report.load import Outcome
-from sumo_ayss.report.options import MODES, ReportOptions
 from sumo_ayss.report.sections.common import fmt_est, pairs_table
 
 __all__ = ["exposure_blocks", "outcome_blocks", "premise_blocks"]
