@@ -150,7 +150,8 @@ def _paper_rows(a: CaseAnalysis) -> list[dict[str, Any]]:
                 "unit": f"{a.info.indicator.unit} (higher = safer)",
                 "p_vs_next": pair.verdict.p_seed_welch if pair else "",
                 "significant_vs_next": pair.significant if pair else "",
-                "vs_next": pair.sentence if pair else "",
+                # Tagged like the seed-level modes' sentences ("[exposure mode] ...").
+                "vs_next": f"[paper mode] {pair.sentence}" if pair else "",
             }
         )
     return rows
