@@ -95,7 +95,7 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         sumo_seed: SUMO's ``--seed``; default: drawn from the env's RNG at the first reset.
     """
 
-    metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
+    # ``metadata`` is gymnasium.Env's own, ``{"render_modes": []}``: no rendering.
     #: The registered case (:mod:`sumo_ayss.cases`) this env runs.
     CASE: ClassVar[str]
     #: The POV's action while a VUT's one-step response is measured
