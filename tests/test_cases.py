@@ -79,6 +79,25 @@ def test_builtin_cases_are_registered_in_order() -> None:
     assert case_of_indicator("delta_v_bar_mps") == "cut_in" and case_of_indicator("x") is None
 
 
+def test_the_case_package_is_a_leaf() -> None:
+    """Configuration, analysis and report read it: it imports nothing heavy and no other
+    layer of the package (the env class and the row builder are import paths)."""
+    from tests.helpers import loaded_among, modules_loaded_by
+
+    heavy = ("torch", "libsumo", "traci", "stable_baselines3", "matplotlib")
+    assert loaded_among("import sumo_ayss.cases", heavy) == []
+    ours = {m for m in modules_loaded_by("import sumo_ayss.cases") if m.startswith("sumo_ayss")}
+    assert ours == {
+        "sumo_ayss",
+        "sumo_ayss.cases",
+        "sumo_ayss.cases.car_following",
+        "sumo_ayss.cases.cut_in",
+        "sumo_ayss.cases.registry",
+        "sumo_ayss.errors",
+        "sumo_ayss.validation",
+    }
+
+
 def test_get_case_names_the_registered_cases() -> None:
     assert get_case("cut_in").lanes == 2
     with pytest.raises(ConfigError, match=r"unknown case 'cut-in' \(did you mean 'cut_in'\?\); "):
