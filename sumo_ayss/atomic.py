@@ -40,8 +40,9 @@ def _tmp_path(path: Path) -> Path:
     return path.with_name(f".{path.name}.{os.getpid()}{TMP_SUFFIX}")
 
 
-def atomic_write_with(path: str | Path, write: Callable[[Path], None]) -> None:
-    """Let ``write(tmp)`` create a temporary file, then fsync it and rename it to ``path``.
+def atomic_write_with(path: str | Path, write: Callable[[Path], object]) -> None:
+    """Let ``write(tmp)`` create a temporary file, then fsync it and rename it to ``path``
+    (what ``write`` returns is ignored).
 
     For writers that need a path (SB3's ``save``, matplotlib's ``savefig``, ``torch.save``).
     The temporary file keeps ``path``'s suffix (some writers choose the format by it).

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import functools
 import hashlib
 import logging
 import time
@@ -107,9 +108,7 @@ def run_case(
     envs: dict[str, Any] = {}
     for r in runs:
         envs.setdefault(r.config.env.vut, r.config.env)
-    opponents = [
-        Opponent(r.config.env.vut, r.seed, lambda env, r=r: load_spcp(r, env)) for r in runs
-    ]
+    opponents = [Opponent(r.config.env.vut, r.seed, functools.partial(load_spcp, r)) for r in runs]
     t0 = time.perf_counter()
     with controller_imports(trust_controller):
         table = run_crossplay(envs, opponents, n=n, seed=seed, n_envs=n_envs, progress=progress)
@@ -176,7 +175,7 @@ def main(argv: Sequence[str] | None = None) -> None:
                 n_envs=args.n_envs,
                 force=args.force,
                 trust_controller=args.trust_controller,
-                progress=lambda line, case=case: print(f"{case}: {line}", flush=True),
+                progress=functools.partial(print, f"{case}:", flush=True),
             )
             rows, _pairs = rank_crossplay(read_matrix(csv_path), blocks=args.blocks)
             print(f"\n{case}: cross-play ranking, safest first (lower exposure = safer)")

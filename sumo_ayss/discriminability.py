@@ -43,6 +43,7 @@ from sumo_ayss.analysis.discriminability import (
     compare_responses,
 )
 from sumo_ayss.atomic import atomic_write_json, atomic_write_text
+from sumo_ayss.cases import case_names
 from sumo_ayss.cli import prog
 from sumo_ayss.config import (
     Case,
@@ -298,7 +299,7 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     )
     p.add_argument("config", type=Path, help="experiment YAML or pipeline YAML")
     p.add_argument("--vuts", nargs="+", default=None, help="VUTs to compare (>= 2)")
-    p.add_argument("--case", choices=["car_following", "cut_in"], default=None)
+    p.add_argument("--case", choices=case_names(), default=None)
     p.add_argument(
         "--out", type=Path, default=None, help="default: runs/discriminability/<stem>_<case>"
     )

@@ -32,7 +32,7 @@ Pipeline YAML (every key optional)::
     evaluate: {n_outcome: 200, n_ayss: 100000}  # n_ayss: shorthand for ayss.n_samples
     #   ayss: {h_m: [0, 5], seed: 4242, ...}   # Monte Carlo (sumo_ayss.config.AyssConfig)
     vuts: {}                    # extra VUTs (name: vehicle type) added to every experiment
-    report: {mode: crossplay, crossplay_blocks: seed, n_boot: 2000}  # report.options
+    report: {mode: crossplay, crossplay_blocks: seed, n_boot: 2000}  # config.report
     expected_order: []          # a known safety order, safest first (validation studies)
     workers: 0                  # 0 = as many as cores
     retries: 1

@@ -11,7 +11,7 @@ and prints the table. With ``expected_order`` (a known safety order, e.g. a ladd
 writes ``<out>/order_check.json``: per case and mode, Kendall's τ of the ranking against it,
 whether the two ends differ significantly, and how many adjacent pairs do.
 
-The mode (``report.mode`` or ``--mode``, :data:`sumo_ayss.report.options.MODES`) decides which
+The mode (``report.mode`` or ``--mode``, :data:`sumo_ayss.config.report.MODES`) decides which
 rows come first and which ranking the report's verdicts use; the rows of every other mode
 available for a case follow, each tagged with its mode:
 
@@ -45,7 +45,7 @@ from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.run_folder import OUTCOME_JSON, RunFolder
 
 if TYPE_CHECKING:
-    from sumo_ayss.report.options import ReportOptions
+    from sumo_ayss.config.report import ReportOptions
 
 RANKING_COLUMNS = [
     "case",
@@ -69,8 +69,8 @@ def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> l
     Safety indices that the pipeline's report already computed in this process for the
     same samples and settings are reused, not bootstrapped again.
     """
+    from sumo_ayss.config.report import ReportOptions
     from sumo_ayss.report.load import group_runs, load_run
-    from sumo_ayss.report.options import ReportOptions
 
     options = options or ReportOptions()
     groups = group_runs([load_run(d) for d in run_dirs])
@@ -150,7 +150,8 @@ def _paper_rows(a: CaseAnalysis) -> list[dict[str, Any]]:
                 "unit": f"{a.info.indicator.unit} (higher = safer)",
                 "p_vs_next": pair.verdict.p_seed_welch if pair else "",
                 "significant_vs_next": pair.significant if pair else "",
-                "vs_next": pair.sentence if pair else "",
+                # Tagged like the seed-level modes' sentences ("[exposure mode] ...").
+                "vs_next": f"[paper mode] {pair.sentence}" if pair else "",
             }
         )
     return rows
@@ -291,6 +292,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     import dataclasses
 
     from sumo_ayss.cli import prog
+    from sumo_ayss.config.report import MODES
     from sumo_ayss.pipeline import (
         configure_logging,
         final_messages,
@@ -298,7 +300,6 @@ def main(argv: Sequence[str] | None = None) -> None:
         plan_jobs,
         run_pipeline,
     )
-    from sumo_ayss.report.options import MODES
 
     parser = argparse.ArgumentParser(
         prog=prog("python -m sumo_ayss.rank"), description=__doc__.splitlines()[0]

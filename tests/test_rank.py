@@ -36,6 +36,7 @@ def test_paper_mode_ranking_of_three_vuts_is_ordered_with_intervals(tmp_path, mo
     points = [r["score"] for r in rows]
     assert points == sorted(points, reverse=True)
     assert rows[0]["significant_vs_next"] is True
+    assert all(r["vs_next"].startswith("[paper mode] ") for r in rows[:-1])
     assert rows[-1]["vs_next"] == ""
     csv_path, md_path = write_ranking(rows, tmp_path)
     assert csv_path.read_text().splitlines()[0].startswith("case,mode,rank,vut,score")

@@ -23,7 +23,6 @@ from typing import Any, Literal, Protocol
 
 import numpy as np
 
-from sumo_ayss.analysis.cases import CaseInfo, case_info
 from sumo_ayss.analysis.crossplay import (
     CrossplayMatrix,
     crossplay_sentence,
@@ -41,6 +40,7 @@ from sumo_ayss.analysis.seeds import (
     verdict_sentence,
 )
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
+from sumo_ayss.cases import Case, case_info
 from sumo_ayss.errors import ConfigError, TableError
 from sumo_ayss.run_folder import CaseFolder
 
@@ -61,7 +61,7 @@ logger = logging.getLogger(__name__)
 
 
 class CaseOptions(Protocol):
-    """The statistical settings read here (e.g. :class:`sumo_ayss.report.options.ReportOptions`)."""
+    """The statistical settings read here (e.g. :class:`sumo_ayss.config.report.ReportOptions`)."""
 
     @property
     def h_max_m(self) -> float: ...
@@ -192,7 +192,7 @@ class CaseAnalysis:
 
     Attributes:
         case: Case name.
-        info: Naming and units of the case.
+        info: The case's record (:func:`sumo_ayss.cases.case_info`): naming, units, wording.
         runs: ``{vut: runs sorted by seed}``.
         indices: ``{vut: safety index}`` for VUTs with AYSS samples.
         ranking: VUTs safest first (point estimate).
@@ -221,7 +221,7 @@ class CaseAnalysis:
     """
 
     case: str
-    info: CaseInfo
+    info: Case
     runs: dict[str, list[Run]]
     indices: dict[str, SafetyIndex] = field(default_factory=dict)
     ranking: list[RankedVut] = field(default_factory=list)

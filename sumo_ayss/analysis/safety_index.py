@@ -26,6 +26,9 @@ from numpy.typing import ArrayLike, NDArray
 from sumo_ayss.analysis.bootstrap import RngLike, binned_mean_bootstrap, bootstrap_ci
 from sumo_ayss.analysis.stats import bin_index
 from sumo_ayss.analysis.validate import check_level
+from sumo_ayss.cases import Indicator  # naming records live with their cases; re-exported
+from sumo_ayss.cases.car_following import POV_ACCELERATION
+from sumo_ayss.cases.cut_in import DELTA_V_BAR
 from sumo_ayss.errors import ConfigError
 
 __all__ = ["DELTA_V_BAR", "POV_ACCELERATION", "Indicator", "SafetyIndex", "safety_index"]
@@ -33,40 +36,6 @@ __all__ = ["DELTA_V_BAR", "POV_ACCELERATION", "Indicator", "SafetyIndex", "safet
 
 def _empty() -> NDArray[np.float64]:
     return np.empty(0, dtype=np.float64)
-
-
-# --------------------------------------------------------------------------- indicator
-
-
-@dataclass(frozen=True)
-class Indicator:
-    """How to name an aggressiveness indicator in a verdict sentence.
-
-    Attributes:
-        name: Human name, e.g. ``"POV acceleration"``.
-        unit: Unit, e.g. ``"m/s²"``; may be empty.
-        comparative: What the safer VUT's SPCPs do, with ``{amount}`` (value and unit) and
-            optionally ``{name}``; e.g. ``"brake {amount} harder"``.
-    """
-
-    name: str = "aggressiveness indicator"
-    unit: str = ""
-    comparative: str = "have a {name} {amount} lower"
-
-    def amount(self, value: float) -> str:
-        """Formats ``value`` with two decimals and the unit, e.g. ``"1.23 m/s²"``."""
-        return f"{value:.2f} {self.unit}".rstrip()
-
-    def phrase(self, value: float) -> str:
-        """The comparative phrase for a difference ``value`` (>= 0) in the indicator."""
-        return self.comparative.format(name=self.name, amount=self.amount(value))
-
-
-POV_ACCELERATION = Indicator("POV acceleration", "m/s²", "brake {amount} harder")
-"""Car-following indicator: POV acceleration implied by the SPCP's action, m/s²."""
-
-DELTA_V_BAR = Indicator("Δv̄", "m/s", "close in {amount} faster (lower Δv̄)")
-"""Cut-in indicator: relative velocity projected on relative position, m/s."""
 
 
 # --------------------------------------------------------------------------- safety index

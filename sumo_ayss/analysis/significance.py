@@ -21,7 +21,7 @@ __all__ = ["PairVerdict", "SignificanceOptions", "pair_verdict", "significance_r
 
 
 class SignificanceOptions(Protocol):
-    """The settings of the rule (e.g. :class:`sumo_ayss.report.options.ReportOptions`)."""
+    """The settings of the rule (e.g. :class:`sumo_ayss.config.report.ReportOptions`)."""
 
     @property
     def level(self) -> float: ...

@@ -13,6 +13,8 @@ Sections and their modules:
 * an experiment, ``env`` + ``agent`` + ``train`` (:class:`ExperimentConfig`):
   :mod:`sumo_ayss.config.experiment`;
 * the AYSS Monte Carlo (:class:`AyssConfig`): :mod:`sumo_ayss.config.ayss`;
+* the report's statistical settings and analysis mode (:class:`ReportOptions`):
+  :mod:`sumo_ayss.config.report`;
 * a pipeline, ``grid``, ``experiments``, ``evaluate``, ``report``, ... (:class:`PipelineConfig`):
   :mod:`sumo_ayss.config.pipeline`.
 
@@ -54,12 +56,14 @@ from sumo_ayss.config.pipeline import (
     PipelineConfig,
     load_pipeline,
 )
+from sumo_ayss.config.report import MODES, ReportOptions
 from sumo_ayss.config.yaml_io import read_yaml, safe_load_yaml, write_yaml
 from sumo_ayss.validation import SEED_MAX, check_out_dir, check_seed, check_sumo_network
 
 __all__ = [
     "DEFAULT_AYSS_SEED",
     "MANAGED_SUMO_OPTIONS",
+    "MODES",
     "PROJECT_ROOT",
     "SEED_MAX",
     "ActuatorConfig",
@@ -72,6 +76,7 @@ __all__ = [
     "GridConfig",
     "OddConfig",
     "PipelineConfig",
+    "ReportOptions",
     "RewardConfig",
     "RewardShape",
     "ShapeKind",

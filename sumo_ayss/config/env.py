@@ -15,12 +15,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar, Literal
 
+from sumo_ayss.cases import DEFAULT_CASE, case_names, get_case
 from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE, VehicleType
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.frozen import FrozenMap
 from sumo_ayss.validation import check_choice, check_range, check_sumo_network, require
 
-Case = Literal["car_following", "cut_in"]
+#: A registered case name (:mod:`sumo_ayss.cases`); checked against the registry.
+Case = str
 ShapeKind = Literal["linear", "quadratic", "exponential"]
 
 #: Repository root (holds networks/, configs/, routes/) when running from a checkout.
@@ -265,7 +267,8 @@ class EnvConfig:
 
     SECTION: ClassVar[str] = "env"
 
-    case: Case = "car_following"
+    case: Case = DEFAULT_CASE
+    """A registered case (:func:`sumo_ayss.cases.case_names`)."""
     vut: str = "pi1"
     """Name of the VUT in ``vuts`` (built-ins: pi1, pi2)."""
     vuts: Mapping[str, VehicleType] = field(default_factory=lambda: dict(BUILTIN_VUTS))
@@ -283,7 +286,7 @@ class EnvConfig:
 
     def __post_init__(self) -> None:
         s = self.SECTION
-        check_choice(f"{s}.case", self.case, typing.get_args(Case))
+        check_choice(f"{s}.case", self.case, case_names())
         object.__setattr__(self, "vuts", FrozenMap(self.vuts))
         for name, vt in self.vuts.items():
             vt.validate(f"{s}.vuts.{name}")
@@ -306,11 +309,12 @@ class EnvConfig:
         require(
             not (
                 self.actuator.highway_env
-                and self.case == "cut_in"
+                and get_case(self.case).lane_change
                 and self.sim.lateral_resolution_m is None
             ),
             f"{s}.sim.lateral_resolution_m must be set (e.g. 0.1) with env.actuator.mode "
-            "highway_env in cut_in: the POV's free lateral position needs SUMO's sublane model",
+            f"highway_env in {self.case}: the POV's free lateral position needs SUMO's "
+            "sublane model",
         )
         if self.network is not None:
             path = Path(self.network)

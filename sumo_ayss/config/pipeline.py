@@ -5,20 +5,20 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import typing
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
+from sumo_ayss.cases import case_names
 from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config.ayss import AyssConfig
 from sumo_ayss.config.env import PROJECT_ROOT, Case
 from sumo_ayss.config.mapping import build
+from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.config.yaml_io import read_yaml
 from sumo_ayss.frozen import FrozenMap
-from sumo_ayss.report.options import ReportOptions
-from sumo_ayss.validation import check_seed, require, suggest
+from sumo_ayss.validation import check_choice, check_seed, require, suggest
 
 
 @dataclass(frozen=True)
@@ -27,7 +27,8 @@ class GridConfig:
 
     SECTION: ClassVar[str] = "grid"
 
-    cases: tuple[Case, ...] = ("car_following", "cut_in")
+    cases: tuple[Case, ...] = field(default_factory=case_names)
+    """Registered cases (:mod:`sumo_ayss.cases`); default: all of them."""
     vuts: tuple[str, ...] = ("pi1", "pi2")
     seeds: tuple[int, ...] = (0, 1, 2)
 
@@ -36,6 +37,8 @@ class GridConfig:
             values = getattr(self, name)
             require(len(values) > 0, f"grid.{name} must not be empty")
             require(len(set(values)) == len(values), f"grid.{name} has duplicates: {list(values)}")
+        for i, case in enumerate(self.cases):
+            check_choice(f"grid.cases[{i}]", case, case_names())
         for seed in self.seeds:
             check_seed(seed, "grid.seeds[]")
 
@@ -67,17 +70,18 @@ class EvaluateConfig:
         object.__setattr__(self, "ayss", dataclasses.replace(self.ayss, n_samples=self.n_ayss))
 
 
+def _default_experiments() -> dict[str, Path]:
+    """``configs/<case>.yaml`` of every registered case."""
+    return {case: PROJECT_ROOT / "configs" / f"{case}.yaml" for case in case_names()}
+
+
 @dataclass(frozen=True)
 class PipelineConfig:
     """A whole batch: grid, experiment file per case, output folder, parallelism."""
 
     grid: GridConfig = field(default_factory=GridConfig)
-    experiments: Mapping[str, Path] = field(
-        default_factory=lambda: {
-            "car_following": PROJECT_ROOT / "configs" / "car_following.yaml",
-            "cut_in": PROJECT_ROOT / "configs" / "cut_in.yaml",
-        }
-    )
+    experiments: Mapping[str, Path] = field(default_factory=_default_experiments)
+    """Experiment YAML per case; default: ``configs/<case>.yaml`` of every registered case."""
     out: Path = Path("runs") / "paper"
     total_timesteps: int | None = None
     eval_every: int | None = None
@@ -106,7 +110,7 @@ class PipelineConfig:
         object.__setattr__(self, "vuts", FrozenMap(self.vuts))
         for name, vt in self.vuts.items():
             vt.validate(f"vuts.{name}")
-        known = typing.get_args(Case)
+        known = case_names()
         for case in self.experiments:
             require(
                 case in known,

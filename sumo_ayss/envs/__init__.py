@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from sumo_ayss.cases import get_case
+
 if TYPE_CHECKING:
     from sumo_ayss.config import EnvConfig
     from sumo_ayss.envs.car_following import CarFollowingEnv
@@ -32,14 +34,10 @@ def __getattr__(name: str) -> Any:
 
 
 def make_env(config: EnvConfig, sumo_seed: int | None = None) -> PairEnv:
-    """The env of ``config.case`` (no wrappers), SUMO not started yet."""
-    if config.case == "cut_in":
-        from sumo_ayss.envs.cut_in import CutInEnv
-
-        return CutInEnv(config, sumo_seed=sumo_seed)
-    from sumo_ayss.envs.car_following import CarFollowingEnv
-
-    return CarFollowingEnv(config, sumo_seed=sumo_seed)
+    """The env of ``config.case`` (its registered :attr:`~sumo_ayss.cases.Case.env`, no
+    wrappers), SUMO not started yet."""
+    env: PairEnv = get_case(config.case).env_class()(config, sumo_seed=sumo_seed)
+    return env
 
 
 __all__ = ["CarFollowingEnv", "CutInEnv", "InitialCondition", "PairEnv", "make_env"]

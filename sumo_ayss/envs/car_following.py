@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from typing import Any, ClassVar
 
+from sumo_ayss.cases.car_following import CAR_FOLLOWING
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import (
     HEADWAY_HIGH_M,
@@ -37,7 +38,9 @@ def target_speed_mps(action: int, pov_speed_mps: float) -> float:
 class CarFollowingEnv(PairEnv):
     """One-lane car-following: POV ahead of the VUT in the same lane."""
 
-    CASE: ClassVar[str] = "car_following"
+    CASE: ClassVar[str] = CAR_FOLLOWING.name
+    RESPONSE_ACTION: ClassVar[int] = round(1.0 / TARGET_STEP)  # target = 1.0 · v_pov
+    RESPONSE_HOLDS_SPEED: ClassVar[bool] = True
     OBS_LOW: ClassVar[tuple[float, ...]] = (0.0, 0.0, HEADWAY_LOW_M)
     OBS_HIGH: ClassVar[tuple[float, ...]] = (SPEED_HIGH_MPS, SPEED_HIGH_MPS, HEADWAY_HIGH_M)
     N_ACTIONS: ClassVar[int] = N_ACTIONS

@@ -87,6 +87,7 @@ from __future__ import annotations
 import math
 from typing import Any, ClassVar, NamedTuple
 
+from sumo_ayss.cases.cut_in import CUT_IN
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import (
@@ -161,13 +162,13 @@ class CutInEnv(PairEnv):
     """Two-lane cut-in: the POV, in the left lane, may change into the VUT's lane once.
 
     Args:
-        config: environment configuration, ``case="cut_in"``; default ``EnvConfig(case=
-            "cut_in")``.
+        config: environment configuration of the cut-in case; default: its defaults.
         vut: shortcut to override ``config.vut``.
         sumo_seed: SUMO's ``--seed``; default: drawn from the env's RNG at the first reset.
     """
 
-    CASE: ClassVar[str] = "cut_in"
+    CASE: ClassVar[str] = CUT_IN.name
+    RESPONSE_ACTION: ClassVar[int] = LANE_CHANGE  # keeps its speed, the lateral motion runs on
     OBS_LOW: ClassVar[tuple[float, ...]] = (0.0, 0.0, HEADWAY_LOW_M, 0.0)
     OBS_HIGH: ClassVar[tuple[float, ...]] = (SPEED_HIGH_MPS, SPEED_HIGH_MPS, HEADWAY_HIGH_M, 1.0)
     N_ACTIONS: ClassVar[int] = N_ACTIONS

@@ -95,8 +95,15 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         sumo_seed: SUMO's ``--seed``; default: drawn from the env's RNG at the first reset.
     """
 
-    metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
+    # ``metadata`` is gymnasium.Env's own, ``{"render_modes": []}``: no rendering.
+    #: The registered case (:mod:`sumo_ayss.cases`) this env runs.
     CASE: ClassVar[str]
+    #: The POV's action while a VUT's one-step response is measured
+    #: (:mod:`sumo_ayss.scenarios.responses`).
+    RESPONSE_ACTION: ClassVar[int]
+    #: :attr:`RESPONSE_ACTION` only holds the POV's speed: the clipped actuator law then
+    #: moves the POV exactly as highway-env's does, and faster.
+    RESPONSE_HOLDS_SPEED: ClassVar[bool] = False
     #: Observation bounds (finite; values are clipped into them) and number of actions.
     OBS_LOW: ClassVar[tuple[float, ...]]
     OBS_HIGH: ClassVar[tuple[float, ...]]
@@ -112,7 +119,7 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         sumo_seed: int | None = None,
     ) -> None:
         super().__init__()
-        config = config if config is not None else EnvConfig(case=self.CASE)  # type: ignore[arg-type]
+        config = config if config is not None else EnvConfig(case=self.CASE)
         if config.case != self.CASE:
             raise ConfigError(f"env.case must be {self.CASE!r} for {type(self).__name__}")
         if vut is not None:
@@ -436,7 +443,7 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         if self.sumo_seed is None:  # never seeded: fresh entropy, not the env's RNG
             self.sumo_seed = sumo_seed_of(int(np.random.SeedSequence().entropy))  # type: ignore[arg-type]
         vtypes = session_vtypes(cfg)
-        network = cfg.network if cfg.network is not None else network_path(cfg.case)  # type: ignore[arg-type]
+        network = cfg.network if cfg.network is not None else network_path(cfg.case)
         session = SumoSession(
             network, vtypes, cfg.sim, self.sumo_seed, owner=f"{type(self).__name__}({cfg.vut})"
         )

@@ -70,13 +70,14 @@ from stable_baselines3.common.vec_env.base_vec_env import (
     VecEnvStepReturn,
 )
 
+from sumo_ayss.cases import get_case
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv, session_vtypes, sumo_seed_of
 from sumo_ayss.envs.protocol import EpisodePhases, StepResult
 from sumo_ayss.errors import ActionError, ConfigError
-from sumo_ayss.sim.network import LANES_OF_CASE, build_parallel_network, parallel_road_edge
+from sumo_ayss.sim.network import build_parallel_network, parallel_road_edge
 from sumo_ayss.sim.pair import VehiclePair
 from sumo_ayss.sim.session import SumoSession
 
@@ -340,7 +341,7 @@ class PairVecEnv(VecEnv):
         self._tmp = tempfile.TemporaryDirectory(prefix="sumo_ayss_vec_")
         try:
             network = build_parallel_network(
-                self.num_envs, LANES_OF_CASE[cfg.case], Path(self._tmp.name)
+                self.num_envs, get_case(cfg.case).lanes, Path(self._tmp.name)
             )
             session = SumoSession(
                 network,

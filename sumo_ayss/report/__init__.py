@@ -36,11 +36,11 @@ _LAZY = {
     "find_run_dirs": "sumo_ayss.report.load",
     "group_runs": "sumo_ayss.report.load",
     "load_run": "sumo_ayss.report.load",
-    "ReportOptions": "sumo_ayss.report.options",
-    "MODES": "sumo_ayss.report.options",
+    "ReportOptions": "sumo_ayss.config.report",
+    "MODES": "sumo_ayss.config.report",
 }
-"""Public names and their modules, imported on first use: configuration imports
-:mod:`sumo_ayss.report.options` without loading matplotlib through the document."""
+"""Public names and their modules, imported on first use: importing the package loads
+neither matplotlib nor the document."""
 
 __all__ = sorted(_LAZY)
 

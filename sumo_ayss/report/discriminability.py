@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
+from sumo_ayss.cases import case_info
 from sumo_ayss.report import figstyle
 from sumo_ayss.report.blocks import Block, FigureBlock, Heading, Paragraph, Table
 
@@ -198,17 +199,9 @@ def discriminability_blocks(
     )
     blocks: list[Any] = [heading, Paragraph(text)]
     blocks += [Paragraph(line) for line in record.get("summary", [])]
-    if case == "cut_in" and settings.get("decisions", 1) == 1:
-        blocks.append(
-            Paragraph(
-                "Cut-in, one decision: the POV starts its lane change from the centre of its own "
-                "lane, so during the first 0.2 s a SUMO car-following VUT does not see it yet and "
-                "drives freely; one-decision responses then differ only where the VUTs' free "
-                "driving differs, and Δv̄ after one step can differ between SPCPs only through "
-                "the states at which they choose to cut in. The reaction to the cut-in itself "
-                "shows over two decisions (--decisions 2)."
-            )
-        )
+    note = case_info(case).one_decision_note
+    if note and settings.get("decisions", 1) == 1:
+        blocks.append(Paragraph(note))
     if missing:
         blocks.append(Paragraph(f"Not in the record ({where}): {', '.join(missing)}."))
     if path is not None:

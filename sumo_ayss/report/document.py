@@ -23,6 +23,7 @@ from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis, analyse_case, vut_safety_index
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict, significance_rule
+from sumo_ayss.config.report import MODES, ReportOptions
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.report.blocks import (
     Block,
@@ -37,8 +38,6 @@ from sumo_ayss.report.blocks import (
 from sumo_ayss.report.checks import mixing_problems, trust_warnings
 from sumo_ayss.report.figstyle import vut_colors
 from sumo_ayss.report.load import RUN_FILES, Run, find_run_dirs, group_runs, load_run
-from sumo_ayss.report.options import MODES, ReportOptions
-from sumo_ayss.report.reference import PAPER_TABLES, PaperRow
 from sumo_ayss.report.render import render_html, render_markdown
 from sumo_ayss.report.sections.case import case_blocks, verdict_lines
 from sumo_ayss.report.sections.common import display_path
@@ -48,14 +47,12 @@ __all__ = [
     "DEFAULT_TITLE",
     "HTML_NAME",
     "MARKDOWN_NAME",
-    "PAPER_TABLES",
     "BulletList",
     "Callout",
     "CaseAnalysis",
     "FigureBlock",
     "Heading",
     "PairVerdict",
-    "PaperRow",
     "Paragraph",
     "Report",
     "ReportOptions",

@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 from sumo_ayss.analysis import binned_mean_ci
 from sumo_ayss.analysis.ranking import SafetyIndex
 from sumo_ayss.analysis.seeds import SeedRankRow
+from sumo_ayss.cases import case_info
 from sumo_ayss.config import RewardConfig
 from sumo_ayss.plots import plot_reward_shapes
 from sumo_ayss.report.figstyle import DPI, no_data, save, seed_style, style, vut_colors
@@ -92,7 +93,7 @@ def learning_curves_figure(
     has_lc = any(
         r.eval_curve is not None and np.isfinite(r.eval_curve.lane_change_rate).any()
         for r in runs
-        if r.case == "cut_in"
+        if case_info(r.case).lane_change
     )
     panels: list[tuple[str, str, float]] = [
         ("mean_return", "mean evaluation episode reward", 1.0),

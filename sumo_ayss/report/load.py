@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from sumo_ayss.cases import case_names, case_of_indicator
 from sumo_ayss.config import RewardConfig, build
 from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.report.checks import Training, read_training
@@ -30,8 +31,6 @@ from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     CONFIG_YAML,
     EVAL_CSV,
-    INDICATOR_ACCEL,
-    INDICATOR_DELTA_V_BAR,
     OUTCOME_JSON,
     SPCP_JSON,
     VERSIONS_JSON,
@@ -86,12 +85,6 @@ class RunFiles:
 
 RUN_FILES = RunFiles()
 """The file names the report reads."""
-
-#: ``indicator_name`` values in ``ayss.csv`` and the case whose indicator each is.
-INDICATOR_CASES: Mapping[str, str] = {
-    INDICATOR_ACCEL: "car_following",
-    INDICATOR_DELTA_V_BAR: "cut_in",
-}
 
 
 # --------------------------------------------------------------------------- records
@@ -150,7 +143,7 @@ class Run:
 
     Attributes:
         path: The run folder.
-        case: ``"car_following"`` or ``"cut_in"`` (from ``config.yaml``, else the folder path).
+        case: The case name (from ``config.yaml``, else the folder path).
         vut: VUT name.
         seed: Training seed, or None if unknown.
         vut_description: The VUT's description from the catalog in ``config.yaml``.
@@ -188,7 +181,8 @@ class Run:
 
 
 def group_runs(runs: Sequence[Run]) -> dict[str, dict[str, list[Run]]]:
-    """Runs grouped by case, then VUT; cases car-following first, VUTs and seeds sorted.
+    """Runs grouped by case, then VUT; cases in registry order (:mod:`sumo_ayss.cases`),
+    unknown ones last, VUTs and seeds sorted.
 
     Args:
         runs: Loaded runs.
@@ -196,9 +190,9 @@ def group_runs(runs: Sequence[Run]) -> dict[str, dict[str, list[Run]]]:
     Returns:
         ``{case: {vut: [runs sorted by seed]}}``.
     """
-    order = {"car_following": 0, "cut_in": 1}
+    order = {name: i for i, name in enumerate(case_names())}
     out: dict[str, dict[str, list[Run]]] = {}
-    for case in sorted({r.case for r in runs}, key=lambda c: (order.get(c, 9), c)):
+    for case in sorted({r.case for r in runs}, key=lambda c: (order.get(c, len(order)), c)):
         by_vut: dict[str, list[Run]] = {}
         for vut in sorted({r.vut for r in runs if r.case == case}):
             members = [r for r in runs if r.case == case and r.vut == vut]
@@ -350,8 +344,8 @@ def _check_ayss(run: Run) -> None:
     ayss = run.ayss
     if ayss is None or ayss.indicator_name is None:
         return
-    expected_case = INDICATOR_CASES[ayss.indicator_name]
-    if expected_case != run.case:
+    expected_case = case_of_indicator(ayss.indicator_name)
+    if expected_case is not None and expected_case != run.case:
         run.problems.append(
             f"{AYSS_CSV}: indicator {ayss.indicator_name!r} belongs to {expected_case}, "
             f"not {run.case}"

@@ -118,7 +118,6 @@ from sumo_ayss.run_folder.schemas import (
     CROSSPLAY_SCHEMA,
     INDICATOR_ACCEL,
     INDICATOR_DELTA_V_BAR,
-    INDICATOR_NAMES,
     OUTCOME_SCHEMA,
 )
 from sumo_ayss.run_folder.summaries import (
@@ -158,7 +157,6 @@ __all__ = [
     "EVAL_CSV",
     "INDICATOR_ACCEL",
     "INDICATOR_DELTA_V_BAR",
-    "INDICATOR_NAMES",
     "JOB_LOG",
     "LATEST_JSON",
     "MODEL_ZIP",

@@ -16,6 +16,7 @@ Written and read with :func:`~sumo_ayss.run_folder.table.write_table` /
 
 from __future__ import annotations
 
+from sumo_ayss.cases import CAR_FOLLOWING, CUT_IN, indicator_columns
 from sumo_ayss.run_folder.table import Column, TableSchema
 
 __all__ = [
@@ -23,7 +24,6 @@ __all__ = [
     "CROSSPLAY_SCHEMA",
     "INDICATOR_ACCEL",
     "INDICATOR_DELTA_V_BAR",
-    "INDICATOR_NAMES",
     "OUTCOME_SCHEMA",
 ]
 
@@ -59,11 +59,9 @@ OUTCOME_SCHEMA = TableSchema(
 )
 
 #: Aggressiveness indicator of car-following: POV acceleration [m/s²], < 0 brakes.
-INDICATOR_ACCEL = "pov_accel_mps2"
+INDICATOR_ACCEL = CAR_FOLLOWING.indicator_column
 #: Aggressiveness indicator of cut-in: Δv̄ [m/s], < 0 closes in.
-INDICATOR_DELTA_V_BAR = "delta_v_bar_mps"
-#: Allowed values of ``ayss.csv``'s ``indicator_name``.
-INDICATOR_NAMES = (INDICATOR_ACCEL, INDICATOR_DELTA_V_BAR)
+INDICATOR_DELTA_V_BAR = CUT_IN.indicator_column
 
 #: ``<run>/ayss.csv``: one row per kept adversarial-yet-safe sample (paper Fig. 4 and 6).
 AYSS_SCHEMA = TableSchema(
@@ -103,7 +101,7 @@ AYSS_SCHEMA = TableSchema(
             "str",
             "-",
             "pov_accel_mps2 (car-following) or delta_v_bar_mps (cut-in)",
-            choices=INDICATOR_NAMES,
+            choices=indicator_columns,  # of the registered cases, asked at each check
         ),
         Column(
             "indicator",

@@ -55,7 +55,7 @@ class StageHeader:
 
     Attributes:
         run_dir: The run folder, relative to the repository where it lies below it.
-        case: ``"car_following"`` or ``"cut_in"``.
+        case: The case name (:mod:`sumo_ayss.cases`).
         vut: The run's VUT.
         train_seed: The training seed.
         spcp_step: Training step of the evaluated SPCP, None if unknown.

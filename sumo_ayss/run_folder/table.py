@@ -8,7 +8,8 @@ Every column has a name, a dtype, a unit and a meaning (:class:`Column`);
   same number), ``inf`` / ``-inf`` / ``nan`` for non-finite values. A column accepts NaN only
   when ``nullable`` (an empty cell then also reads as NaN) and ±inf only when ``allow_inf``.
 * ``int``: decimal integer. ``bool``: ``0`` / ``1`` (``true`` / ``false`` accepted on read).
-* ``str``: the text; ``choices`` restricts it to a fixed set.
+* ``str``: the text; ``choices`` restricts it to a set (fixed, or a function's current
+  answer: the ``ayss.csv`` indicator names follow the case registry).
 
 :func:`write_table` writes atomically (temporary file in the same folder, then
 :func:`os.replace`), so a reader never sees half a table. :func:`read_table` checks the header
@@ -22,7 +23,7 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -64,7 +65,8 @@ class Column:
         meaning: What the value is, with its sign convention.
         nullable: NaN allowed (float columns only).
         allow_inf: ±inf allowed (float columns only).
-        choices: Allowed values of a ``str`` column; ``None`` = any text.
+        choices: Allowed values of a ``str`` column, or a function returning them (asked at
+            each check); ``None`` = any text.
     """
 
     name: str
@@ -73,7 +75,11 @@ class Column:
     meaning: str
     nullable: bool = False
     allow_inf: bool = False
-    choices: tuple[str, ...] | None = None
+    choices: tuple[str, ...] | Callable[[], tuple[str, ...]] | None = None
+
+    def allowed(self) -> tuple[str, ...] | None:
+        """The allowed values now (:attr:`choices`, called when it is a function)."""
+        return self.choices() if callable(self.choices) else self.choices
 
 
 @dataclass(frozen=True)
@@ -105,8 +111,8 @@ def schema_markdown(schema: TableSchema) -> str:
             extra.append("NaN allowed")
         if c.allow_inf:
             extra.append("inf allowed")
-        if c.choices:
-            extra.append("one of " + ", ".join(f"`{v}`" for v in c.choices))
+        if c.allowed():
+            extra.append("one of " + ", ".join(f"`{v}`" for v in c.allowed() or ()))
         note = f" ({'; '.join(extra)})" if extra else ""
         lines.append(f"| `{c.name}` | {c.dtype} | {c.unit} | {c.meaning}{note} |")
     return "\n".join(lines) + "\n"
@@ -223,12 +229,13 @@ def _check_values(col: Column, arr: npt.NDArray[Any], where: str) -> None:
         bad_inf = np.flatnonzero(np.isinf(arr)) if not col.allow_inf else np.array([], int)
         if bad_inf.size:
             raise TableError(f"{where}, column {col.name!r}, row {bad_inf[0]}: inf not allowed")
-    if col.choices is not None:
-        bad = np.flatnonzero(~np.isin(arr, col.choices))
+    allowed = col.allowed()
+    if allowed is not None:
+        bad = np.flatnonzero(~np.isin(arr, allowed))
         if bad.size:
             raise TableError(
                 f"{where}, column {col.name!r}, row {bad[0]}: {str(arr[bad[0]])!r} is not one of "
-                f"{list(col.choices)}"
+                f"{list(allowed)}"
             )
 
 

@@ -50,12 +50,13 @@ import numpy.typing as npt
 from tqdm import tqdm
 
 from sumo_ayss.analysis.metrics import ttc_longitudinal
+from sumo_ayss.cases import get_case
 from sumo_ayss.config import ActuatorConfig, AyssConfig
 from sumo_ayss.envs.car_following import target_speed_mps as cf_target_speed_mps
 from sumo_ayss.envs.cut_in import LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.errors import ActionError, ConfigError, SimulationError
+from sumo_ayss.errors import ActionError, SimulationError
 from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     INDICATOR_ACCEL,
@@ -72,7 +73,9 @@ __all__ = [
     "AyssResult",
     "CutInStepResult",
     "car_following_indicator",
+    "car_following_rows",
     "cut_in_mask",
+    "cut_in_rows",
     "policy_actions",
     "run_ayss",
     "safety_critical_mask",
@@ -95,21 +98,24 @@ BoolArray = npt.NDArray[np.bool_]
 def sample_observations(config: AyssConfig, case: str) -> npt.NDArray[np.float32]:
     """``n_samples`` observations drawn uniformly in the config's box.
 
-    Columns ``(v_pov, v_vut, h)`` for car-following, ``(v_pov, v_vut, h, same_lane=0)`` for
-    cut-in. One generator seeded with ``config.seed`` draws ``v_pov``, then ``v_vut``, then
-    ``h`` (each a block of ``n_samples``): the same (seed, n_samples) give the same draws.
+    Columns: the case's observation (:attr:`~sumo_ayss.cases.Case.observation`),
+    ``(v_pov, v_vut, h)`` drawn, any further column held at the case's
+    :attr:`~sumo_ayss.cases.Case.ayss_fixed_obs` (cut-in: ``same_lane = 0``). One generator
+    seeded with ``config.seed`` draws ``v_pov``, then ``v_vut``, then ``h`` (each a block of
+    ``n_samples``): the same (seed, n_samples) give the same draws.
 
     Returns:
-        float32 array, shape ``(n_samples, 3 or 4)``.
+        float32 array, shape ``(n_samples, len(observation))``.
+
+    Raises:
+        ConfigError: If ``case`` is not a registered case.
     """
+    fixed = get_case(case).ayss_fixed_obs
     rng = np.random.default_rng(config.seed)
     n = config.n_samples
     cols = [rng.uniform(*config.v_pov_mps, n), rng.uniform(*config.v_vut_mps, n)]
     cols.append(rng.uniform(*config.h_m, n))
-    if case == "cut_in":
-        cols.append(np.zeros(n))
-    elif case != "car_following":
-        raise ConfigError(f"case must be 'car_following' or 'cut_in', got {case!r}")
+    cols += [np.full(n, value) for value in fixed]
     return np.stack(cols, axis=1).astype(np.float32)
 
 
@@ -254,8 +260,9 @@ class AyssResult:
 
     Attributes:
         table: One row per kept sample (:data:`AYSS_SCHEMA`).
-        case: ``"car_following"`` or ``"cut_in"``.
-        indicator_name: :data:`INDICATOR_ACCEL` or :data:`INDICATOR_DELTA_V_BAR`.
+        case: The case name.
+        indicator_name: The case's :attr:`~sumo_ayss.cases.Case.indicator_column`
+            (:data:`INDICATOR_ACCEL`, :data:`INDICATOR_DELTA_V_BAR`).
         config: The Monte Carlo settings used.
         counts: Samples left after each filter: ``n_samples``, ``n_headway`` (h <= max),
             ``n_safety_critical`` (and TTC >= min), cut-in: ``n_lane_change`` (and
@@ -311,9 +318,9 @@ def run_ayss(
     cfg = config if config is not None else AyssConfig()
     base = env.unwrapped
     assert isinstance(base, PairEnv)
-    case = base.config.case
+    case = get_case(base.config.case)
     t0 = time.perf_counter()
-    obs = sample_observations(cfg, case)
+    obs = sample_observations(cfg, case.name)
     v_pov, v_vut, h = (obs[:, j].astype(np.float64) for j in range(3))
     ttc = ttc_s(v_pov, v_vut, h)
     in_h = h <= cfg.max_headway_m
@@ -326,13 +333,11 @@ def run_ayss(
         "n_safety_critical": int(critical.size),
         "action_counts": _action_counts(actions),
     }
-    build: Callable[..., tuple[Table, float]]
-    build = _cut_in_rows if case == "cut_in" else _car_following_rows
+    build: Callable[..., tuple[Table, float]] = case.ayss_row_builder()
     table, sim_wall = build(base, obs, ttc, critical, actions, counts, progress)
     counts["n_kept"] = len(table)
-    name = INDICATOR_DELTA_V_BAR if case == "cut_in" else INDICATOR_ACCEL
     wall = time.perf_counter() - t0
-    return AyssResult(table, case, name, cfg, counts, wall, sim_wall)
+    return AyssResult(table, case.name, case.indicator_column, cfg, counts, wall, sim_wall)
 
 
 def _action_counts(actions: IntArray) -> dict[str, int]:
@@ -372,7 +377,7 @@ def _rows(
     )
 
 
-def _car_following_rows(
+def car_following_rows(
     env: PairEnv,
     obs: npt.NDArray[np.float32],
     ttc: FloatArray,
@@ -381,6 +386,20 @@ def _car_following_rows(
     counts: dict[str, Any],
     progress: bool,
 ) -> tuple[Table, float]:
+    """The car-following AYSS rows (the case's :attr:`~sumo_ayss.cases.Case.ayss_rows`).
+
+    Args:
+        env: The case's env (only its actuator configuration is used).
+        obs: All Monte Carlo draws, shape ``(n_samples, d)``.
+        ttc: TTC of every draw [s].
+        critical: Indices of the safety-critical draws.
+        actions: The policy's actions on ``obs[critical]``.
+        counts: The stage's filter counts; a builder may add its own.
+        progress: Show a progress bar (where the builder runs SUMO).
+
+    Returns:
+        ``(table, seconds spent in SUMO)``.
+    """
     kept_obs = obs[critical]
     target, accel = car_following_indicator(
         kept_obs[:, 0].astype(np.float64), actions, env.config.actuator
@@ -392,7 +411,7 @@ def _car_following_rows(
     return table, 0.0
 
 
-def _cut_in_rows(
+def cut_in_rows(
     env: PairEnv,
     obs: npt.NDArray[np.float32],
     ttc: FloatArray,
@@ -401,6 +420,8 @@ def _cut_in_rows(
     counts: dict[str, Any],
     progress: bool,
 ) -> tuple[Table, float]:
+    """The cut-in AYSS rows: lane changes with the POV ahead, run one step in SUMO
+    (arguments as :func:`car_following_rows`; adds ``counts["n_lane_change"]``)."""
     assert isinstance(env, CutInEnv)
     counts["n_lane_change"] = int(np.count_nonzero(actions == LANE_CHANGE))
     keep = cut_in_mask(obs[critical, 2], actions)

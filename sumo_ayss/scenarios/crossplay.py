@@ -28,6 +28,7 @@ import numpy as np
 
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import sample_initial_conditions
+from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, Table
 from sumo_ayss.scenarios.rollout import Policy
@@ -47,7 +48,7 @@ class Opponent:
 
     vut: str
     seed: int
-    load: Callable[[object], Policy]
+    load: Callable[[PairEnv], Policy]
 
 
 def _same_but_vut(envs: Mapping[str, EnvConfig]) -> None:

@@ -32,6 +32,7 @@ import numpy.typing as npt
 from tqdm import tqdm
 
 from sumo_ayss.analysis.stats import check_level, mean_ci
+from sumo_ayss.cases import get_case
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.errors import ConfigError
@@ -142,7 +143,7 @@ class OutcomeSummary:
     """Paper Tables II / III for one SPCP.
 
     Attributes:
-        case: ``"car_following"`` or ``"cut_in"``.
+        case: The case name.
         n_episodes: Episodes summarised.
         crash_rate: Share of episodes that ended in a collision.
         lane_change_rate: Share of episodes with a started lane change (cut-in); ``None``
@@ -174,7 +175,8 @@ def summarize_outcome(table: Table, case: str, level: float = 0.95) -> OutcomeSu
 
     Args:
         table: Rows of :data:`OUTCOME_SCHEMA`.
-        case: ``"car_following"`` or ``"cut_in"``; cut-in adds the lane-change figures.
+        case: A registered case; one whose POV changes lanes
+            (:attr:`~sumo_ayss.cases.Case.lane_change`, cut-in) adds the lane-change figures.
         level: Confidence level of every interval.
 
     Returns:
@@ -184,19 +186,17 @@ def summarize_outcome(table: Table, case: str, level: float = 0.95) -> OutcomeSu
         raise ConfigError(f"summarize_outcome: expected an outcome table, got {table.schema.name}")
     collided, changed = table["collided"], table["lane_changed"]
     returns, headway = table["episode_return"], table["final_headway_m"]
-    cut_in = case == "cut_in"
+    lc = get_case(case).lane_change
     subset = changed & ~collided
     return OutcomeSummary(
         case=case,
         n_episodes=len(table),
         crash_rate=Proportion.of(collided, level),
-        lane_change_rate=Proportion.of(changed, level) if cut_in else None,
+        lane_change_rate=Proportion.of(changed, level) if lc else None,
         mean_return=MeanInterval.of(returns, level),
         mean_final_headway_m=MeanInterval.of(headway, level),
-        lc_no_collision_return=MeanInterval.of(returns[subset], level) if cut_in else None,
-        lc_no_collision_final_headway_m=(
-            MeanInterval.of(headway[subset], level) if cut_in else None
-        ),
+        lc_no_collision_return=MeanInterval.of(returns[subset], level) if lc else None,
+        lc_no_collision_final_headway_m=MeanInterval.of(headway[subset], level) if lc else None,
     )
 
 

@@ -10,7 +10,8 @@ the cut-in's lane-change motion and user-controller VUTs (driven through
 :class:`~sumo_ayss.controllers.ControlledVut`, as in training) are exactly those of the
 training and evaluation episodes.
 
-What the POV does while the response is measured:
+What the POV does while the response is measured (``RESPONSE_ACTION`` of the case's env
+class, :class:`~sumo_ayss.envs.pair_env.PairEnv`):
 
 * car-following: it holds its speed (action 2: target = its own speed, zero acceleration);
 * cut-in: it starts a lane change into the VUT's lane in the first decision (action
@@ -36,15 +37,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
+from sumo_ayss.cases import CaseMapping, get_case
 from sumo_ayss.config import EnvConfig
-from sumo_ayss.envs.car_following import TARGET_STEP
-from sumo_ayss.envs.cut_in import LANE_CHANGE
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.vec_env import PairVecEnv
 from sumo_ayss.errors import ConfigError
@@ -55,9 +55,9 @@ __all__ = ["DEFAULT_N_PAIRS", "VutResponses", "measure_responses"]
 #: per-state cost near its floor (~0.1 ms per state and VUT on one core).
 DEFAULT_N_PAIRS = 256
 
-#: The POV's action while a response is measured, per case (see the module docstring).
-_HOLD_SPEED_ACTION = round(1.0 / TARGET_STEP)  # car-following: target = 1.0 · v_pov
-POV_ACTION = {"car_following": _HOLD_SPEED_ACTION, "cut_in": LANE_CHANGE}
+#: The POV's action while a response is measured, per case (see the module docstring): the
+#: ``RESPONSE_ACTION`` of each registered case's env class.
+POV_ACTION: Mapping[str, int] = CaseMapping(lambda case: case.env_class().RESPONSE_ACTION)
 
 
 @dataclass(frozen=True)
@@ -130,12 +130,13 @@ def measure_responses(
     cfg = dataclasses.replace(
         env, vut=vut, network=None, decision_period_s=dt, episode_s=steps * dt
     )
-    if cfg.case == "car_following" and cfg.actuator.mode != "clipped":
+    env_class = get_case(cfg.case).env_class()
+    if env_class.RESPONSE_HOLDS_SPEED and cfg.actuator.mode != "clipped":
         # The POV holds its speed: highway-env's law with target = v gives a = 0, exactly
         # the clipped law's constant speed, but costs Python sub-steps and a moveToXY per
         # step (about 10x slower). The VUT's sub-steps (``substeps``) are kept.
         cfg = dataclasses.replace(cfg, actuator=dataclasses.replace(cfg.actuator, mode="clipped"))
-    action = POV_ACTION[cfg.case]
+    action = int(env_class.RESPONSE_ACTION)
     n = len(hh)
     accel = np.full(n, math.nan)
     collided = np.zeros(n, dtype=bool)

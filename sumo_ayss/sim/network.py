@@ -12,20 +12,12 @@ import os
 import subprocess
 from pathlib import Path
 
+from sumo_ayss.cases import get_case, registered_cases
 from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE, vtypes_xml
 from sumo_ayss.config import PROJECT_ROOT, Case
 from sumo_ayss.errors import SimulationError
 
 NETWORK_DIR = PROJECT_ROOT / "networks"
-
-#: Built-in network stem per case: one lane for car-following, two for cut-in.
-NETWORK_OF_CASE: dict[Case, str] = {
-    "car_following": "straight_1lane",
-    "cut_in": "straight_2lane",
-}
-
-#: Lanes of each case's built-in road (and of every road of its parallel network).
-LANES_OF_CASE: dict[Case, int] = {"car_following": 1, "cut_in": 2}
 
 #: The only edge of every built-in network; lane ``road_0`` is the rightmost.
 ROAD_EDGE = "road"
@@ -50,8 +42,9 @@ def sumo_binary(name: str) -> Path:
 
 
 def network_path(case: Case) -> Path:
-    """The built ``.net.xml`` of a case's built-in network."""
-    return NETWORK_DIR / f"{NETWORK_OF_CASE[case]}.net.xml"
+    """The built ``.net.xml`` of a case's built-in network (:attr:`Case.network
+    <sumo_ayss.cases.Case.network>`)."""
+    return NETWORK_DIR / f"{get_case(case).network}.net.xml"
 
 
 def build_network(stem: str, directory: Path = NETWORK_DIR, out_dir: Path | None = None) -> Path:
@@ -138,7 +131,7 @@ def main(argv: list[str] | None = None) -> None:
     )
     parser.add_argument("--out-dir", type=Path, default=None, help="default: networks/")
     args = parser.parse_args(argv)
-    for stem in sorted(set(NETWORK_OF_CASE.values())):
+    for stem in sorted({case.network for case in registered_cases() if case.network}):
         print(build_network(stem, out_dir=args.out_dir))
     print(write_vtypes_file((args.out_dir or PROJECT_ROOT / "routes") / "vtypes.add.xml"))
 

@@ -14,10 +14,10 @@ import numpy as np
 
 from sumo_ayss.analysis.case import CaseAnalysis, premise_sentence, seed_ranking_line
 from sumo_ayss.analysis.formatting import fmt_num
+from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragraph, Table
 from sumo_ayss.report.discriminability import discriminability_blocks
-from sumo_ayss.report.options import ReportOptions
 from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.crossplay import crossplay_blocks
 from sumo_ayss.report.sections.outcome import exposure_blocks, outcome_blocks, premise_blocks

@@ -8,6 +8,7 @@ from pathlib import Path
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.crossplay import crossplay_sentence
 from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
+from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -18,7 +19,6 @@ from sumo_ayss.report.blocks import (
     Table,
 )
 from sumo_ayss.report.crossplay_figure import crossplay_figure
-from sumo_ayss.report.options import ReportOptions
 from sumo_ayss.report.sections.common import display_path, pairs_table
 
 __all__ = ["crossplay_blocks"]

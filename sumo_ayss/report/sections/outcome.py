@@ -7,6 +7,8 @@ from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis, exposure_sentence, premise_sentence
 from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
+from sumo_ayss.cases import OUTCOME_COLUMNS
+from sumo_ayss.config.report import MODES, ReportOptions
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import (
     Block,
@@ -17,31 +19,32 @@ from sumo_ayss.report.blocks import (
     Paragraph,
     Table,
 )
-from sumo_ayss.report.options import MODES, ReportOptions
-from sumo_ayss.report.reference import PAPER_TABLES
+from sumo_ayss.report.load import Outcome
 from sumo_ayss.report.sections.common import fmt_est, pairs_table
 
 __all__ = ["exposure_blocks", "outcome_blocks", "premise_blocks"]
 
 
+def _outcome_cells(o: Outcome) -> dict[str, str]:
+    """Every column of :data:`~sumo_ayss.cases.OUTCOME_COLUMNS` for one SPCP's outcome."""
+    sub = o.lane_change_no_collision
+    return {
+        "crash": fmt_est(o.crash_rate, 1, 100.0),
+        "lane_change": fmt_est(o.lane_change_rate, 1, 100.0),
+        "lc_return": fmt_est(sub.mean_return if sub else None),
+        "lc_headway": fmt_est(sub.mean_final_headway_m if sub else None),
+        "lc_episodes": str(sub.n) if sub and sub.n is not None else "—",
+        "return": fmt_est(o.mean_return),
+        "headway": fmt_est(o.mean_final_headway_m),
+        "return_all": fmt_est(o.mean_return),
+        "headway_all": fmt_est(o.mean_final_headway_m),
+    }
+
+
 def outcome_blocks(a: CaseAnalysis) -> list[Block]:
-    cut_in = a.case == "cut_in"
+    columns = a.info.outcome_columns
     pct = "95 % CI"
-    if cut_in:
-        headers: tuple[str, ...] = (
-            "VUT",
-            "seed",
-            "episodes",
-            "crash rate c [%]",
-            "lane-change rate lc [%]",
-            "r̄_epi (LC, no crash)",
-            "h̄ [m] (LC, no crash)",
-            "episodes LC, no crash",
-            "r̄_epi (all)",
-            "h̄ [m] (all)",
-        )
-    else:
-        headers = ("VUT", "seed", "episodes", "crash rate c [%]", "r̄_epi", "h̄ [m]")
+    headers = ("VUT", "seed", "episodes", *(OUTCOME_COLUMNS[c] for c in columns))
     rows = []
     for vut, members in a.runs.items():
         for run in members:
@@ -52,42 +55,14 @@ def outcome_blocks(a: CaseAnalysis) -> list[Block]:
                 )
                 continue
             n = str(o.n) if o.n is not None else "—"
-            crash = fmt_est(o.crash_rate, 1, 100.0)
-            if cut_in:
-                sub = o.lane_change_no_collision
-                rows.append(
-                    (
-                        vut,
-                        str(run.seed),
-                        n,
-                        crash,
-                        fmt_est(o.lane_change_rate, 1, 100.0),
-                        fmt_est(sub.mean_return if sub else None),
-                        fmt_est(sub.mean_final_headway_m if sub else None),
-                        str(sub.n) if sub and sub.n is not None else "—",
-                        fmt_est(o.mean_return),
-                        fmt_est(o.mean_final_headway_m),
-                    )
-                )
-            else:
-                rows.append(
-                    (
-                        vut,
-                        str(run.seed),
-                        n,
-                        crash,
-                        fmt_est(o.mean_return),
-                        fmt_est(o.mean_final_headway_m),
-                    )
-                )
+            cells = _outcome_cells(o)
+            rows.append((vut, str(run.seed), n, *(cells[c] for c in columns)))
     note = (
         f"Each cell: estimate ({pct}). c: episodes with a collision; r̄_epi: mean episode "
         "reward; h̄: mean distance headway at the last step."
     )
-    if cut_in:
-        note += (
-            " As in the paper, r̄_epi and h̄ are over episodes with a lane change and no collision."
-        )
+    if a.info.outcome_note:
+        note += " " + a.info.outcome_note
     table = Table(
         f"Overall safety outcome of each SPCP ({a.info.paper_table} equivalent)",
         headers,
@@ -96,12 +71,13 @@ def outcome_blocks(a: CaseAnalysis) -> list[Block]:
         note,
     )
     blocks: list[Block] = [Heading(f"(d) Outcome of each SPCP ({a.info.paper_table})", 3), table]
-    paper = PAPER_TABLES.get(a.case)
+    paper = a.info.paper_rows
     if paper:
-        p_headers = ("VUT", "SPCP", "c [%]") + (("lc [%]",) if cut_in else ()) + ("r̄_epi", "h̄ [m]")
+        lc = a.info.lane_change
+        p_headers = ("VUT", "SPCP", "c [%]") + (("lc [%]",) if lc else ()) + ("r̄_epi", "h̄ [m]")
         p_rows = tuple(
             (p.vut, f"π*{i + 1}", f"{p.crash_pct:.1f}")
-            + ((f"{p.lane_change_pct:.0f}",) if cut_in and p.lane_change_pct is not None else ())
+            + ((f"{p.lane_change_pct:.0f}",) if lc and p.lane_change_pct is not None else ())
             + (f"{p.mean_return:.2f}", f"{p.mean_final_headway_m:.2f}")
             for i, p in enumerate(paper)
         )

@@ -9,9 +9,9 @@ from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_prob
 from sumo_ayss.analysis.significance import significance_rule
 from sumo_ayss.analysis.verdict import Verdict
+from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, BulletList, FigureBlock, Heading, Paragraph, Table
-from sumo_ayss.report.options import ReportOptions
 from sumo_ayss.report.sections.common import seed_points_text
 
 __all__ = ["paper_blocks"]
@@ -46,7 +46,7 @@ def paper_blocks(
         colors,
         out_dir / f"{a.case}_safety_index.png",
         unit=unit,
-        what=info.symbol if a.case != "cut_in" else "Δv̄",
+        what=info.symbol,
         title=f"{info.title}: safety index",
     )
     blocks.append(
