@@ -38,7 +38,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from sumo_ayss.analysis.case import CaseAnalysis, analyse_case, exposure_sentence
+from sumo_ayss.analysis.case import CaseAnalysis, exposure_sentence
 from sumo_ayss.analysis.crossplay import crossplay_sentence
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.errors import AyssError, ConfigError
@@ -70,12 +70,11 @@ def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> l
     same samples and settings are reused, not bootstrapped again.
     """
     from sumo_ayss.config.report import ReportOptions
-    from sumo_ayss.report.load import group_runs, load_run
+    from sumo_ayss.report.load import analyse_runs, load_run
 
     options = options or ReportOptions()
-    groups = group_runs([load_run(d) for d in run_dirs])
     paper = options.mode == "paper"  # the AYSS bootstrap is only needed in paper mode
-    return [analyse_case(case, runs, options, paper=paper) for case, runs in groups.items()]
+    return analyse_runs([load_run(d) for d in run_dirs], options, paper=paper)
 
 
 #: The modes in the order their rows follow the chosen mode's.

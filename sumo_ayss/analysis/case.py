@@ -4,9 +4,9 @@
 :class:`sumo_ayss.report.load.Run`) into a :class:`CaseAnalysis`: the paper mode (AYSS
 safety index per VUT, hierarchical bootstrap, pairwise verdicts under
 :func:`~.significance.pair_verdict`), the exposure mode (seed-level ranking of the mean
-episode reward the SPCPs extract), the cross-play mode (the case folder's ``crossplay.csv``
-when the cross-play stage wrote one, :mod:`.crossplay`) and the premise check. Both the
-report and :mod:`sumo_ayss.rank` read it; nothing here draws or renders.
+episode reward the SPCPs extract), the cross-play mode (the case's cross-play matrix, which
+its loader read from ``crossplay.csv``, :mod:`.crossplay`) and the premise check. Both the
+report and :mod:`sumo_ayss.rank` read it; nothing here reads a file, draws or renders.
 """
 
 from __future__ import annotations
@@ -24,10 +24,12 @@ from typing import Any, Literal, Protocol
 import numpy as np
 
 from sumo_ayss.analysis.crossplay import (
+    CROSSPLAY_COMMAND,
+    NO_CROSSPLAY_TABLE,
+    CrossplayInput,
     CrossplayMatrix,
     crossplay_sentence,
     rank_crossplay,
-    read_crossplay,
 )
 from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.analysis.premise import Premise, premise_check
@@ -41,11 +43,9 @@ from sumo_ayss.analysis.seeds import (
 )
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
 from sumo_ayss.cases import Case, case_info
-from sumo_ayss.errors import ConfigError, TableError
-from sumo_ayss.run_folder import CaseFolder
+from sumo_ayss.errors import ConfigError
 
 __all__ = [
-    "CROSSPLAY_COMMAND",
     "EXPOSURE_SCORE",
     "CaseAnalysis",
     "CaseOptions",
@@ -246,9 +246,6 @@ class CaseAnalysis:
     crossplay_missing: str = ""
 
 
-CROSSPLAY_COMMAND = "python -m sumo_ayss.crossplay <config>"
-"""The command that writes a case's cross-play table."""
-
 EXPOSURE_SCORE = "extract {amount} {more_less} reward per episode"
 """How an exposure difference reads in a verdict sentence."""
 
@@ -285,9 +282,9 @@ def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
     out.premise = premise_check(metrics, tolerances=options.premise_tolerances, level=options.level)
 
 
-def _crossplay(out: CaseAnalysis, options: CaseOptions) -> None:
-    """Cross-play ranking from the case folder's ``crossplay.csv`` (the parent of the VUT
-    folders), or why there is none; a table not of exactly these VUTs and runs is not used."""
+def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -> None:
+    """Cross-play ranking from the case's cross-play table as its loader found it, or why
+    there is none; a table not of exactly these VUTs and runs is not used."""
     out.crossplay_blocks = options.crossplay_blocks
     if len(out.runs) < 2:
         only = next(iter(out.runs), "?")
@@ -296,32 +293,21 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions) -> None:
             "cross-play compares two or more"
         )
         return
-    case_dirs = sorted({Path(r.path).parent.parent for rs in out.runs.values() for r in rs})
-    if len(case_dirs) != 1:
-        folders = ", ".join(map(str, case_dirs))
-        out.crossplay_missing = (
-            f"no cross-play table: the runs lie in several case folders ({folders})"
-        )
-        return
-    path = CaseFolder(case_dirs[0]).crossplay_csv
-    if not path.is_file():
-        out.crossplay_missing = f"no cross-play table for this case (run {CROSSPLAY_COMMAND})"
-        return
-    try:
-        m = read_crossplay(path)
-    except (TableError, ConfigError) as exc:
-        out.crossplay_missing = f"the cross-play table is unreadable ({exc})"
-        out.problems.append(f"{path}: {exc}")
+    m = found.matrix
+    if m is None:
+        out.crossplay_missing = found.missing or NO_CROSSPLAY_TABLE
+        if found.problem:
+            out.problems.append(found.problem)
         return
     opponents = {(v, int(r.seed)) for v, rs in out.runs.items() for r in rs if r.seed is not None}
     if set(m.vuts) != set(out.runs) or set(m.opponents) != opponents:
         out.crossplay_missing = (
-            f"the cross-play table {path} is not of these runs (VUTs {', '.join(m.vuts)}; "
+            f"the cross-play table {found.path} is not of these runs (VUTs {', '.join(m.vuts)}; "
             f"{len(m.opponents)} opponents, this case has {len(opponents)} runs with a seed); "
             f"run {CROSSPLAY_COMMAND} again once every job is done"
         )
         return
-    out.crossplay, out.crossplay_path = m, path
+    out.crossplay, out.crossplay_path = m, found.path
     out.crossplay_rows, out.crossplay_pairs = rank_crossplay(
         m, blocks=options.crossplay_blocks, level=options.level, alpha=options.welch_alpha
     )
@@ -360,7 +346,12 @@ def premise_sentence(premise: Premise | None, options: CaseOptions) -> str:
 
 
 def analyse_case(
-    case: str, runs: dict[str, list[Run]], options: CaseOptions, *, paper: bool = True
+    case: str,
+    runs: dict[str, list[Run]],
+    options: CaseOptions,
+    *,
+    crossplay: CrossplayInput | None = None,
+    paper: bool = True,
 ) -> CaseAnalysis:
     """Safety index per VUT, ranking, pairwise verdicts and the headline of one case.
 
@@ -368,6 +359,8 @@ def analyse_case(
         case: Case name.
         runs: ``{vut: runs}``.
         options: Statistical settings.
+        crossplay: The case's cross-play table as its loader found it
+            (:func:`sumo_ayss.report.load.load_crossplay`); None: no table.
         paper: Compute the paper mode (AYSS safety indices and their bootstrap, the slow
             part); the report always does, a ranking in exposure mode need not.
 
@@ -417,7 +410,7 @@ def analyse_case(
         if out.headline_kind == "safer":
             out.headline_kind = "warning"
     out.paper_headline, out.paper_ranking_line = out.headline, out.ranking_line
-    _crossplay(out, options)
+    _crossplay(out, options, crossplay or CrossplayInput())
     out.mode = out.ranking_mode = options.mode
     if options.mode == "exposure":
         _exposure_headline(out)

@@ -35,6 +35,8 @@ _LAZY = {
     "Run": "sumo_ayss.report.load",
     "find_run_dirs": "sumo_ayss.report.load",
     "group_runs": "sumo_ayss.report.load",
+    "analyse_runs": "sumo_ayss.report.load",
+    "load_crossplay": "sumo_ayss.report.load",
     "load_run": "sumo_ayss.report.load",
     "ReportOptions": "sumo_ayss.config.report",
     "MODES": "sumo_ayss.config.report",

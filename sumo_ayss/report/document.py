@@ -1,8 +1,9 @@
 """The report: run folders in, ``report.html`` + ``summary.md`` + PNG figures out.
 
 :func:`write_report` reads run folders (:mod:`.load`), checks that they may be pooled
-(:mod:`.checks`), analyses each case (:func:`sumo_ayss.analysis.case.analyse_case`: safety
-indices, verdicts, exposure ranking, premise), composes the sections (:mod:`.sections`) into
+(:mod:`.checks`), analyses each case (:func:`.load.analyse_runs`: the case's cross-play
+table read, then :func:`sumo_ayss.analysis.case.analyse_case`: safety indices, verdicts,
+exposure and cross-play rankings, premise), composes the sections (:mod:`.sections`) into
 one list of blocks (:mod:`.blocks`) and renders it twice (:mod:`.render`):
 
 * ``report.html`` — one self-contained file: figures embedded as base64 PNG, inline CSS, no
@@ -37,7 +38,14 @@ from sumo_ayss.report.blocks import (
 )
 from sumo_ayss.report.checks import mixing_problems, trust_warnings
 from sumo_ayss.report.figstyle import vut_colors
-from sumo_ayss.report.load import RUN_FILES, Run, find_run_dirs, group_runs, load_run
+from sumo_ayss.report.load import (
+    RUN_FILES,
+    Run,
+    analyse_runs,
+    find_run_dirs,
+    group_runs,
+    load_run,
+)
 from sumo_ayss.report.render import render_html, render_markdown
 from sumo_ayss.report.sections.case import case_blocks, verdict_lines
 from sumo_ayss.report.sections.common import display_path
@@ -96,7 +104,7 @@ def build_report(
     out_dir.mkdir(parents=True, exist_ok=True)
     groups = group_runs(runs)
     colors = vut_colors(sorted({r.vut for r in runs}))
-    analyses = [analyse_case(case, by_vut, options) for case, by_vut in groups.items()]
+    analyses = analyse_runs(runs, options)
     now = dt.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z")
     n_seeds = ", ".join(
         f"{case}: " + ", ".join(f"{vut} × {len(m)}" for vut, m in by_vut.items())
