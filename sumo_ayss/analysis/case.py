@@ -6,16 +6,15 @@ safety index per VUT, hierarchical bootstrap, pairwise verdicts under
 :func:`~.significance.pair_verdict`), the exposure mode (seed-level ranking of the mean
 episode reward the SPCPs extract), the cross-play mode (the case's cross-play matrix, which
 its loader read from ``crossplay.csv``, :mod:`.crossplay`) and the premise check. Both the
-report and :mod:`sumo_ayss.rank` read it; nothing here reads a file, draws or renders.
+report and :mod:`sumo_ayss.rank` read it; the pipeline analyses each case once and hands the
+analysis to both. Nothing here reads a file, draws or renders.
 """
 
 from __future__ import annotations
 
-import hashlib
 import itertools
 import logging
 import zlib
-from collections import OrderedDict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -108,51 +107,6 @@ def run_label(run: Run) -> str:
 def _vut_rng(options: CaseOptions, case: str, vut: str) -> np.random.Generator:
     """A bootstrap stream per (case, VUT), stable whatever other VUTs are in the report."""
     return np.random.default_rng([options.rng_seed, zlib.crc32(f"{case}/{vut}".encode())])
-
-
-_INDEX_CACHE: OrderedDict[tuple[Any, ...], SafetyIndex | None] = OrderedDict()
-_INDEX_CACHE_SIZE = 16
-"""Safety indices of the last VUTs analysed in this process, keyed by their AYSS samples and
-settings: the pipeline's report and then :mod:`sumo_ayss.rank` analyse the same runs, and
-the bootstrap is the slow part, so rank reuses the report's indices instead of redrawing them
-(the same draws would give the same index anyway, see :func:`_vut_rng`)."""
-
-
-def _samples_digest(runs: Sequence[Run]) -> str:
-    """A digest of the AYSS samples of ``runs``, in order (seeds without samples skipped)."""
-    digest = hashlib.blake2b(digest_size=16)
-    for r in runs:
-        if r.ayss is None or len(r.ayss) == 0:
-            continue
-        for values in (r.ayss.indicator, r.ayss.h):
-            arr = np.ascontiguousarray(values, dtype=np.float64)
-            digest.update(f"{arr.size};".encode())
-            digest.update(arr.tobytes())
-    return digest.hexdigest()
-
-
-def _case_vut_index(
-    case: str, vut: str, runs: Sequence[Run], options: CaseOptions
-) -> SafetyIndex | None:
-    """:func:`vut_safety_index` on the (case, VUT) stream, reused within the process."""
-    key = (
-        case,
-        vut,
-        _samples_digest(runs),
-        tuple(options.h_range),
-        options.index_bins,
-        options.level,
-        options.n_boot,
-        options.rng_seed,
-    )
-    if key in _INDEX_CACHE:
-        _INDEX_CACHE.move_to_end(key)
-        return _INDEX_CACHE[key]
-    idx = vut_safety_index(runs, options, _vut_rng(options, case, vut))
-    _INDEX_CACHE[key] = idx
-    while len(_INDEX_CACHE) > _INDEX_CACHE_SIZE:
-        _INDEX_CACHE.popitem(last=False)
-    return idx
 
 
 def vut_safety_index(
@@ -373,7 +327,7 @@ def analyse_case(
         for run in members:
             out.problems += [f"{run_label(run)}: {p}" for p in run.problems]
     for vut, members in runs.items() if paper else ():
-        idx = _case_vut_index(case, vut, members, options)
+        idx = vut_safety_index(members, options, _vut_rng(options, case, vut))
         if idx is not None:
             out.indices[vut] = idx
         else:
