@@ -25,8 +25,8 @@ import matplotlib as mpl
 mpl.use("Agg")
 from matplotlib.figure import Figure
 
-from sumo_ayss.analysis.crossplay import read_crossplay
 from sumo_ayss.atomic import atomic_write_text
+from sumo_ayss.report.load import read_crossplay_matrix
 from sumo_ayss.run_folder import CaseFolder, RunFolder, case_dir_for, read_outcome_json, seed_of_dir
 
 
@@ -111,7 +111,7 @@ def crossplay_figure(
     """``<root>/crossplay_by_opponent.png``: per ladder and case, per run, each opponent's
     mean episode reward across the VUTs in the known order (when crossplay.csv exists)."""
     cells = [
-        (ladder, case, run, expected, read_crossplay(path))
+        (ladder, case, run, expected, read_crossplay_matrix(path))
         for (ladder, case), runs in sorted(panels.items())
         for run, study, expected in runs
         if (path := CaseFolder(case_dir_for(study, case)).crossplay_csv).is_file()

@@ -120,10 +120,11 @@ def run_case(
 
 
 def read_matrix(csv_path: Path) -> Any:
-    """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of a ``crossplay.csv``."""
-    from sumo_ayss.analysis.crossplay import read_crossplay
+    """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of a ``crossplay.csv``
+    (:func:`sumo_ayss.report.load.read_crossplay_matrix`)."""
+    from sumo_ayss.report.load import read_crossplay_matrix
 
-    return read_crossplay(csv_path)
+    return read_crossplay_matrix(csv_path)
 
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:

@@ -10,8 +10,10 @@ candidate, training finished, done, failed) with the grid's counts and ETA.
 Each job (case, VUT, seed) trains (or resumes) its SPCP candidates, selects the SPCP, runs
 the outcome episodes and the Monte Carlo AYSS. In cross-play mode (``report.mode:
 crossplay``, the default) every SPCP of a case with two or more VUTs then drives against
-every VUT of the case (:func:`run_crossplay_stage`, :mod:`sumo_ayss.crossplay`); then one
-report covers the whole grid. Jobs
+every VUT of the case (:func:`run_crossplay_stage`, :mod:`sumo_ayss.crossplay`); then the
+finished runs are loaded and each case analysed once, and one report covers the whole grid
+(:func:`run_pipeline` returns the loaded runs and the analyses, which :mod:`sumo_ayss.rank`
+ranks without reading or bootstrapping again). Jobs
 run in parallel processes (one SUMO per process: libsumo holds one simulation each), or as
 Ray tasks. Every stage writes atomically and is skipped when its output exists and was made
 from the same inputs, so rerunning after a crash or Ctrl-C continues where it stopped. A
@@ -48,7 +50,7 @@ import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, NamedTuple
 
 from sumo_ayss.cli import prog
 from sumo_ayss.config import PipelineConfig, check_out_dir, load_experiment, load_pipeline, to_dict
@@ -59,12 +61,41 @@ from sumo_ayss.progress import JobStatus
 from sumo_ayss.run_folder import RunFolder
 from sumo_ayss.validation import suggest
 
+if TYPE_CHECKING:
+    from sumo_ayss.analysis.case import CaseAnalysis
+    from sumo_ayss.report.load import Run
+
 logger = logging.getLogger("sumo_ayss.pipeline")  # also when run as __main__
 
 Backend = Literal["local", "ray"]
 
 
-__all__ = ["load_pipeline", "main", "plan_jobs", "run_crossplay_stage", "run_pipeline"]
+__all__ = [
+    "PipelineResult",
+    "load_pipeline",
+    "main",
+    "plan_jobs",
+    "run_crossplay_stage",
+    "run_pipeline",
+]
+
+
+class PipelineResult(NamedTuple):
+    """What :func:`run_pipeline` did and found.
+
+    Attributes:
+        statuses: One per job, in grid order.
+        report: The report's ``report.html``, or None when no job finished.
+        runs: The finished jobs' run folders, loaded once
+            (:func:`sumo_ayss.report.load.load_run`), in the order of ``statuses``.
+        analyses: Every case's analysis (:func:`sumo_ayss.report.load.analyse_runs`, paper
+            mode included), computed once; the report's verdicts, and rank's rows.
+    """
+
+    statuses: list[JobStatus]
+    report: Path | None
+    runs: list[Run]
+    analyses: list[CaseAnalysis]
 
 
 def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
@@ -140,21 +171,23 @@ def configure_logging(live: bool) -> Any:
     return None
 
 
-def final_messages(statuses: Sequence[JobStatus], report: Path | None) -> list[str]:
-    """What the CLI prints at the end: failures, the report and its trust warnings."""
+def final_messages(result: PipelineResult) -> list[str]:
+    """What the CLI prints at the end: failures, the report and its trust warnings (from
+    the runs the pipeline loaded)."""
     lines = [
         f"FAILED {s.spec.name}: {s.error}  (log: {RunFolder(s.spec.run_dir).job_log})"
-        for s in statuses
+        for s in result.statuses
         if s.state == "failed"
     ]
-    done = [s for s in statuses if s.state == "done"]
+    done = [s for s in result.statuses if s.state == "done"]
     if done:
-        from sumo_ayss.report.checks import read_training, trust_warnings
+        from sumo_ayss.report.checks import trust_warnings
 
-        runs = [(s.spec.name, read_training(s.spec.run_dir)) for s in done]
+        training = {r.path: r.training for r in result.runs}
+        runs = [(s.spec.name, training[Path(s.spec.run_dir).resolve()]) for s in done]
         lines += [f"WARNING: {w}" for w in trust_warnings(runs)]
-    if report is not None:
-        lines.append(f"report: {report}")
+    if result.report is not None:
+        lines.append(f"report: {result.report}")
     return lines
 
 
@@ -165,8 +198,9 @@ def run_pipeline(
     address: str | None = None,
     live: bool = True,
     console: Any = None,
-) -> tuple[list[JobStatus], Path | None]:
-    """Run the grid, then the report over every finished job; return statuses and report.
+) -> PipelineResult:
+    """Run the grid, then load every finished job's run folder, analyse each case once and
+    write the report; return the statuses, the report, the loaded runs and the analyses.
 
     ``live``: show a live table when standard output is a terminal (``console``: the
     :class:`rich.console.Console` to draw it on, default a new one); job events are logged
@@ -191,15 +225,18 @@ def run_pipeline(
             jobs, min(cfg.n_workers, len(jobs)), cfg.retries, console if live else None
         )
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
-    report = None
-    if finished and cfg.report.mode == "crossplay":
+    if not finished:
+        return PipelineResult(statuses, None, [], [])
+    if cfg.report.mode == "crossplay":
         run_crossplay_stage(cfg, statuses)
-    if finished:
-        write_discriminability(cfg)
-        from sumo_ayss.report import write_report
+    write_discriminability(cfg)
+    from sumo_ayss.report.document import load_runs, write_report_for
+    from sumo_ayss.report.load import analyse_runs
 
-        report = write_report(finished, cfg.out / "report", options=cfg.report)
-    return statuses, report
+    runs = load_runs(finished)
+    analyses = analyse_runs(runs, cfg.report)  # once per case: the report's and rank's
+    report = write_report_for(runs, cfg.out / "report", analyses=analyses, options=cfg.report)
+    return PipelineResult(statuses, report, runs, analyses)
 
 
 def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> list[Path]:
@@ -297,7 +334,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     console = configure_logging(not args.no_live)
     try:
         cfg = load_pipeline(args.config, out=args.out, workers=args.workers, seeds=args.seeds)
-        statuses, report = run_pipeline(
+        result = run_pipeline(
             cfg,
             backend=args.backend,
             address=args.address,
@@ -309,9 +346,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     except KeyboardInterrupt:
         print("interrupted: no job runs any more; rerun the same command to resume", flush=True)
         sys.exit(130)
-    for line in final_messages(statuses, report):
+    for line in final_messages(result):
         print(line)
-    sys.exit(1 if any(s.state == "failed" for s in statuses) else 0)
+    sys.exit(1 if any(s.state == "failed" for s in result.statuses) else 0)
 
 
 if __name__ == "__main__":

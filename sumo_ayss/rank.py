@@ -21,10 +21,13 @@ available for a case follow, each tagged with its mode:
   ``<out>/<case>/crossplay.csv`` exists;
 * ``exposure`` (always available): the mean episode reward each VUT's own SPCPs extract
   (lower = safer), a paired t-test over shared seeds;
-* ``paper`` (computed in paper mode only, the AYSS bootstrap is slow): the paper's AYSS
+* ``paper`` (in paper mode only, the AYSS bootstrap is slow): the paper's AYSS
   aggressiveness index (:func:`sumo_ayss.analysis.ranking.safety_index`).
 
-``--no-run`` ranks existing run folders and never runs cross-play.
+After the pipeline, the rows come from the analyses the pipeline computed for its report
+(:class:`sumo_ayss.pipeline.PipelineResult`): no run folder is read and no bootstrap drawn
+again. ``--no-run`` ranks existing run folders (each read once, each case analysed once,
+the bootstrap only in paper mode) and never runs cross-play.
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from sumo_ayss.analysis.case import CaseAnalysis, analyse_case, exposure_sentence
+from sumo_ayss.analysis.case import CaseAnalysis, exposure_sentence
 from sumo_ayss.analysis.crossplay import crossplay_sentence
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.errors import AyssError, ConfigError
@@ -46,6 +49,7 @@ from sumo_ayss.run_folder import OUTCOME_JSON, RunFolder
 
 if TYPE_CHECKING:
     from sumo_ayss.config.report import ReportOptions
+    from sumo_ayss.report.load import Run
 
 RANKING_COLUMNS = [
     "case",
@@ -64,18 +68,25 @@ RANKING_COLUMNS = [
 
 
 def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> list[CaseAnalysis]:
-    """The analysis of every case among ``run_dirs`` (see :func:`analyse_case`).
+    """The analysis of every case among ``run_dirs``, for ranking without the pipeline.
 
-    Safety indices that the pipeline's report already computed in this process for the
-    same samples and settings are reused, not bootstrapped again.
+    Each run folder is read once (:func:`sumo_ayss.report.load.load_run`) and each case
+    analysed once (:func:`sumo_ayss.report.load.analyse_runs`); the AYSS bootstrap runs in
+    paper mode only.
     """
+    from sumo_ayss.report.load import load_run
+
+    return analyse_loaded([load_run(d) for d in run_dirs], options)
+
+
+def analyse_loaded(runs: Sequence[Run], options: ReportOptions | None = None) -> list[CaseAnalysis]:
+    """:func:`analyse` of runs already loaded."""
     from sumo_ayss.config.report import ReportOptions
-    from sumo_ayss.report.load import group_runs, load_run
+    from sumo_ayss.report.load import analyse_runs
 
     options = options or ReportOptions()
-    groups = group_runs([load_run(d) for d in run_dirs])
-    paper = options.mode == "paper"  # the AYSS bootstrap is only needed in paper mode
-    return [analyse_case(case, runs, options, paper=paper) for case, runs in groups.items()]
+    # The AYSS bootstrap is only needed in paper mode.
+    return analyse_runs(runs, options, paper=options.mode == "paper")
 
 
 #: The modes in the order their rows follow the chosen mode's.
@@ -86,12 +97,13 @@ def available_modes(a: CaseAnalysis) -> list[str]:
     """The modes with a ranking for this case, the analysis's own mode first.
 
     Cross-play needs the case's ``crossplay.csv``; exposure needs outcome summaries; paper
-    needs the safety indices (computed in paper mode).
+    needs the safety indices and is ranked in paper mode only (the pipeline's analyses
+    have them in every mode, for its report).
     """
     have = {
         "crossplay": bool(a.crossplay_rows),
         "exposure": bool(a.exposure_rows),
-        "paper": bool(a.ranking),
+        "paper": bool(a.ranking) and a.mode == "paper",
     }
     return sorted((m for m in MODE_ORDER if have[m]), key=lambda m: m != a.mode)
 
@@ -326,8 +338,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--no-live", action="store_true", help="no live table (log lines)")
     args = parser.parse_args(argv)
     console = configure_logging(not args.no_live)
-    report = None
-    statuses: list[Any] = []
+    result = None
     try:
         cfg = load_pipeline(args.config, workers=args.workers, out=args.out, seeds=args.seeds)
         if args.mode is not None:
@@ -338,11 +349,14 @@ def main(argv: Sequence[str] | None = None) -> None:
             complete = len(done) == len(planned)
             if not done:
                 raise ConfigError(f"--no-run: no finished run folder under {cfg.out}")
+            from sumo_ayss.report.load import load_run
+
+            runs = [load_run(d) for d in done]
+            analyses = analyse_loaded(runs, cfg.report)
         else:
-            statuses, report = run_pipeline(cfg, live=console is not None, console=console)
-            done = [s.spec.run_dir for s in statuses if s.state == "done"]
-            complete = len(done) == len(statuses)
-        analyses = analyse(done, cfg.report)
+            result = run_pipeline(cfg, live=console is not None, console=console)
+            complete = all(s.state == "done" for s in result.statuses)
+            analyses = result.analyses  # the report's: computed once, not again here
     except AyssError as e:
         sys.exit(f"error: {e}")
     except KeyboardInterrupt:
@@ -351,14 +365,16 @@ def main(argv: Sequence[str] | None = None) -> None:
     checks = order_checks(analyses, cfg.expected_order)
     _, md = write_ranking(ranking_rows(analyses), cfg.out, checks, cfg.expected_order)
     print(md.read_text())
-    if args.no_run:
-        from sumo_ayss.report.checks import read_training, trust_warnings
+    if result is None:  # --no-run
+        from sumo_ayss.report.checks import trust_warnings
 
-        runs = [(str(d), read_training(d)) for d in done]
-        for warning in trust_warnings(runs):
+        for warning in trust_warnings(
+            [(str(d), r.training) for d, r in zip(done, runs, strict=True)]
+        ):
             print(f"WARNING: {warning}")
-    for line in final_messages(statuses, report):
-        print(line)
+    else:
+        for line in final_messages(result):
+            print(line)
     sys.exit(0 if complete else 1)
 
 

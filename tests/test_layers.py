@@ -27,6 +27,39 @@ PACKAGE = "sumo_ayss"
 ROOT = Path(__file__).resolve().parents[1] / PACKAGE
 #: The largest module allowed [lines].
 MAX_MODULE_LINES = 500
+#: What :mod:`sumo_ayss.analysis` may import from the package besides itself: the error
+#: tree, range checks and the case records. It reads no file (no run_folder, report or
+#: config) and runs nothing (no sim, envs or agents): its loader
+#: (:mod:`sumo_ayss.report.load`) reads the run folders and the cross-play table and hands
+#: it arrays and records.
+ANALYSIS_MAY_IMPORT = (
+    "sumo_ayss.analysis",
+    "sumo_ayss.errors",
+    "sumo_ayss.validation",
+    "sumo_ayss.cases",
+)
+#: Calls that read or write files; none appears in :mod:`sumo_ayss.analysis`.
+FILE_CALLS = frozenset(
+    {
+        "open",
+        "read_text",
+        "read_bytes",
+        "write_text",
+        "write_bytes",
+        "is_file",
+        "exists",
+        "glob",
+        "rglob",
+        "iterdir",
+        "loadtxt",
+        "genfromtxt",
+        "load",
+        "save",
+        "savez",
+        "read_csv",
+        "savefig",
+    }
+)
 
 
 def module_files() -> dict[str, Path]:
@@ -153,6 +186,42 @@ def test_no_module_level_import_circles() -> None:
     modules = module_files()
     top, _ = import_edges(modules)
     assert circles(set(modules), top) == []
+
+
+def _within(name: str, prefixes: tuple[str, ...]) -> bool:
+    return any(name == p or name.startswith(p + ".") for p in prefixes)
+
+
+def test_analysis_imports_no_loader_and_reads_no_file() -> None:
+    """analysis/ is pure: it imports nothing from run_folder, report, config or the stages,
+    at module or function level, and calls no file reader or writer."""
+    modules = module_files()
+    assert "sumo_ayss.analysis.case" in modules
+    top, lazy = import_edges(modules)
+    outside = sorted(
+        (a, b)
+        for a, b in top | lazy
+        if _within(a, ("sumo_ayss.analysis",)) and not _within(b, ANALYSIS_MAY_IMPORT)
+    )
+    assert outside == []
+    calls = []
+    for name, path in modules.items():
+        if not _within(name, ("sumo_ayss.analysis",)):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Call):
+                f = node.func
+                called = f.attr if isinstance(f, ast.Attribute) else getattr(f, "id", "")
+                if called in FILE_CALLS:
+                    calls.append(f"{name}:{node.lineno} {called}")
+    assert calls == []
+
+
+def test_the_analysis_rule_catches_a_loader_import() -> None:
+    """The rule above, on an edge it must refuse (the one analysis/ had before)."""
+    assert not _within("sumo_ayss.run_folder", ANALYSIS_MAY_IMPORT)
+    assert not _within("sumo_ayss.report.load", ANALYSIS_MAY_IMPORT)
+    assert _within("sumo_ayss.cases.cut_in", ANALYSIS_MAY_IMPORT)
 
 
 def modules_over_limit() -> dict[str, int]:

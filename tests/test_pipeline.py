@@ -65,7 +65,7 @@ def test_failing_job_is_retried_then_reported_others_complete(tmp_path: Path) ->
     broken = cfg.out / "car_following" / "pi2" / "seed_0"
     broken.mkdir(parents=True)
     (broken / "config.yaml").write_text("not: [a, valid, run\n")  # a corrupt run folder
-    statuses, report = run_pipeline(cfg, live=False)
+    statuses, report, *_ = run_pipeline(cfg, live=False)
     by_name = {s.spec.name: s for s in statuses}
     bad = by_name["car_following/pi2/seed_0"]
     assert bad.state == "failed" and bad.attempts == 2  # tried, retried once, reported
@@ -87,7 +87,7 @@ def test_failing_job_is_retried_then_reported_others_complete(tmp_path: Path) ->
 def test_crossplay_mode_runs_the_crossplay_stage_and_reports_it(tmp_path: Path) -> None:
     cfg = load_pipeline(write_configs(tmp_path, [0]))
     assert cfg.report.mode == "crossplay" and cfg.report.crossplay_blocks == "seed"
-    statuses, report = run_pipeline(cfg, live=False)
+    statuses, report, *_ = run_pipeline(cfg, live=False)
     assert all(s.state == "done" for s in statuses)
     case = cfg.out / "car_following"
     record = json.loads((case / "crossplay.json").read_text())
@@ -231,7 +231,8 @@ def test_progress_is_logged_per_job_event_and_small_budget_is_flagged(
 
     cfg = load_pipeline(write_configs(tmp_path, [0]))  # 2 jobs, 1 worker
     with caplog.at_level(logging.INFO, logger="sumo_ayss.pipeline"):
-        statuses, report = run_pipeline(cfg, live=True)  # not a terminal: log lines only
+        result = run_pipeline(cfg, live=True)  # not a terminal: log lines only
+    statuses, report = result.statuses, result.report
     lines = [r.getMessage() for r in caplog.records if r.name == "sumo_ayss.pipeline"]
     first = statuses[0].spec.name
     assert any(
@@ -242,7 +243,7 @@ def test_progress_is_logged_per_job_event_and_small_budget_is_flagged(
     done = [x for x in lines if ": done in " in x]
     assert len(done) == 2 and "1/2 done, 0 running, 1 queued" in done[0]
     assert "training" in done[0] and " s, evaluation " in done[0]
-    messages = final_messages(statuses, report)
+    messages = final_messages(result)
     assert messages[0].startswith("WARNING: Small training budget: 600 transitions per run")
     assert messages[-1] == f"report: {report}"
     for written in (cfg.out / "pipeline.json", report, report.with_name("summary.md")):

@@ -64,31 +64,7 @@ def test_exposure_mode_ranks_by_outcome_reward_and_checks_a_known_order(tmp_path
     assert (tmp_path / "order_check.json").is_file()
 
 
-def test_rank_reuses_the_reports_bootstrap(tmp_path, monkeypatch):
-    """After the report analysed the runs, rank draws no bootstrap again: same indices."""
-    import sumo_ayss.analysis.case as case_mod
-    from sumo_ayss.report import write_report
-
-    dirs = _three_vuts(tmp_path, monkeypatch)
-    options = ReportOptions(mode="paper", n_boot=300)
-    write_report([tmp_path], tmp_path / "report", options=options)
-    calls = []
-    real = case_mod.vut_safety_index
-    monkeypatch.setattr(
-        case_mod, "vut_safety_index", lambda *a, **k: calls.append(1) or real(*a, **k)
-    )
-    first = analyse(dirs, options)
-    assert calls == [], "rank recomputed a safety index the report had computed"
-    second = analyse(dirs, ReportOptions(mode="paper", n_boot=300, rng_seed=1))
-    assert len(calls) == 3, "another bootstrap seed must give new indices"
-    assert first[0].indices["pi1"].point == second[0].indices["pi1"].point
-
-
-def test_rank_no_run_checks_the_known_order_in_every_mode_available(tmp_path, monkeypatch, capsys):
-    """``rank --no-run`` on existing folders: a row set and an order check per (case, mode);
-    cross-play rows where the case's crossplay.csv exists, and no cross-play is run."""
-    _three_vuts(tmp_path / "runs", monkeypatch)
-    expected = ["cautious", "pi2", "pi1"]
+def _pipe_yaml(tmp_path: Path, expected: list[str], **extra) -> Path:
     pipe = tmp_path / "pipe.yaml"
     pipe.write_text(
         yaml.safe_dump(
@@ -100,9 +76,99 @@ def test_rank_no_run_checks_the_known_order_in_every_mode_available(tmp_path, mo
                 "vuts": {"cautious": {"model": "IDM", "params": {"minGap": 12.0}}},
                 "out": "runs",
                 "expected_order": expected,
+                **extra,
             }
         )
     )
+    return pipe
+
+
+def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, monkeypatch, capsys):
+    """``rank`` with the pipeline: the pipeline reads each run folder and the cross-play
+    table once and analyses each case once (one bootstrap per VUT) for its report, and rank
+    ranks those analyses; the rows equal ``--no-run``'s, which also computes once."""
+    import sumo_ayss.analysis.case as case_mod
+    import sumo_ayss.pipeline as pipeline_mod
+    import sumo_ayss.report.load as load_mod
+    from sumo_ayss.progress import JobStatus
+
+    dirs = _three_vuts(tmp_path / "runs", monkeypatch)
+    expected = ["cautious", "pi2", "pi1"]
+    make_crossplay(tmp_path / "runs" / "car_following", expected, [0, 1, 2])
+    pipe = _pipe_yaml(tmp_path, expected, report={"n_boot": 300})
+    # The grid's jobs are the finished folders above (no training here).
+    monkeypatch.setattr(
+        pipeline_mod,
+        "run_grid_local",
+        lambda jobs, *a, **k: [JobStatus(spec=j, state="done") for j in jobs],
+    )
+    monkeypatch.setattr(pipeline_mod, "write_discriminability", lambda cfg: None)
+    counts: dict[str, list[str]] = {"ayss": [], "crossplay": [], "bootstrap": [], "case": []}
+
+    def counted(key, real, label):
+        def wrapper(*a, **k):
+            counts[key].append(label(*a, **k))
+            return real(*a, **k)
+
+        return wrapper
+
+    monkeypatch.setattr(
+        load_mod, "read_ayss", counted("ayss", load_mod.read_ayss, lambda p: str(p.parent))
+    )
+    monkeypatch.setattr(
+        load_mod,
+        "read_crossplay_matrix",
+        counted("crossplay", load_mod.read_crossplay_matrix, lambda p: str(p)),
+    )
+    monkeypatch.setattr(
+        case_mod,
+        "vut_safety_index",
+        counted("bootstrap", case_mod.vut_safety_index, lambda runs, *a: runs[0].vut),
+    )
+    monkeypatch.setattr(
+        load_mod, "analyse_case", counted("case", load_mod.analyse_case, lambda c, *a, **k: c)
+    )
+    with pytest.raises(SystemExit) as done:
+        main([str(pipe), "--no-live", "--mode", "paper"])
+    assert done.value.code == 0
+    assert sorted(counts["ayss"]) == sorted(str(d.resolve()) for d in dirs)  # each once
+    assert len(counts["crossplay"]) == 1
+    assert sorted(counts["bootstrap"]) == sorted(expected)  # one bootstrap per VUT
+    assert counts["case"] == ["car_following"]
+    assert (tmp_path / "runs" / "report" / "summary.md").is_file()
+    with_pipeline = (tmp_path / "runs" / "ranking.csv").read_text()
+    modes = [line.split(",")[1] for line in with_pipeline.splitlines()[1:]]
+    assert modes == ["paper"] * 3 + ["crossplay"] * 3 + ["exposure"] * 3
+
+    for seen in counts.values():
+        seen.clear()
+    with pytest.raises(SystemExit):
+        main([str(pipe), "--no-run", "--no-live", "--mode", "paper"])
+    assert len(counts["ayss"]) == 9 and len(counts["crossplay"]) == 1
+    assert len(counts["bootstrap"]) == 3 and counts["case"] == ["car_following"]
+    assert (tmp_path / "runs" / "ranking.csv").read_text() == with_pipeline
+    capsys.readouterr()
+
+
+def test_paper_rows_only_in_paper_mode_even_from_the_pipelines_analyses(tmp_path, monkeypatch):
+    """The pipeline's analyses carry the paper mode (its report shows it); rank lists paper
+    rows in paper mode only, as ``--no-run`` (which skips the bootstrap otherwise) does."""
+    from sumo_ayss.report.load import analyse_runs, load_run
+
+    dirs = _three_vuts(tmp_path, monkeypatch)
+    options = ReportOptions(mode="exposure", n_boot=200)
+    full = analyse_runs([load_run(d) for d in dirs], options)  # paper mode computed
+    assert full[0].ranking
+    assert ranking_rows(full) == ranking_rows(analyse(dirs, options))
+    assert {r["mode"] for r in ranking_rows(full)} == {"exposure"}
+
+
+def test_rank_no_run_checks_the_known_order_in_every_mode_available(tmp_path, monkeypatch, capsys):
+    """``rank --no-run`` on existing folders: a row set and an order check per (case, mode);
+    cross-play rows where the case's crossplay.csv exists, and no cross-play is run."""
+    _three_vuts(tmp_path / "runs", monkeypatch)
+    expected = ["cautious", "pi2", "pi1"]
+    pipe = _pipe_yaml(tmp_path, expected)
     with pytest.raises(SystemExit) as done:  # no crossplay.csv yet: exposure only
         main([str(pipe), "--no-run", "--no-live"])
     assert done.value.code == 0

@@ -36,7 +36,7 @@ def test_grid_on_a_local_ray_instance(tmp_path: Path) -> None:
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     try:
         cfg = load_pipeline(write_configs(tmp_path, [0]))
-        statuses, report = run_pipeline(cfg, backend="ray", live=False)
+        statuses, report, *_ = run_pipeline(cfg, backend="ray", live=False)
     finally:
         ray.shutdown()
     assert [s.state for s in statuses] == ["done", "done"]

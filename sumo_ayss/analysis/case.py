@@ -4,18 +4,17 @@
 :class:`sumo_ayss.report.load.Run`) into a :class:`CaseAnalysis`: the paper mode (AYSS
 safety index per VUT, hierarchical bootstrap, pairwise verdicts under
 :func:`~.significance.pair_verdict`), the exposure mode (seed-level ranking of the mean
-episode reward the SPCPs extract), the cross-play mode (the case folder's ``crossplay.csv``
-when the cross-play stage wrote one, :mod:`.crossplay`) and the premise check. Both the
-report and :mod:`sumo_ayss.rank` read it; nothing here draws or renders.
+episode reward the SPCPs extract), the cross-play mode (the case's cross-play matrix, which
+its loader read from ``crossplay.csv``, :mod:`.crossplay`) and the premise check. Both the
+report and :mod:`sumo_ayss.rank` read it; the pipeline analyses each case once and hands the
+analysis to both. Nothing here reads a file, draws or renders.
 """
 
 from __future__ import annotations
 
-import hashlib
 import itertools
 import logging
 import zlib
-from collections import OrderedDict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,10 +23,12 @@ from typing import Any, Literal, Protocol
 import numpy as np
 
 from sumo_ayss.analysis.crossplay import (
+    CROSSPLAY_COMMAND,
+    NO_CROSSPLAY_TABLE,
+    CrossplayInput,
     CrossplayMatrix,
     crossplay_sentence,
     rank_crossplay,
-    read_crossplay,
 )
 from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.analysis.premise import Premise, premise_check
@@ -41,11 +42,9 @@ from sumo_ayss.analysis.seeds import (
 )
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
 from sumo_ayss.cases import Case, case_info
-from sumo_ayss.errors import ConfigError, TableError
-from sumo_ayss.run_folder import CaseFolder
+from sumo_ayss.errors import ConfigError
 
 __all__ = [
-    "CROSSPLAY_COMMAND",
     "EXPOSURE_SCORE",
     "CaseAnalysis",
     "CaseOptions",
@@ -108,51 +107,6 @@ def run_label(run: Run) -> str:
 def _vut_rng(options: CaseOptions, case: str, vut: str) -> np.random.Generator:
     """A bootstrap stream per (case, VUT), stable whatever other VUTs are in the report."""
     return np.random.default_rng([options.rng_seed, zlib.crc32(f"{case}/{vut}".encode())])
-
-
-_INDEX_CACHE: OrderedDict[tuple[Any, ...], SafetyIndex | None] = OrderedDict()
-_INDEX_CACHE_SIZE = 16
-"""Safety indices of the last VUTs analysed in this process, keyed by their AYSS samples and
-settings: the pipeline's report and then :mod:`sumo_ayss.rank` analyse the same runs, and
-the bootstrap is the slow part, so rank reuses the report's indices instead of redrawing them
-(the same draws would give the same index anyway, see :func:`_vut_rng`)."""
-
-
-def _samples_digest(runs: Sequence[Run]) -> str:
-    """A digest of the AYSS samples of ``runs``, in order (seeds without samples skipped)."""
-    digest = hashlib.blake2b(digest_size=16)
-    for r in runs:
-        if r.ayss is None or len(r.ayss) == 0:
-            continue
-        for values in (r.ayss.indicator, r.ayss.h):
-            arr = np.ascontiguousarray(values, dtype=np.float64)
-            digest.update(f"{arr.size};".encode())
-            digest.update(arr.tobytes())
-    return digest.hexdigest()
-
-
-def _case_vut_index(
-    case: str, vut: str, runs: Sequence[Run], options: CaseOptions
-) -> SafetyIndex | None:
-    """:func:`vut_safety_index` on the (case, VUT) stream, reused within the process."""
-    key = (
-        case,
-        vut,
-        _samples_digest(runs),
-        tuple(options.h_range),
-        options.index_bins,
-        options.level,
-        options.n_boot,
-        options.rng_seed,
-    )
-    if key in _INDEX_CACHE:
-        _INDEX_CACHE.move_to_end(key)
-        return _INDEX_CACHE[key]
-    idx = vut_safety_index(runs, options, _vut_rng(options, case, vut))
-    _INDEX_CACHE[key] = idx
-    while len(_INDEX_CACHE) > _INDEX_CACHE_SIZE:
-        _INDEX_CACHE.popitem(last=False)
-    return idx
 
 
 def vut_safety_index(
@@ -246,9 +200,6 @@ class CaseAnalysis:
     crossplay_missing: str = ""
 
 
-CROSSPLAY_COMMAND = "python -m sumo_ayss.crossplay <config>"
-"""The command that writes a case's cross-play table."""
-
 EXPOSURE_SCORE = "extract {amount} {more_less} reward per episode"
 """How an exposure difference reads in a verdict sentence."""
 
@@ -285,9 +236,9 @@ def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
     out.premise = premise_check(metrics, tolerances=options.premise_tolerances, level=options.level)
 
 
-def _crossplay(out: CaseAnalysis, options: CaseOptions) -> None:
-    """Cross-play ranking from the case folder's ``crossplay.csv`` (the parent of the VUT
-    folders), or why there is none; a table not of exactly these VUTs and runs is not used."""
+def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -> None:
+    """Cross-play ranking from the case's cross-play table as its loader found it, or why
+    there is none; a table not of exactly these VUTs and runs is not used."""
     out.crossplay_blocks = options.crossplay_blocks
     if len(out.runs) < 2:
         only = next(iter(out.runs), "?")
@@ -296,32 +247,21 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions) -> None:
             "cross-play compares two or more"
         )
         return
-    case_dirs = sorted({Path(r.path).parent.parent for rs in out.runs.values() for r in rs})
-    if len(case_dirs) != 1:
-        folders = ", ".join(map(str, case_dirs))
-        out.crossplay_missing = (
-            f"no cross-play table: the runs lie in several case folders ({folders})"
-        )
-        return
-    path = CaseFolder(case_dirs[0]).crossplay_csv
-    if not path.is_file():
-        out.crossplay_missing = f"no cross-play table for this case (run {CROSSPLAY_COMMAND})"
-        return
-    try:
-        m = read_crossplay(path)
-    except (TableError, ConfigError) as exc:
-        out.crossplay_missing = f"the cross-play table is unreadable ({exc})"
-        out.problems.append(f"{path}: {exc}")
+    m = found.matrix
+    if m is None:
+        out.crossplay_missing = found.missing or NO_CROSSPLAY_TABLE
+        if found.problem:
+            out.problems.append(found.problem)
         return
     opponents = {(v, int(r.seed)) for v, rs in out.runs.items() for r in rs if r.seed is not None}
     if set(m.vuts) != set(out.runs) or set(m.opponents) != opponents:
         out.crossplay_missing = (
-            f"the cross-play table {path} is not of these runs (VUTs {', '.join(m.vuts)}; "
+            f"the cross-play table {found.path} is not of these runs (VUTs {', '.join(m.vuts)}; "
             f"{len(m.opponents)} opponents, this case has {len(opponents)} runs with a seed); "
             f"run {CROSSPLAY_COMMAND} again once every job is done"
         )
         return
-    out.crossplay, out.crossplay_path = m, path
+    out.crossplay, out.crossplay_path = m, found.path
     out.crossplay_rows, out.crossplay_pairs = rank_crossplay(
         m, blocks=options.crossplay_blocks, level=options.level, alpha=options.welch_alpha
     )
@@ -360,7 +300,12 @@ def premise_sentence(premise: Premise | None, options: CaseOptions) -> str:
 
 
 def analyse_case(
-    case: str, runs: dict[str, list[Run]], options: CaseOptions, *, paper: bool = True
+    case: str,
+    runs: dict[str, list[Run]],
+    options: CaseOptions,
+    *,
+    crossplay: CrossplayInput | None = None,
+    paper: bool = True,
 ) -> CaseAnalysis:
     """Safety index per VUT, ranking, pairwise verdicts and the headline of one case.
 
@@ -368,6 +313,8 @@ def analyse_case(
         case: Case name.
         runs: ``{vut: runs}``.
         options: Statistical settings.
+        crossplay: The case's cross-play table as its loader found it
+            (:func:`sumo_ayss.report.load.load_crossplay`); None: no table.
         paper: Compute the paper mode (AYSS safety indices and their bootstrap, the slow
             part); the report always does, a ranking in exposure mode need not.
 
@@ -380,7 +327,7 @@ def analyse_case(
         for run in members:
             out.problems += [f"{run_label(run)}: {p}" for p in run.problems]
     for vut, members in runs.items() if paper else ():
-        idx = _case_vut_index(case, vut, members, options)
+        idx = vut_safety_index(members, options, _vut_rng(options, case, vut))
         if idx is not None:
             out.indices[vut] = idx
         else:
@@ -417,7 +364,7 @@ def analyse_case(
         if out.headline_kind == "safer":
             out.headline_kind = "warning"
     out.paper_headline, out.paper_ranking_line = out.headline, out.ranking_line
-    _crossplay(out, options)
+    _crossplay(out, options, crossplay or CrossplayInput())
     out.mode = out.ranking_mode = options.mode
     if options.mode == "exposure":
         _exposure_headline(out)

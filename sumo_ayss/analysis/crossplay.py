@@ -35,19 +35,26 @@ import numpy.typing as npt
 
 from sumo_ayss.analysis.seeds import SeedComparison, SeedRankRow, SeedScores, rank_seeds
 from sumo_ayss.errors import ConfigError
-from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, read_table
 
 __all__ = [
     "BLOCKS",
+    "CROSSPLAY_COMMAND",
+    "NO_CROSSPLAY_TABLE",
+    "CrossplayInput",
     "CrossplayMatrix",
     "crossplay_matrix",
     "crossplay_sentence",
     "rank_crossplay",
-    "read_crossplay",
 ]
 
 #: Block units of the paired test: training seeds (default) or single opponents.
 BLOCKS = ("seed", "opponent")
+
+CROSSPLAY_COMMAND = "python -m sumo_ayss.crossplay <config>"
+"""The command that writes a case's cross-play table."""
+
+NO_CROSSPLAY_TABLE = f"no cross-play table for this case (run {CROSSPLAY_COMMAND})"
+"""Why a case has no cross-play ranking when its loader found no table."""
 
 
 @dataclass(frozen=True)
@@ -135,18 +142,25 @@ def crossplay_matrix(
     return CrossplayMatrix(vuts, opps, sums / counts, crashes / counts, int(counts[0, 0]))
 
 
-def read_crossplay(csv_path: Path) -> CrossplayMatrix:
-    """The :class:`CrossplayMatrix` of a case folder's ``crossplay.csv``.
+@dataclass(frozen=True)
+class CrossplayInput:
+    """A case's cross-play table as its loader found it: the matrix, or why there is none.
 
-    Raises:
-        TableError: If the file is missing or does not match
-            :data:`~sumo_ayss.run_folder.CROSSPLAY_SCHEMA`.
-        ConfigError: If the design is not complete and balanced (:func:`crossplay_matrix`).
+    The loader (:func:`sumo_ayss.report.load.load_crossplay`) reads the file; nothing in
+    :mod:`sumo_ayss.analysis` does.
+
+    Attributes:
+        matrix: The table's :class:`CrossplayMatrix`, or None (the default: no table found).
+        path: The table read (shown in the report), or None.
+        missing: Why there is no matrix, one sentence; "" with no matrix means that no
+            table was found (:data:`NO_CROSSPLAY_TABLE`).
+        problem: A line for the case's problem list (an unreadable table), or "".
     """
-    c = read_table(csv_path, CROSSPLAY_SCHEMA).columns
-    return crossplay_matrix(
-        c["vut"], c["opponent_vut"], c["opponent_seed"], c["episode_return"], c["collided"]
-    )
+
+    matrix: CrossplayMatrix | None = None
+    path: Path | None = None
+    missing: str = ""
+    problem: str = ""
 
 
 def rank_crossplay(

@@ -1,9 +1,11 @@
 """The report: run folders in, ``report.html`` + ``summary.md`` + PNG figures out.
 
-:func:`write_report` reads run folders (:mod:`.load`), checks that they may be pooled
-(:mod:`.checks`), analyses each case (:func:`sumo_ayss.analysis.case.analyse_case`: safety
-indices, verdicts, exposure ranking, premise), composes the sections (:mod:`.sections`) into
-one list of blocks (:mod:`.blocks`) and renders it twice (:mod:`.render`):
+:func:`write_report` reads run folders (:func:`load_runs`, :mod:`.load`; and checks that they
+may be pooled, :mod:`.checks`), analyses each case (:func:`.load.analyse_runs`: safety
+indices, verdicts, exposure and cross-play rankings, premise) unless its caller hands the
+analyses in (the pipeline, which passes them on to rank), composes the sections
+(:mod:`.sections`) into one list of blocks (:mod:`.blocks`) and renders it twice
+(:mod:`.render`):
 
 * ``report.html`` — one self-contained file: figures embedded as base64 PNG, inline CSS, no
   JavaScript, no network; it opens offline;
@@ -37,7 +39,14 @@ from sumo_ayss.report.blocks import (
 )
 from sumo_ayss.report.checks import mixing_problems, trust_warnings
 from sumo_ayss.report.figstyle import vut_colors
-from sumo_ayss.report.load import RUN_FILES, Run, find_run_dirs, group_runs, load_run
+from sumo_ayss.report.load import (
+    RUN_FILES,
+    Run,
+    analyse_runs,
+    find_run_dirs,
+    group_runs,
+    load_run,
+)
 from sumo_ayss.report.render import render_html, render_markdown
 from sumo_ayss.report.sections.case import case_blocks, verdict_lines
 from sumo_ayss.report.sections.common import display_path
@@ -59,12 +68,14 @@ __all__ = [
     "Table",
     "analyse_case",
     "build_report",
+    "load_runs",
     "pair_verdict",
     "render_html",
     "render_markdown",
     "significance_rule",
     "vut_safety_index",
     "write_report",
+    "write_report_for",
 ]
 
 logger = logging.getLogger(__name__)
@@ -80,6 +91,7 @@ def build_report(
     *,
     title: str = DEFAULT_TITLE,
     options: ReportOptions | None = None,
+    analyses: Sequence[CaseAnalysis] | None = None,
 ) -> Report:
     """Computes the statistics, draws the figures into ``out_dir`` and assembles the blocks.
 
@@ -88,6 +100,8 @@ def build_report(
         out_dir: Folder for the PNG figures (created).
         title: Report title.
         options: Statistical settings; defaults if None.
+        analyses: The analyses of ``runs`` (:func:`.load.analyse_runs` with ``options``
+            and the paper mode), when the caller already has them; computed here if None.
 
     Returns:
         The :class:`Report`.
@@ -96,7 +110,8 @@ def build_report(
     out_dir.mkdir(parents=True, exist_ok=True)
     groups = group_runs(runs)
     colors = vut_colors(sorted({r.vut for r in runs}))
-    analyses = [analyse_case(case, by_vut, options) for case, by_vut in groups.items()]
+    if analyses is None:
+        analyses = analyse_runs(runs, options)
     now = dt.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z")
     n_seeds = ", ".join(
         f"{case}: " + ", ".join(f"{vut} × {len(m)}" for vut, m in by_vut.items())
@@ -138,6 +153,36 @@ def build_report(
     return Report(title, subtitle, tuple(blocks))
 
 
+def load_runs(paths: Sequence[str | Path]) -> list[Run]:
+    """The run folders among ``paths`` (and below them), loaded, checked to be poolable.
+
+    Args:
+        paths: Run folders ``<out>/<case>/<vut>/seed_<k>`` and/or roots to search.
+
+    Returns:
+        The loaded runs (:func:`.load.load_run`), in :func:`find_run_dirs` order.
+
+    Raises:
+        ConfigError: If ``paths`` is empty, a path is not a folder, no run folder is found,
+            or the runs must not be pooled into one report (:func:`.checks.mixing_problems`).
+    """
+    if not paths:
+        raise ConfigError("paths: expected at least one run folder or root")
+    run_dirs = find_run_dirs(paths)
+    if not run_dirs:
+        raise ConfigError(f"no run folder (with {RUN_FILES.config}) under {list(map(str, paths))}")
+    runs = [load_run(d) for d in run_dirs]
+    problems = mixing_problems(
+        [(r.case, r.vut, r.seed, display_path(r.path, Path.cwd()), r.training) for r in runs]
+    )
+    if problems:
+        raise ConfigError(
+            "these runs must not be pooled into one report (report each group separately, "
+            "e.g. one pipeline output folder at a time):\n  " + "\n  ".join(problems)
+        )
+    return runs
+
+
 def write_report(
     paths: Sequence[str | Path],
     out_dir: str | Path | None = None,
@@ -157,31 +202,40 @@ def write_report(
         The path of ``report.html``.
 
     Raises:
-        ConfigError: If ``paths`` is empty, a path is not a folder, or no run folder is
-            found.
+        ConfigError: As :func:`load_runs`.
     """
-    if not paths:
-        raise ConfigError("paths: expected at least one run folder or root")
-    run_dirs = find_run_dirs(paths)
-    if not run_dirs:
-        raise ConfigError(f"no run folder (with {RUN_FILES.config}) under {list(map(str, paths))}")
+    runs = load_runs(paths)
     target = Path(out_dir) if out_dir is not None else Path(paths[0]) / "report"
-    runs = [load_run(d) for d in run_dirs]
-    problems = mixing_problems(
-        [(r.case, r.vut, r.seed, display_path(r.path, Path.cwd()), r.training) for r in runs]
-    )
-    if problems:
-        raise ConfigError(
-            "these runs must not be pooled into one report (report each group separately, "
-            "e.g. one pipeline output folder at a time):\n  " + "\n  ".join(problems)
-        )
+    return write_report_for(runs, target, title=title, options=options)
+
+
+def write_report_for(
+    runs: Sequence[Run],
+    out_dir: Path,
+    *,
+    analyses: Sequence[CaseAnalysis] | None = None,
+    title: str = DEFAULT_TITLE,
+    options: ReportOptions | None = None,
+) -> Path:
+    """Writes ``report.html``, ``summary.md`` and the PNGs of loaded runs into ``out_dir``.
+
+    Args:
+        runs: Loaded runs (:func:`load_runs`).
+        out_dir: Output folder.
+        analyses: Their analyses, when the caller has them (see :func:`build_report`).
+        title: Report title.
+        options: Statistical settings; defaults if None.
+
+    Returns:
+        The path of ``report.html``.
+    """
     for warning in trust_warnings([(f"{r.case} {r.label}", r.training) for r in runs]):
         logger.warning("%s", warning)
-    report = build_report(runs, target, title=title, options=options)
-    html_path = target / HTML_NAME
+    report = build_report(runs, out_dir, title=title, options=options, analyses=analyses)
+    html_path = out_dir / HTML_NAME
     from sumo_ayss.atomic import atomic_write_text
 
     atomic_write_text(html_path, render_html(report))
-    atomic_write_text(target / MARKDOWN_NAME, render_markdown(report, target))
+    atomic_write_text(out_dir / MARKDOWN_NAME, render_markdown(report, out_dir))
     logger.info("report written to %s", html_path)
     return html_path

@@ -1,8 +1,12 @@
-"""Read run folders back for the report, tolerating missing and broken files.
+"""Read run folders and case folders back for the report and rank, tolerating missing and
+broken files.
 
 A run folder ``<out>/<case>/<vut>/seed_<k>/`` is written by :mod:`sumo_ayss.train` and by the
-evaluate stage; its file names and the schema of each file are in :mod:`sumo_ayss.run_folder`,
-whose readers this module calls (one reader per file).
+evaluate stage, a case's ``crossplay.csv`` by the cross-play stage; their file names and the
+schema of each file are in :mod:`sumo_ayss.run_folder`, whose readers this module calls (one
+reader per file). :mod:`sumo_ayss.analysis` reads no file: :func:`analyse_runs` hands it the
+loaded runs and each case's cross-play matrix (:func:`load_crossplay`), one analysis per case
+for whoever needs it (the report, rank).
 
 Nothing here raises on a missing or unreadable file: :func:`load_run` records a sentence per
 problem in :attr:`Run.problems` and leaves the field empty, so a report on a run that has not
@@ -22,18 +26,22 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from sumo_ayss.analysis.case import CaseAnalysis, CaseOptions, analyse_case
+from sumo_ayss.analysis.crossplay import CrossplayInput, CrossplayMatrix, crossplay_matrix
 from sumo_ayss.cases import case_names, case_of_indicator
 from sumo_ayss.config import RewardConfig, build
-from sumo_ayss.errors import AyssError, ConfigError
+from sumo_ayss.errors import AyssError, ConfigError, TableError
 from sumo_ayss.report.checks import Training, read_training
 from sumo_ayss.run_folder import (
     AYSS_CSV,
     AYSS_SCHEMA,
     CONFIG_YAML,
+    CROSSPLAY_SCHEMA,
     EVAL_CSV,
     OUTCOME_JSON,
     SPCP_JSON,
     VERSIONS_JSON,
+    CaseFolder,
     Estimate,
     Outcome,
     OutcomeSubset,
@@ -60,10 +68,13 @@ __all__ = [
     "Run",
     "RunFiles",
     "SpcpChoice",
+    "analyse_runs",
     "find_run_dirs",
     "group_runs",
+    "load_crossplay",
     "load_run",
     "read_ayss",
+    "read_crossplay_matrix",
     "read_eval_curve",
     "read_outcome",
 ]
@@ -350,3 +361,72 @@ def _check_ayss(run: Run) -> None:
             f"{AYSS_CSV}: indicator {ayss.indicator_name!r} belongs to {expected_case}, "
             f"not {run.case}"
         )
+
+
+# --------------------------------------------------------------------------- cases
+
+
+def read_crossplay_matrix(path: Path) -> CrossplayMatrix:
+    """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of a case folder's
+    ``crossplay.csv`` (read against :data:`~sumo_ayss.run_folder.CROSSPLAY_SCHEMA`).
+
+    Raises:
+        TableError: If the file is missing or does not follow the schema.
+        ConfigError: If the design is not complete and balanced
+            (:func:`~sumo_ayss.analysis.crossplay.crossplay_matrix`).
+    """
+    c = read_table(path, CROSSPLAY_SCHEMA).columns
+    return crossplay_matrix(
+        c["vut"], c["opponent_vut"], c["opponent_seed"], c["episode_return"], c["collided"]
+    )
+
+
+def load_crossplay(runs: Mapping[str, Sequence[Run]]) -> CrossplayInput:
+    """The cross-play table of one case's runs: ``crossplay.csv`` of the case folder they lie
+    in (the parent of the VUT folders), read against
+    :data:`~sumo_ayss.run_folder.CROSSPLAY_SCHEMA`; never raises.
+
+    Args:
+        runs: ``{vut: runs}`` of one case.
+
+    Returns:
+        The :class:`~sumo_ayss.analysis.crossplay.CrossplayInput`: the matrix and its path,
+        or why there is none (no table, runs in several case folders, an unreadable table
+        or one whose design is not complete and balanced).
+    """
+    case_dirs = sorted({Path(r.path).parent.parent for rs in runs.values() for r in rs})
+    if len(case_dirs) != 1:
+        folders = ", ".join(map(str, case_dirs))
+        return CrossplayInput(
+            missing=f"no cross-play table: the runs lie in several case folders ({folders})"
+        )
+    path = CaseFolder(case_dirs[0]).crossplay_csv
+    if not path.is_file():
+        return CrossplayInput()
+    try:
+        matrix = read_crossplay_matrix(path)
+    except (TableError, ConfigError) as exc:
+        return CrossplayInput(
+            path=path,
+            missing=f"the cross-play table is unreadable ({exc})",
+            problem=f"{path}: {exc}",
+        )
+    return CrossplayInput(matrix, path)
+
+
+def analyse_runs(
+    runs: Sequence[Run], options: CaseOptions, *, paper: bool = True
+) -> list[CaseAnalysis]:
+    """The analysis of every case among ``runs``, each computed once, in :func:`group_runs`
+    order (:func:`~sumo_ayss.analysis.case.analyse_case` on the case's runs and its
+    cross-play table, :func:`load_crossplay`).
+
+    Args:
+        runs: Loaded runs (any cases and VUTs).
+        options: Statistical settings.
+        paper: Compute the paper mode (the AYSS bootstrap, the slow part).
+    """
+    return [
+        analyse_case(case, by_vut, options, crossplay=load_crossplay(by_vut), paper=paper)
+        for case, by_vut in group_runs(runs).items()
+    ]

@@ -435,7 +435,7 @@ def test_crossplay_section_and_headline_from_the_case_table(tmp_path: Path) -> N
 
 def test_crossplay_needs_two_vuts_and_a_table_of_these_runs(tmp_path: Path) -> None:
     from sumo_ayss.analysis.case import analyse_case
-    from sumo_ayss.report.load import group_runs
+    from sumo_ayss.report.load import group_runs, load_crossplay
 
     root = tmp_path / "runs"
     dirs = [make_run(root, "cut_in", "pi1", s) for s in range(2)]
@@ -446,5 +446,31 @@ def test_crossplay_needs_two_vuts_and_a_table_of_these_runs(tmp_path: Path) -> N
     dirs += [make_run(root, "cut_in", "pi2", s) for s in range(2)]
     make_crossplay(root / "cut_in", ["pi1", "pi2"], range(3))  # a seed these runs lack
     runs = group_runs([load_run(d) for d in dirs])["cut_in"]
-    stale = analyse_case("cut_in", runs, FAST)
+    stale = analyse_case("cut_in", runs, FAST, crossplay=load_crossplay(runs))
     assert "is not of these runs" in stale.crossplay_missing and stale.ranking_mode == "exposure"
+    without = analyse_case("cut_in", runs, FAST)  # no table handed in
+    assert "no cross-play table for this case" in without.crossplay_missing
+
+
+def test_the_loader_hands_analysis_the_crossplay_table_or_why_there_is_none(tmp_path: Path) -> None:
+    """analysis/ reads no file: :func:`load_crossplay` reads the case's crossplay.csv."""
+    from sumo_ayss.analysis.case import analyse_case
+    from sumo_ayss.report.load import group_runs, load_crossplay
+
+    root = tmp_path / "runs"
+    dirs = [make_run(root, "cut_in", v, s) for v in ("pi1", "pi2") for s in range(2)]
+    runs = group_runs([load_run(d) for d in dirs])["cut_in"]
+    assert load_crossplay(runs).matrix is None and not load_crossplay(runs).missing  # no table
+    path = make_crossplay(root / "cut_in", ["pi1", "pi2"], range(2))
+    found = load_crossplay(runs)
+    assert found.matrix is not None and found.path == path and found.matrix.vuts == ("pi1", "pi2")
+    a = analyse_case("cut_in", runs, FAST, crossplay=found)
+    assert a.crossplay is found.matrix and a.crossplay_path == path and a.crossplay_rows
+    path.write_text("vut,opponent_vut\npi1,pi1\n")
+    broken = load_crossplay(runs)
+    assert broken.matrix is None and "unreadable" in broken.missing
+    a = analyse_case("cut_in", runs, FAST, crossplay=broken)
+    assert a.crossplay_missing == broken.missing and broken.problem in a.problems
+    other = make_run(tmp_path / "elsewhere", "cut_in", "pi2", 5)
+    mixed = group_runs([load_run(d) for d in [*dirs, other]])["cut_in"]
+    assert "several case folders" in load_crossplay(mixed).missing
