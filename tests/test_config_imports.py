@@ -12,7 +12,7 @@ import json, sys
 from pathlib import Path
 import sumo_ayss.config as config
 import sumo_ayss.agents.hparams
-import sumo_ayss.report.options
+import sumo_ayss.config.report
 root = Path(sys.argv[1])
 pipe = config.load_pipeline(root / "configs" / "paper.yaml")
 for case, path in pipe.experiments.items():

@@ -9,8 +9,8 @@ import pytest
 import yaml
 
 from sumo_ayss.config import PROJECT_ROOT
+from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.rank import analyse, main, order_check, ranking_rows, write_ranking
-from sumo_ayss.report.options import ReportOptions
 from tests.report.test_report import EXPOSURE, OFFSET, make_crossplay, make_run
 
 
