@@ -142,7 +142,6 @@ def test_register_refuses_a_taken_name_or_indicator(toy: Case) -> None:
 def test_builtin_cases_match_their_envs() -> None:
     import gymnasium as gym
 
-    from sumo_ayss.scenarios.responses import POV_ACTION
     from sumo_ayss.sim.network import network_path
 
     for case in registered_cases():
@@ -151,13 +150,12 @@ def test_builtin_cases_match_their_envs() -> None:
         env = cls(EnvConfig(case=case.name))  # SUMO starts at the first reset only
         try:
             assert env.observation_space.shape == (len(case.observation),)
-            assert 0 <= POV_ACTION[case.name] < env.action_space.n
+            assert 0 <= cls.RESPONSE_ACTION < env.action_space.n
         finally:
             env.close()
         assert network_path(case.name).is_file()
         assert gym.spec(case.gym_id).entry_point == case.env
         assert callable(case.ayss_row_builder())
-    assert list(POV_ACTION) == list(BUILTIN)
 
 
 # --------------------------------------------------------------------------- a third case

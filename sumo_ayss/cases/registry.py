@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import importlib
 import re
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Generic, TypeVar
+from typing import Any
 
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.validation import require, suggest
@@ -18,7 +18,6 @@ __all__ = [
     "BASE_OBSERVATION",
     "OUTCOME_COLUMNS",
     "Case",
-    "CaseMapping",
     "Indicator",
     "PaperRow",
     "case_info",
@@ -30,8 +29,6 @@ __all__ = [
     "registered_cases",
     "unregister_case",
 ]
-
-T = TypeVar("T")
 
 #: The observation columns every case starts with (the AYSS Monte Carlo samples them):
 #: POV speed [m/s], VUT speed [m/s], headway h [m] (POV rear bumper minus VUT front bumper).
@@ -284,22 +281,3 @@ def indicator_columns() -> tuple[str, ...]:
 def case_of_indicator(column: str) -> str | None:
     """The case whose AYSS rows carry ``indicator_name == column``, or None."""
     return next((c.name for c in _REGISTRY.values() if c.indicator_column == column), None)
-
-
-class CaseMapping(Mapping[str, T], Generic[T]):
-    """A read-only ``{case name: fn(case)}`` over the registered cases, evaluated on access
-    (so cases registered later appear too)."""
-
-    def __init__(self, fn: Callable[[Case], T]) -> None:
-        self._fn = fn
-
-    def __getitem__(self, name: str) -> T:
-        if name not in _REGISTRY:
-            raise KeyError(name)
-        return self._fn(_REGISTRY[name])
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(case_names())
-
-    def __len__(self) -> int:
-        return len(_REGISTRY)

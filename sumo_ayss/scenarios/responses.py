@@ -37,13 +37,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
-from sumo_ayss.cases import CaseMapping, get_case
+from sumo_ayss.cases import get_case
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.vec_env import PairVecEnv
@@ -54,10 +54,6 @@ __all__ = ["DEFAULT_N_PAIRS", "VutResponses", "measure_responses"]
 #: Pairs in the one SUMO simulation: 256 roads cost ~0.2 s to build and start, and keep the
 #: per-state cost near its floor (~0.1 ms per state and VUT on one core).
 DEFAULT_N_PAIRS = 256
-
-#: The POV's action while a response is measured, per case (see the module docstring): the
-#: ``RESPONSE_ACTION`` of each registered case's env class.
-POV_ACTION: Mapping[str, int] = CaseMapping(lambda case: case.env_class().RESPONSE_ACTION)
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ from sumo_ayss.controllers import ControllerInput, bound_acceleration, commanded
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.errors import ConfigError
-from sumo_ayss.scenarios.responses import POV_ACTION, measure_responses
+from sumo_ayss.scenarios.responses import measure_responses
 
 pytestmark = pytest.mark.sumo
 
@@ -49,7 +49,7 @@ def test_response_is_the_speed_change_of_the_single_env_step() -> None:
                 seed=0, options={"initial_condition": InitialCondition(v_pov, v_vut, h)}
             )
             assert obs[1] == pytest.approx(v_vut, abs=1e-4)
-            obs2, _, _, _, info = env.step(POV_ACTION["car_following"])
+            obs2, _, _, _, info = env.step(CarFollowingEnv.RESPONSE_ACTION)
             assert obs2[0] == pytest.approx(v_pov, abs=1e-4)  # the POV held its speed
             expected.append((float(obs2[1]) - v_vut) / cfg.sim.step_length_s)
             assert info["vut_accel_mps2"] == pytest.approx(expected[-1], abs=1e-3)
@@ -120,7 +120,7 @@ def test_highway_env_vut_matches_the_fidelity_env_step() -> None:
         for (v_pov, v_vut, h), got in zip(STATES, r.accel_mps2, strict=True):
             ic = InitialCondition(v_pov, v_vut, h)
             env.reset(seed=0, options={"initial_condition": ic})
-            obs, _, _, _, info = env.step(POV_ACTION["car_following"])
+            obs, _, _, _, info = env.step(CarFollowingEnv.RESPONSE_ACTION)
             assert obs[0] == pytest.approx(v_pov, abs=1e-4)
             assert got == pytest.approx(info["vut_accel_mps2"], abs=1e-9)
     finally:
