@@ -42,6 +42,7 @@ from sumo_ayss.vtype_params import (
     as_number,
     check_param,
     fmt_number,
+    random_draws,
 )
 
 # ------------------------------------------------------------------------------ controllers
@@ -337,6 +338,13 @@ class VehicleType:
                 "its limits go into controller.max_accel_mps2 / max_decel_mps2"
             )
         self.controller.validate(f"{where}.controller")
+
+    def random_draws(self) -> tuple[str, ...]:
+        """Why SUMO draws random numbers for this vehicle (empty: none; a controller VUT is
+        the controller's business). See :func:`sumo_ayss.vtype_params.random_draws`."""
+        if self.controller is not None:
+            return ()
+        return random_draws(self.model, self.params)
 
     @property
     def length_m(self) -> float:

@@ -49,9 +49,6 @@ from sumo_ayss.run_folder import (
 
 logger = logging.getLogger(__name__)
 
-#: Pairs simulated at once in one SUMO simulation.
-DEFAULT_N_ENVS = 50
-
 
 def _sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
@@ -79,14 +76,28 @@ def run_case(
     *,
     n: int,
     seed: int,
-    n_envs: int = DEFAULT_N_ENVS,
     force: bool = False,
     trust_controller: bool = False,
     progress: Callable[[str], None] | None = None,
 ) -> Path:
-    """Cross-play of one case's runs; writes and returns the case folder's ``crossplay.csv``."""
+    """Cross-play of one case's runs; writes and returns the case folder's ``crossplay.csv``.
+
+    After the rollouts, every SPCP's episodes against its own VUT are compared with its
+    run's ``outcome.csv`` (:func:`~sumo_ayss.scenarios.crossplay.diagonal_check`); the
+    result goes into ``crossplay.json``.
+
+    Raises:
+        DiagonalMismatchError: If an SPCP did not reproduce its outcome table (the table
+            and the record are written first, for inspection; loaders refuse to rank it).
+        TableError: If a run's outcome table is missing or was run on other scenarios.
+    """
     from sumo_ayss.evaluate import load_run, load_spcp
-    from sumo_ayss.scenarios.crossplay import Opponent, run_crossplay
+    from sumo_ayss.scenarios.crossplay import (
+        Opponent,
+        check_diagonal,
+        diagonal_check,
+        run_crossplay,
+    )
 
     runs = [load_run(d) for d in run_dirs]
     pool = tuple(
@@ -95,36 +106,67 @@ def run_case(
     )
     folder = CaseFolder(case_dir)
     csv_path, json_path = folder.crossplay_csv, folder.crossplay_json
-    requested = CrossplayRecord(runs[0].config.env.case, n, seed, pool, (), 0.0)
+    case = runs[0].config.env.case
+    requested = CrossplayRecord(case, n, seed, pool, (), 0.0)
     if not force and csv_path.is_file() and json_path.is_file():
         try:
             done = read_crossplay_json(json_path)
         except TableError as exc:
             logger.warning("%s; cross-play of %s runs again", exc, case_dir)
         else:
-            if done.same_inputs(requested):
+            if done.same_inputs(requested) and done.diagonal:
                 logger.info("%s: cross-play done with these settings and SPCPs; skipped", case_dir)
+                check_diagonal(done.diagonal, case)
                 return csv_path
+    outcomes = {(r.config.env.vut, r.seed): _outcome_table(r.run_dir, n, seed) for r in runs}
     envs: dict[str, Any] = {}
     for r in runs:
         envs.setdefault(r.config.env.vut, r.config.env)
     opponents = [Opponent(r.config.env.vut, r.seed, functools.partial(load_spcp, r)) for r in runs]
     t0 = time.perf_counter()
     with controller_imports(trust_controller):
-        table = run_crossplay(envs, opponents, n=n, seed=seed, n_envs=n_envs, progress=progress)
+        table = run_crossplay(envs, opponents, n=n, seed=seed, progress=progress)
+    wall_s = time.perf_counter() - t0
+    checks = tuple(diagonal_check(table, v, s, out) for (v, s), out in outcomes.items())
     folder.path.mkdir(parents=True, exist_ok=True)
     write_table(csv_path, table)
-    wall_s = time.perf_counter() - t0
-    write_crossplay_json(json_path, dataclasses.replace(requested, vuts=tuple(envs), wall_s=wall_s))
+    record = dataclasses.replace(requested, vuts=tuple(envs), wall_s=wall_s, diagonal=checks)
+    write_crossplay_json(json_path, record)
+    check_diagonal(checks, case)
     return csv_path
 
 
-def read_matrix(csv_path: Path) -> Any:
-    """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of a ``crossplay.csv``
-    (:func:`sumo_ayss.report.load.read_crossplay_matrix`)."""
-    from sumo_ayss.report.load import read_crossplay_matrix
+def _outcome_table(run_dir: Path, n: int, seed: int) -> Any:
+    """A run's outcome table, checked to hold the scenarios cross-play drives."""
+    from sumo_ayss.run_folder import OUTCOME_SCHEMA, read_outcome_json, read_table
 
-    return read_crossplay_matrix(csv_path)
+    folder = RunFolder(run_dir)
+    settings = read_outcome_json(folder.outcome_json).settings
+    if (settings.get("n"), settings.get("seed")) != (n, seed):
+        raise TableError(
+            f"{folder.outcome_json}: the outcome stage ran n={settings.get('n')}, "
+            f"seed={settings.get('seed')}; cross-play drives n={n}, seed={seed}, so its diagonal "
+            "cannot be checked against it (re-run: python -m sumo_ayss.evaluate <run> --force)"
+        )
+    return read_table(folder.outcome_csv, OUTCOME_SCHEMA)
+
+
+def read_matrix(run_dirs: Sequence[Path]) -> Any:
+    """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of one case's runs, scored
+    on their harm scale, with its diagonal check (:func:`sumo_ayss.report.load.
+    load_crossplay`).
+
+    Raises:
+        TableError: If there is no usable table (the message says why).
+    """
+    from sumo_ayss.report.episodes import load_crossplay
+    from sumo_ayss.report.load import group_runs, load_run
+
+    groups = group_runs([load_run(d) for d in run_dirs])
+    found = load_crossplay(next(iter(groups.values())))
+    if found.matrix is None:
+        raise TableError(found.missing or f"no cross-play table for {run_dirs[0]}")
+    return found.matrix
 
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
@@ -135,7 +177,6 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     p.add_argument("config", help="pipeline YAML (the grid to cross-play)")
     p.add_argument("--out", default=None, help="replace the config's out")
     p.add_argument("--seeds", type=int, nargs="+", default=None, help="replace grid.seeds")
-    p.add_argument("--n-envs", type=int, default=DEFAULT_N_ENVS, help="pairs per simulation")
     p.add_argument("--force", action="store_true", help="rerun even when done")
     p.add_argument(
         "--blocks",
@@ -168,20 +209,25 @@ def main(argv: Sequence[str] | None = None) -> None:
         seeds = cfg.grid.seeds
         for case in cfg.grid.cases:
             dirs = case_runs(Path(cfg.out), case, cfg.grid.vuts, seeds)
-            csv_path = run_case(
+            run_case(
                 dirs,
                 case_dir_for(cfg.out, case),
                 n=cfg.evaluate.n_outcome,
                 seed=DEFAULT_OUTCOME_SEED,
-                n_envs=args.n_envs,
                 force=args.force,
                 trust_controller=args.trust_controller,
                 progress=functools.partial(print, f"{case}:", flush=True),
             )
-            rows, _pairs = rank_crossplay(read_matrix(csv_path), blocks=args.blocks)
-            print(f"\n{case}: cross-play ranking, safest first (lower exposure = safer)")
+            matrix = read_matrix(dirs)
+            rows, _pairs = rank_crossplay(matrix, blocks=args.blocks)
+            print(f"\n{case}: cross-play ranking, safest first (lower harm = safer)")
             for r in rows:
-                print(f"  {r.rank}. {r.name}: X = {r.mean:.2f} ({r.lo:.2f} to {r.hi:.2f})")
+                crashes, episodes = matrix.crashes(r.name)
+                print(
+                    f"  {r.rank}. {r.name}: H = {r.mean:.3f} ({r.lo:.3f} to {r.hi:.3f}); "
+                    f"crashes {crashes}/{episodes}; mean speed "
+                    f"{matrix.vut_mobility(r.name):.1f} m/s"
+                )
                 if r.vs_next is not None:
                     print(f"     {crossplay_sentence(r.vs_next, args.blocks)}")
             if cfg.expected_order:

@@ -30,3 +30,9 @@ class ActionError(AyssError, ValueError):
 
 class TableError(AyssError, ValueError):
     """A table or summary file is missing, malformed, or does not match its schema."""
+
+
+class DiagonalMismatchError(AyssError, RuntimeError):
+    """Cross-play drove a VUT differently from the outcome stage: an SPCP against its own VUT
+    did not reproduce its run's outcome table (the message names the VUT, the run and the
+    share of differing episodes)."""

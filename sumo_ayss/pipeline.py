@@ -249,7 +249,7 @@ def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> l
     then says that the cross-play table is missing); a failure of the stage itself is
     logged, never fatal.
     """
-    from sumo_ayss.crossplay import DEFAULT_N_ENVS, run_case
+    from sumo_ayss.crossplay import run_case
     from sumo_ayss.run_folder import case_dir_for
     from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
 
@@ -275,7 +275,6 @@ def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> l
                 case_dir_for(cfg.out, case),
                 n=cfg.evaluate.n_outcome,
                 seed=DEFAULT_OUTCOME_SEED,
-                n_envs=DEFAULT_N_ENVS,
                 trust_controller=True,  # the pipeline's own runs, from the user's configs
                 progress=functools.partial(_crossplay_progress, case),
             )

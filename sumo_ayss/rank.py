@@ -64,7 +64,18 @@ RANKING_COLUMNS = [
     "p_vs_next",
     "significant_vs_next",
     "vs_next",
+    "crash_rate",
+    "crash_lo",
+    "crash_hi",
+    "episodes",
+    "mobility_mps",
+    "timid",
 ]
+"""``ranking.csv``'s columns. ``score``: harm per episode in cross-play and exposure mode
+(:mod:`sumo_ayss.analysis.harm`, lower = safer), the AYSS safety index in paper mode (higher
+= safer). ``crash_rate`` with its Wilson interval ``crash_lo``/``crash_hi`` (fractions) over
+``episodes``, ``mobility_mps`` (mean VUT speed) and ``timid`` (mobility below 80 % of the
+median VUT's) describe the same episodes as the score; empty in paper mode."""
 
 
 def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> list[CaseAnalysis]:
@@ -108,12 +119,17 @@ def available_modes(a: CaseAnalysis) -> list[str]:
     return sorted((m for m in MODE_ORDER if have[m]), key=lambda m: m != a.mode)
 
 
+#: Unit text of the harm score per mode, in ``ranking.csv`` and ``ranking.md``.
+HARM_UNITS = {
+    "crossplay": "harm/episode, pooled SPCPs (lower = safer)",
+    "exposure": "harm/episode, own SPCPs (lower = safer)",
+}
+
+
 def _seed_rows(a: CaseAnalysis, mode: str) -> list[dict[str, Any]]:
-    """Rows of a seed-level ranking (exposure or cross-play)."""
-    if mode == "crossplay":
-        ranked, unit = a.crossplay_rows, "reward/episode, pooled SPCPs (lower = safer)"
-    else:
-        ranked, unit = a.exposure_rows, "reward/episode (lower = safer)"
+    """Rows of a seed-level ranking (exposure or cross-play), with crashes and mobility."""
+    ranked = a.crossplay_rows if mode == "crossplay" else a.exposure_rows
+    outcomes = a.outcomes.get(mode, {})
     rows = []
     for r in ranked:
         nxt = r.vs_next
@@ -123,6 +139,7 @@ def _seed_rows(a: CaseAnalysis, mode: str) -> list[dict[str, Any]]:
             sentence = crossplay_sentence(nxt, a.crossplay_blocks)
         else:
             sentence = exposure_sentence(nxt)
+        o = outcomes.get(r.name)
         rows.append(
             {
                 "case": a.case,
@@ -133,10 +150,16 @@ def _seed_rows(a: CaseAnalysis, mode: str) -> list[dict[str, Any]]:
                 "lo": r.lo,
                 "hi": r.hi,
                 "n_seeds": r.n_seeds,
-                "unit": unit,
+                "unit": HARM_UNITS[mode],
                 "p_vs_next": nxt.p if nxt else "",
                 "significant_vs_next": nxt.significant if nxt else "",
                 "vs_next": sentence,
+                "crash_rate": o.crash_rate if o else "",
+                "crash_lo": o.crash_lo if o else "",
+                "crash_hi": o.crash_hi if o else "",
+                "episodes": o.episodes if o else "",
+                "mobility_mps": o.mobility if o else "",
+                "timid": o.timid if o else "",
             }
         )
     return rows
@@ -164,6 +187,7 @@ def _paper_rows(a: CaseAnalysis) -> list[dict[str, Any]]:
                 "significant_vs_next": pair.significant if pair else "",
                 # Tagged like the seed-level modes' sentences ("[exposure mode] ...").
                 "vs_next": f"[paper mode] {pair.sentence}" if pair else "",
+                **dict.fromkeys(RANKING_COLUMNS[RANKING_COLUMNS.index("crash_rate") :], ""),
             }
         )
     return rows
@@ -173,8 +197,8 @@ def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
     """Ranking rows of every case, for every mode available (:func:`available_modes`: the
     analysis's mode first), safest first within a (case, mode); ``mode`` tags each row.
 
-    Cross-play mode: X, the mean episode reward of the pooled SPCPs (lower = safer).
-    Exposure mode: E, the mean episode reward per SPCP (lower = safer).
+    Cross-play mode: H, the mean harm per episode the pooled SPCPs bring about (lower =
+    safer). Exposure mode: the mean harm per episode of each VUT's own SPCPs (lower = safer).
     Paper mode: the AYSS safety index (higher = safer).
     """
     rows: list[dict[str, Any]] = []
@@ -274,14 +298,17 @@ def write_ranking(
     writer.writerows(rows)
     atomic_write_text(out / "ranking.csv", buf.getvalue())
     lines = [
-        "| case | mode | rank | VUT | score (95 % CI) | seeds | vs next |",
-        "|---|---|---:|---|---|---:|---|",
+        "| case | mode | rank | VUT | score (95 % CI) | seeds | crash rate (95 % CI) | "
+        "mean speed | vs next |",
+        "|---|---|---:|---|---|---:|---|---|---|",
     ]
     for r in rows:
-        ci = f" ({r['lo']:.2f} to {r['hi']:.2f})" if math.isfinite(r["lo"]) else ""
+        digits = 2 if r["mode"] == "paper" else 3
+        ci = f" ({r['lo']:.{digits}f} to {r['hi']:.{digits}f})" if math.isfinite(r["lo"]) else ""
         lines.append(
-            f"| {r['case']} | {r['mode']} | {r['rank']} | {r['vut']} | {r['score']:.2f}{ci} "
-            f"{r['unit']} | {r['n_seeds']} | {r['vs_next']} |"
+            f"| {r['case']} | {r['mode']} | {r['rank']} | {r['vut']} | "
+            f"{r['score']:.{digits}f}{ci} {r['unit']} | {r['n_seeds']} | {_crash_cell(r)} | "
+            f"{_mobility_cell(r)} | {r['vs_next']} |"
         )
     for c in checks:
         lines += [
@@ -298,6 +325,27 @@ def write_ranking(
 
         atomic_write_json(out / "order_check.json", {"expected": list(expected), "cases": checks})
     return out / "ranking.csv", out / "ranking.md"
+
+
+def _crash_cell(row: dict[str, Any]) -> str:
+    """``"11.6 % (10.2–13.2 %), 209/1800"``, or "" (paper mode)."""
+    if row["crash_rate"] == "":
+        return ""
+    return (
+        f"{100 * row['crash_rate']:.1f} % ({100 * row['crash_lo']:.1f}–"
+        f"{100 * row['crash_hi']:.1f} %), {round(row['crash_rate'] * row['episodes'])}/"
+        f"{row['episodes']}"
+    )
+
+
+def _mobility_cell(row: dict[str, Any]) -> str:
+    """``"21.3 m/s"``, ``"4.2 m/s TIMID"`` (far below the others), "not recorded", or ""."""
+    mob = row["mobility_mps"]
+    if mob == "":
+        return ""
+    if not math.isfinite(mob):
+        return "not recorded"
+    return f"{mob:.1f} m/s" + (" TIMID" if row["timid"] else "")
 
 
 def main(argv: Sequence[str] | None = None) -> None:

@@ -390,6 +390,15 @@ def train(
         raise CheckpointError(
             f"{run_dir} already holds a run; pass --resume to continue it or choose another --out"
         )
+    draws = cfg.env.vut_type.random_draws()
+    if draws:
+        logger.warning(
+            "VUT %s draws random numbers in SUMO (%s): its episodes are reproducible for a "
+            "given seed and path, but training's pairs and the outcome stage draw other "
+            "numbers, so they agree in distribution, not episode for episode",
+            cfg.env.vut,
+            "; ".join(draws),
+        )
     trainer = Trainer(cfg, seed, run_dir)
     try:
         if resume:

@@ -412,6 +412,43 @@ MODEL_PARAMS: Mapping[str, frozenset[str]] = MappingProxyType(
     }
 )
 
+#: Noise parameters: a vehicle draws random numbers while one is > 0, and SUMO's default
+#: when it is not given is > 0 (Krauss family, SmartSK, Daniel1, PWagner2009: sigma 0.5;
+#: EIDM: its three sigmas). ``speedDev`` (every model; default 0.1) draws the vehicle's
+#: speed factor.
+NOISE_PARAMS: frozenset[str] = frozenset({"sigma", "sigmaerror", "sigmagap", "sigmaleader"})
+
+#: Models whose trajectories depend on SUMO's ``--seed`` even with every noise parameter and
+#: speedDev at 0 (measured on SUMO 1.28 with the testbed's car-following env: the same
+#: scenarios and POV actions on seeds 1 and 2 gave other episodes;
+#: tests/test_vut_equivalence.py keeps this list honest).
+ALWAYS_RANDOM_MODELS: frozenset[str] = frozenset({"BKerner", "CC", "PWagner2009", "W99"})
+
+
+def random_draws(model: str, params: Mapping[str, float]) -> tuple[str, ...]:
+    """Why a SUMO vType draws random numbers, one phrase per reason (empty: it draws none).
+
+    Such a VUT is the same vehicle on every path of the testbed, but SUMO draws its numbers
+    from streams shared by all vehicles of a simulation: the single env and N pairs in one
+    simulation draw different numbers, so their episodes agree in distribution, not one for
+    one. The outcome stage and cross-play drive the same path on the same SUMO seed and
+    agree exactly.
+    """
+    reasons = []
+    dev = params.get("speedDev")
+    if dev is None or dev > 0:
+        shown = "SUMO's default 0.1" if dev is None else f"{dev:g}"
+        reasons.append(f"speedDev {shown} (a random speed factor per vehicle)")
+    for name in sorted(NOISE_PARAMS & MODEL_PARAMS.get(model, frozenset())):
+        value = params.get(name)
+        if value is None or value > 0:
+            shown = "SUMO's default > 0" if value is None else f"{value:g}"
+            reasons.append(f"{name} {shown} (driver noise)")
+    if model in ALWAYS_RANDOM_MODELS:
+        reasons.append(f"model {model} (draws random numbers whatever its parameters)")
+    return tuple(reasons)
+
+
 #: Parameters a model cannot run without (SUMO refuses the vType otherwise).
 REQUIRED_PARAMS: Mapping[str, frozenset[str]] = MappingProxyType({"CC": frozenset({"lanesCount"})})
 

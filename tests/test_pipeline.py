@@ -99,7 +99,7 @@ def test_crossplay_mode_runs_the_crossplay_stage_and_reports_it(tmp_path: Path) 
     verdicts = text.split('id="inputs"')[0]
     assert "[crossplay mode]" in verdicts and "Ranking (crossplay mode), safest first" in verdicts
     assert "no cross-play table" not in text
-    assert "(i) Cross-play ranking" in text and "Ranking by cross-play exposure X" in text
+    assert "(i) Cross-play ranking" in text and "Ranking by cross-play harm H" in text
     assert (report.parent / "car_following_crossplay_by_opponent.png").is_file()
     before = (case / "crossplay.csv").stat().st_mtime_ns
     run_pipeline(cfg, live=False)  # a rerun skips every finished stage, cross-play included

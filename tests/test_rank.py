@@ -89,6 +89,7 @@ def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, mon
     ranks those analyses; the rows equal ``--no-run``'s, which also computes once."""
     import sumo_ayss.analysis.case as case_mod
     import sumo_ayss.pipeline as pipeline_mod
+    import sumo_ayss.report.episodes as episodes_mod
     import sumo_ayss.report.load as load_mod
     from sumo_ayss.progress import JobStatus
 
@@ -116,9 +117,9 @@ def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, mon
         load_mod, "read_ayss", counted("ayss", load_mod.read_ayss, lambda p: str(p.parent))
     )
     monkeypatch.setattr(
-        load_mod,
+        episodes_mod,
         "read_crossplay_matrix",
-        counted("crossplay", load_mod.read_crossplay_matrix, lambda p: str(p)),
+        counted("crossplay", episodes_mod.read_crossplay_matrix, lambda p, *a: str(p)),
     )
     monkeypatch.setattr(
         case_mod,

@@ -166,6 +166,8 @@ def _outcome_table() -> Table:
             "lane_changed": [True, True],
             "final_headway_m": [1.5, -0.2],
             "n_steps": [25, 7],
+            "near_miss_pay": [12.5, 9.0],
+            "vut_mean_speed_mps": [21.5, 0.5],
         },
     )
 
@@ -284,6 +286,8 @@ def test_crossplay_files_of_a_case_folder_round_trip(tmp_path: Path) -> None:
             "collided": np.array([False, True]),
             "final_headway_m": [3.0, -0.5],
             "n_steps": np.array([7, 4], dtype=np.int64),
+            "near_miss_pay": [1.5, 12.5],
+            "vut_mean_speed_mps": [20.0, 19.25],
         },
     )
     write_table(folder.crossplay_csv, table)

@@ -31,6 +31,7 @@ from sumo_ayss.analysis.crossplay import (
     rank_crossplay,
 )
 from sumo_ayss.analysis.formatting import fmt_num
+from sumo_ayss.analysis.harm import VutOutcome, vut_outcomes
 from sumo_ayss.analysis.premise import Premise, premise_check
 from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex, rank, safety_index
 from sumo_ayss.analysis.seeds import (
@@ -172,6 +173,11 @@ class CaseAnalysis:
         crossplay_path: The ``crossplay.csv`` read, or None.
         crossplay_missing: Why there is no cross-play ranking, one sentence; "" when there
             is one.
+        crossplay_diagonal: The table's diagonal check, ``(vut, seed, n, n_equal)`` per run
+            (empty: the record predates the check).
+        outcomes: ``{mode: {vut: VutOutcome}}`` for the modes that read outcomes
+            (``"crossplay"``, ``"exposure"``): crashes with their interval and mobility,
+            shown beside the harm score.
     """
 
     case: str
@@ -198,26 +204,33 @@ class CaseAnalysis:
     crossplay_blocks: str = "seed"
     crossplay_path: Path | None = None
     crossplay_missing: str = ""
+    crossplay_diagonal: tuple[tuple[str, int, int, int], ...] = ()
+    outcomes: dict[str, dict[str, VutOutcome]] = field(default_factory=dict)
 
 
-EXPOSURE_SCORE = "extract {amount} {more_less} reward per episode"
+EXPOSURE_SCORE = "bring about {amount} {more_less} harm per episode"
 """How an exposure difference reads in a verdict sentence."""
 
 
 def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
-    """Exposure-mode ranking and the premise check, from the runs' outcome summaries."""
+    """Exposure-mode ranking (each VUT's own SPCPs: mean harm of their outcome episodes,
+    per seed) and the premise check, from the runs' outcome tables and summaries."""
     scores = []
+    counts: dict[str, tuple[int, int, float]] = {}
     for vut, members in out.runs.items():
-        values = {
-            r.seed: r.outcome.mean_return.value
-            for r in members
-            if r.seed is not None and r.outcome is not None and r.outcome.mean_return.known
-        }
-        if values:
-            scores.append(SeedScores(vut, values))
+        done = [r for r in members if r.seed is not None and r.episodes is not None]
+        if done:
+            scores.append(SeedScores(vut, {r.seed: r.episodes.mean_harm for r in done}))
+            counts[vut] = (
+                sum(r.episodes.crashes for r in done),
+                sum(r.episodes.n for r in done),
+                float(np.mean([r.episodes.mobility for r in done])),
+            )
         else:
-            out.problems.append(f"{vut}: no outcome summary with a seed, so no exposure")
+            out.problems.append(f"{vut}: no outcome table with a seed, so no exposure")
     out.exposure_scores = {sc.name: dict(sc.values) for sc in scores}
+    if counts:
+        out.outcomes["exposure"] = vut_outcomes(counts, options.level)
     if scores:
         out.exposure_rows, out.exposure_pairs = rank_seeds(
             scores, higher_is_safer=False, level=options.level, alpha=options.welch_alpha
@@ -262,6 +275,10 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -
         )
         return
     out.crossplay, out.crossplay_path = m, found.path
+    out.crossplay_diagonal = found.diagonal
+    out.outcomes["crossplay"] = vut_outcomes(
+        {v: (*m.crashes(v), m.vut_mobility(v)) for v in m.vuts}, options.level
+    )
     out.crossplay_rows, out.crossplay_pairs = rank_crossplay(
         m, blocks=options.crossplay_blocks, level=options.level, alpha=options.welch_alpha
     )

@@ -4,10 +4,15 @@ Input: the cross-play table (:mod:`sumo_ayss.scenarios.crossplay`) as plain colu
 row per (VUT driven against, opponent SPCP, scenario). Every opponent drove the same
 scenarios against every VUT.
 
-Score: the cross-play exposure of VUT v, ``X(v) = mean over opponents o of E(o, v)``, with
-``E(o, v)`` the mean episode reward opponent o extracts from v over the scenarios. Lower is
-safer, as in exposure mode: the same adversarial-yet-safe reward, paid for fewer or less
-close near-misses.
+Score: the cross-play harm of VUT v, ``H(v) = mean over opponents o of H(o, v)``, with
+``H(o, v)`` the mean harm per episode opponent o brought about against v over the scenarios
+(:mod:`.harm`: 1 for a collision, else the near-miss pay over the most an episode can pay).
+Lower is safer. A collision counts as the worst outcome for the VUT: before issue 22 the
+score was the mean episode *reward* the opponents extracted, in which a crash pays the
+opponent -10 and so counted as the VUT's gain (a braking ladder came out inverted in cut-in;
+opponents trained against other VUTs do crash, a VUT's own SPCP learns not to). The matrix
+keeps that reading (:attr:`CrossplayMatrix.returns`) for comparison, beside each cell's crash
+rate and the VUT's mobility (mean speed).
 
 Test: a paired t-test over blocks (:func:`sumo_ayss.analysis.seeds.compare_seeds`, blocks in
 the role of seeds), by default ``blocks="seed"``: block s is the mean over the opponents of
@@ -59,24 +64,31 @@ NO_CROSSPLAY_TABLE = f"no cross-play table for this case (run {CROSSPLAY_COMMAND
 
 @dataclass(frozen=True)
 class CrossplayMatrix:
-    """Mean episode reward of every opponent against every VUT.
+    """Per (VUT, opponent) cell: mean harm, crash rate, mean reward and mobility.
 
     Attributes:
         vuts: VUTs driven against, in first-seen order.
         opponents: ``(trained-against VUT, training seed)`` of each opponent, sorted.
-        returns: ``returns[i, j]`` = mean episode reward of opponent j against VUT i.
+        harm: ``harm[i, j]`` = mean harm per episode of opponent j against VUT i, in [0, 1]
+            (:func:`~.harm.episode_harm`); the score.
         crash_rate: ``crash_rate[i, j]`` = share of its episodes that ended in a collision.
         n_scenarios: Scenarios per cell.
+        returns: ``returns[i, j]`` = mean episode reward (the reading before issue 22);
+            NaN where not given.
+        mobility: ``mobility[i, j]`` = mean of the episodes' VUT mean speed [m/s]; NaN where
+            the table does not record it.
     """
 
     vuts: tuple[str, ...]
     opponents: tuple[tuple[str, int], ...]
-    returns: npt.NDArray[np.float64]
+    harm: npt.NDArray[np.float64]
     crash_rate: npt.NDArray[np.float64]
     n_scenarios: int
+    returns: npt.NDArray[np.float64]
+    mobility: npt.NDArray[np.float64]
 
     def scores(self, blocks: str = "seed") -> list[SeedScores]:
-        """Per VUT: block -> its mean E(opponent, VUT), for :func:`rank_seeds`.
+        """Per VUT: block -> its mean harm H(opponent, VUT), for :func:`rank_seeds`.
 
         Args:
             blocks: ``"seed"`` (block = training seed; its value is the mean over that
@@ -84,7 +96,7 @@ class CrossplayMatrix:
         """
         if blocks == "opponent":
             return [
-                SeedScores(v, dict(enumerate(self.returns[i].tolist())))
+                SeedScores(v, dict(enumerate(self.harm[i].tolist())))
                 for i, v in enumerate(self.vuts)
             ]
         if blocks != "seed":
@@ -92,33 +104,61 @@ class CrossplayMatrix:
         seeds = sorted({s for _, s in self.opponents})
         cols = {s: [j for j, (_, t) in enumerate(self.opponents) if t == s] for s in seeds}
         return [
-            SeedScores(v, {s: float(self.returns[i, cols[s]].mean()) for s in seeds})
+            SeedScores(v, {s: float(self.harm[i, cols[s]].mean()) for s in seeds})
             for i, v in enumerate(self.vuts)
         ]
+
+    def crashes(self, vut: str) -> tuple[int, int]:
+        """``(collisions, episodes)`` of ``vut`` against the whole pool."""
+        i = self.vuts.index(vut)
+        n = self.n_scenarios * len(self.opponents)
+        return round(float(self.crash_rate[i].sum()) * self.n_scenarios), n
+
+    def vut_mobility(self, vut: str) -> float:
+        """Mean speed [m/s] of ``vut`` over all its episodes against the pool (NaN: not
+        recorded)."""
+        row = self.mobility[self.vuts.index(vut)]
+        return float(row.mean()) if np.all(np.isfinite(row)) else math.nan
 
 
 def crossplay_matrix(
     vut: Sequence[str],
     opponent_vut: Sequence[str],
     opponent_seed: Sequence[int],
-    episode_return: npt.ArrayLike,
+    harm: npt.ArrayLike,
     collided: npt.ArrayLike,
+    *,
+    episode_return: npt.ArrayLike | None = None,
+    mobility: npt.ArrayLike | None = None,
 ) -> CrossplayMatrix:
     """Reduces the cross-play table's columns (one entry per episode) to the matrix.
 
+    Args:
+        vut, opponent_vut, opponent_seed: Who drove against whom.
+        harm: Each episode's harm (:func:`~.harm.episode_harm`).
+        collided: Whether each episode ended in a collision.
+        episode_return: Each episode's reward sum (kept for comparison), or None.
+        mobility: Each episode's VUT mean speed [m/s] (NaN: not recorded), or None.
+
     Raises:
-        ConfigError: If the lengths differ, a value is not finite, or the design is not
-            complete and balanced (every opponent against every VUT on equally many
+        ConfigError: If the lengths differ, a harm or return is not finite, or the design is
+            not complete and balanced (every opponent against every VUT on equally many
             scenarios).
     """
-    ret = np.asarray(episode_return, dtype=np.float64)
+    h = np.asarray(harm, dtype=np.float64)
     crash = np.asarray(collided, dtype=np.float64)
     n = len(vut)
-    if not (len(opponent_vut) == len(opponent_seed) == ret.size == crash.size == n):
+    ret = np.full(n, np.nan) if episode_return is None else np.asarray(episode_return, float)
+    mob = np.full(n, np.nan) if mobility is None else np.asarray(mobility, dtype=np.float64)
+    if not (len(opponent_vut) == len(opponent_seed) == h.size == crash.size == n):
+        raise ConfigError("cross-play columns: lengths differ")
+    if ret.size != n or mob.size != n:
         raise ConfigError("cross-play columns: lengths differ")
     if n == 0:
         raise ConfigError("cross-play table: no rows")
-    if not np.all(np.isfinite(ret)):
+    if not np.all(np.isfinite(h)):
+        raise ConfigError("cross-play table: harm has non-finite values")
+    if episode_return is not None and not np.all(np.isfinite(ret)):
         raise ConfigError("cross-play table: episode_return has non-finite values")
     vuts = tuple(dict.fromkeys(str(v) for v in vut))
     opps = tuple(
@@ -126,20 +166,30 @@ def crossplay_matrix(
     )
     vi = {v: i for i, v in enumerate(vuts)}
     oi = {o: j for j, o in enumerate(opps)}
-    sums = np.zeros((len(vuts), len(opps)))
-    crashes = np.zeros_like(sums)
-    counts = np.zeros_like(sums)
+    shape = (len(vuts), len(opps))
+    sums = {key: np.zeros(shape) for key in ("harm", "crash", "ret", "mob")}
+    counts = np.zeros(shape)
     for k in range(n):
         i, j = vi[str(vut[k])], oi[(str(opponent_vut[k]), int(opponent_seed[k]))]
-        sums[i, j] += ret[k]
-        crashes[i, j] += crash[k]
+        sums["harm"][i, j] += h[k]
+        sums["crash"][i, j] += crash[k]
+        sums["ret"][i, j] += ret[k]
+        sums["mob"][i, j] += mob[k]
         counts[i, j] += 1
     if counts.min() == 0 or counts.min() != counts.max():
         raise ConfigError(
             "cross-play table: not every opponent drove the same number of scenarios against "
             f"every VUT (per-cell counts {int(counts.min())}..{int(counts.max())})"
         )
-    return CrossplayMatrix(vuts, opps, sums / counts, crashes / counts, int(counts[0, 0]))
+    return CrossplayMatrix(
+        vuts,
+        opps,
+        harm=sums["harm"] / counts,
+        crash_rate=sums["crash"] / counts,
+        n_scenarios=int(counts[0, 0]),
+        returns=sums["ret"] / counts,
+        mobility=sums["mob"] / counts,
+    )
 
 
 @dataclass(frozen=True)
@@ -155,20 +205,27 @@ class CrossplayInput:
         missing: Why there is no matrix, one sentence; "" with no matrix means that no
             table was found (:data:`NO_CROSSPLAY_TABLE`).
         problem: A line for the case's problem list (an unreadable table), or "".
+        diagonal: The diagonal check of the table's record, one ``(vut, seed, n, n_equal)``
+            per run: its SPCP against its own VUT reproduced ``n_equal`` of the ``n``
+            episodes of its outcome table; empty when the record predates the check.
+        rollout: How the table's episodes were driven (``"outcome"``: the outcome stage's
+            path; ``"pairs"``: the vec env, before issue 21); "" without a record.
     """
 
     matrix: CrossplayMatrix | None = None
     path: Path | None = None
     missing: str = ""
     problem: str = ""
+    diagonal: tuple[tuple[str, int, int, int], ...] = ()
+    rollout: str = ""
 
 
 def rank_crossplay(
     m: CrossplayMatrix, *, blocks: str = "seed", level: float = 0.95, alpha: float = 0.05
 ) -> tuple[list[SeedRankRow], list[SeedComparison]]:
-    """Ranking by cross-play exposure X (lower = safer), paired over blocks.
+    """Ranking by cross-play harm H (lower = safer), paired over blocks.
 
-    With balanced blocks (every seed trains one opponent per VUT), X is the same mean for
+    With balanced blocks (every seed trains one opponent per VUT), H is the same mean for
     both block units; only the test differs.
 
     Returns:
@@ -179,7 +236,7 @@ def rank_crossplay(
 
 
 def _fmt(x: float) -> str:
-    return f"{x:.2f}".replace("-", "−")
+    return f"{x:.3f}".replace("-", "−")
 
 
 def crossplay_sentence(c: SeedComparison, blocks: str = "seed") -> str:
@@ -199,8 +256,8 @@ def crossplay_sentence(c: SeedComparison, blocks: str = "seed") -> str:
     stats = f"{pct} CI {ci}; paired t-test over {c.n_a} {unit}, {p}"
     more = "more" if b_higher else "less"
     what = (
-        f"the pooled SPCPs extract {abs(c.difference):.2f} {more} reward per episode "
-        f"from {c.name_b} than from {c.name_a}"
+        f"the pooled SPCPs bring about {abs(c.difference):.3f} {more} harm per episode "
+        f"against {c.name_b} than against {c.name_a}"
     )
     if c.significant and c.difference < 0:
         return f"[crossplay mode] {c.name_a} is safer than {c.name_b}: {what} ({stats})."

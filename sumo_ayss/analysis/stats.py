@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from statistics import NormalDist
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -35,6 +36,7 @@ __all__ = [
     "student_t_sf",
     "t_quantile",
     "welch_t_test",
+    "wilson_interval",
 ]
 
 
@@ -207,3 +209,38 @@ def cohens_d(x: ArrayLike, y: ArrayLike) -> float:
     if s_pooled == 0.0:
         return math.nan
     return float(xs.mean() - ys.mean()) / s_pooled
+
+
+def wilson_interval(count: int, n: int, level: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval of a binomial proportion ``count / n``.
+
+    ``(p + z²/2n ± z·sqrt(p(1-p)/n + z²/4n²)) / (1 + z²/n)`` with ``p = count / n`` and
+    ``z`` the standard normal ``(1 + level) / 2`` quantile. Unlike the Wald interval it
+    does not collapse to a point at 0 or n successes: at ``count = 0`` it is
+    ``[0, z² / (n + z²)]``.
+
+    Args:
+        count: Successes, ``0 <= count <= n``.
+        n: Trials, >= 1.
+        level: Confidence level in (0, 1).
+
+    Returns:
+        ``(lo, hi)`` as fractions in [0, 1].
+
+    Raises:
+        ConfigError: If ``n < 1``, ``count`` is outside ``[0, n]`` or ``level`` is invalid.
+    """
+    level = check_level(level)
+    if isinstance(n, bool) or int(n) != n or n < 1:
+        raise ConfigError(f"n: expected an integer >= 1, got {n!r}")
+    if isinstance(count, bool) or int(count) != count or not 0 <= count <= n:
+        raise ConfigError(f"count: expected an integer in [0, {n}], got {count!r}")
+    z = NormalDist().inv_cdf(0.5 * (1.0 + level))
+    p = count / n
+    z2n = z * z / n
+    denom = 1.0 + z2n
+    centre = (p + 0.5 * z2n) / denom
+    half = z / denom * math.sqrt(p * (1.0 - p) / n + z * z / (4.0 * n * n))
+    lo = 0.0 if count == 0 else max(0.0, centre - half)
+    hi = 1.0 if count == n else min(1.0, centre + half)
+    return lo, hi

@@ -41,6 +41,9 @@ MANAGED_SUMO_OPTIONS: dict[str, str] = {
     "collision.mingap-factor": "env.sim.collision_mingap_factor",
     "lanechange.duration": "env.sim.lanechange_duration_s",
     "begin": "always 0",
+    "default.action-step-length": (
+        "env.vuts.<name>.params.actionStepLength (per VUT; the POV acts every step)"
+    ),
 }
 
 
@@ -291,6 +294,7 @@ class EnvConfig:
         for name, vt in self.vuts.items():
             vt.validate(f"{s}.vuts.{name}")
         self.pov.validate(f"{s}.pov")
+        self._check_action_steps()
         check_choice(f"{s}.vut", self.vut, sorted(self.vuts))
         require(self.episode_s > 0, f"{s}.episode_s must be > 0, got {self.episode_s}")
         ratio = self.decision_period_s / self.sim.step_length_s
@@ -326,6 +330,32 @@ class EnvConfig:
             self.odd.pov_speed_mps[1] <= top,
             f"{s}.odd.pov_speed_mps max ({self.odd.pov_speed_mps[1]}) must be <= "
             f"env.actuator.max_speed_mps ({top}): the POV could not drive its initial speed",
+        )
+
+    def _check_action_steps(self) -> None:
+        """SUMO's ``actionStepLength`` only as a whole number of steps, and not for the POV.
+
+        SUMO rounds an action step that is not a multiple of the step length (a warning the
+        testbed's SUMO never prints) and drives a vehicle with ``actionStepLength`` below
+        the step at the step length; the POV is moved by the testbed's actuator every step.
+        A VUT is refused here rather than simulated with another action step than it names.
+        """
+        s, dt = self.SECTION, self.sim.step_length_s
+        for name, vt in self.vuts.items():
+            length = vt.params.get("actionStepLength")
+            if length is None:
+                continue
+            ratio = float(length) / dt
+            require(
+                abs(ratio - round(ratio)) < 1e-9 and round(ratio) >= 1,
+                f"{s}.vuts.{name}.params.actionStepLength must be a whole multiple of "
+                f"env.sim.step_length_s ({dt} s: {dt}, {2 * dt:g}, {3 * dt:g}, ...), got "
+                f"{length} (SUMO would round it without a word)",
+            )
+        require(
+            "actionStepLength" not in self.pov.params,
+            f"{s}.pov.params.actionStepLength is not allowed: the POV is driven by the "
+            "testbed's actuator every SUMO step (env.actuator), not by SUMO's driver model",
         )
 
     @property

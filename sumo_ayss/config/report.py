@@ -22,19 +22,21 @@ __all__ = ["CROSSPLAY_BLOCKS", "DEFAULT_MODE", "MODES", "ReportOptions"]
 MODES: Mapping[str, str] = {
     "crossplay": (
         "Cross-play mode (default): every SPCP of a case drives against every VUT of the case "
-        "on the same outcome scenarios; a VUT's score X is the mean episode reward this pooled "
-        "population of opponents extracts from it, and a lower X is a safer VUT. A difference "
+        "on the same outcome scenarios; a VUT's score H is the mean harm per episode this "
+        "pooled population of opponents brings about against it (1 for a collision, else the "
+        "near-miss reward paid over the most an episode can pay), and a lower H is a safer "
+        "VUT. A collision is the worst outcome for the VUT, never its gain. A difference "
         "between two VUTs is read within each opponent, so the search noise of one SPCP "
         "cancels; two VUTs are compared by a paired t-test over training-seed blocks (block s "
         "= the mean over seed s's opponents; report.crossplay_blocks: opponent makes every "
-        "opponent a block); significant when p < alpha."
+        "opponent a block); significant when p < alpha. Crash rate and mobility (mean VUT "
+        "speed) stand beside the score; a VUT far slower than the others is flagged TIMID."
     ),
     "exposure": (
-        "Exposure mode: a VUT's score is the adversarial exposure E, the mean "
-        "episode reward its SPCP extracts over the common outcome scenarios (the same "
-        "scenarios for every VUT and seed); a lower E is a safer VUT, because the same "
-        "adversarial-yet-safe reward paid for fewer or less close near-misses. Each training "
-        "seed's SPCP is one observation; seeds are shared across VUTs (same seed values), so "
+        "Exposure mode: a VUT's score is the mean harm per episode its own SPCPs bring about "
+        "over the common outcome scenarios (the same scenarios for every VUT and seed; harm as "
+        "in cross-play mode); a lower score is a safer VUT. Each training seed's SPCP is one "
+        "observation; seeds are shared across VUTs (same seed values), so "
         "two VUTs are compared by a paired t-test on their per-seed differences (Welch's "
         "t-test when the seed sets differ); significant when p < alpha."
     ),

@@ -385,6 +385,7 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
                 else self._vut_control.last_command_mps2
             ),
             "target_speed_mps": self._target,
+            "vut_speed_mps": k.vut_speed_mps,
             "collision": collided,
             "reward_adversarial": r_a,
             "reward_collision": -1.0 if collided else 0.0,

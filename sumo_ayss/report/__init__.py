@@ -38,7 +38,7 @@ _LAZY = {
     "find_run_dirs": "sumo_ayss.report.load",
     "group_runs": "sumo_ayss.report.load",
     "analyse_runs": "sumo_ayss.report.load",
-    "load_crossplay": "sumo_ayss.report.load",
+    "load_crossplay": "sumo_ayss.report.episodes",
     "load_run": "sumo_ayss.report.load",
     "ReportOptions": "sumo_ayss.config.report",
     "MODES": "sumo_ayss.config.report",

@@ -1,4 +1,4 @@
-"""Cross-play figure: the reward each opponent SPCP extracts from every VUT."""
+"""Cross-play figure: the harm each opponent SPCP brings about against every VUT."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from sumo_ayss.report.figstyle import save, seed_style, style
 def crossplay_figure(
     order: Sequence[str],
     opponents: Sequence[tuple[str, int]],
-    returns: NDArray[np.float64],
+    harm: NDArray[np.float64],
     vuts: Sequence[str],
     colors: Mapping[str, str],
     path: Path,
@@ -27,10 +27,10 @@ def crossplay_figure(
     Args:
         order: VUTs safest first (the x axis).
         opponents: ``(trained-against VUT, training seed)`` of each opponent (columns of
-            ``returns``).
-        returns: ``returns[i, j]`` = mean episode reward opponent j extracts from VUT
-            ``vuts[i]``.
-        vuts: The VUTs of the rows of ``returns``.
+            ``harm``).
+        harm: ``harm[i, j]`` = mean harm per episode opponent j brings about against VUT
+            ``vuts[i]`` (:mod:`sumo_ayss.analysis.harm`).
+        vuts: The VUTs of the rows of ``harm``.
         colors: ``{vut: colour}``; an opponent is drawn in its trained-against VUT's colour,
             one line style per seed.
         path: PNG file to write.
@@ -48,7 +48,7 @@ def crossplay_figure(
             ls, marker = seed_style(seeds.index(seed))
             ax.plot(
                 range(len(order)),
-                [float(returns[i, j]) for i in rows],
+                [float(harm[i, j]) for i in rows],
                 color=colors.get(vut, "C0"),
                 ls=ls,
                 marker=marker,
@@ -59,7 +59,7 @@ def crossplay_figure(
         ax.set_xticks(range(len(order)), [f"#{k + 1} {v}" for k, v in enumerate(order)])
         ax.set_xlim(-0.4, len(order) - 0.6 + 0.2)
         ax.set_xlabel("VUT driven against, safest first (cross-play ranking)")
-        ax.set_ylabel("reward extracted (mean reward/episode)")
+        ax.set_ylabel("harm per episode (1 = collision)")
         ax.set_title(title)
         ax.grid(axis="y", alpha=0.3)
         ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))

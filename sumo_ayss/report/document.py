@@ -138,13 +138,15 @@ def build_report(
         Paragraph(
             "How to read this report: against each VUT an adversarial-yet-safe opponent (POV) "
             "was trained with the same reward; its best checkpoint is the VUT's SPCP. Exposure "
-            "mode ranks VUTs by how much of that reward their SPCPs extract (sections d and f): "
-            "less means the opponent could create fewer and less close near-misses. Cross-play "
+            "mode ranks VUTs by the harm their SPCPs bring about (sections d and f): a "
+            "collision counts as the worst episode, otherwise the near-miss reward paid, so "
+            "less means fewer collisions and fewer, less close near-misses. Cross-play "
             "mode (section i) lets every SPCP of a case drive against every VUT and ranks the "
-            "VUTs by what the pooled SPCPs extract, so one SPCP's search noise cancels. The "
-            "paper's reading (sections c and g) assumes that all SPCPs reached the same overall "
-            "outcome (checked in section e) and then reveals a safer VUT by a more aggressive "
-            "SPCP: harder braking (car-following) or a smaller Δv̄ (cut-in) at the same headway."
+            "VUTs by the harm the pooled SPCPs bring about, so one SPCP's search noise "
+            "cancels. The paper's reading (sections c and g) assumes that all SPCPs reached "
+            "the same overall outcome (checked in section e) and then reveals a safer VUT by "
+            "a more aggressive SPCP: harder braking (car-following) or a smaller Δv̄ (cut-in) "
+            "at the same headway."
         )
     )
     blocks += inputs_blocks(runs, groups, out_dir)

@@ -5,8 +5,9 @@ A run folder ``<out>/<case>/<vut>/seed_<k>/`` is written by :mod:`sumo_ayss.trai
 evaluate stage, a case's ``crossplay.csv`` by the cross-play stage; their file names and the
 schema of each file are in :mod:`sumo_ayss.run_folder`, whose readers this module calls (one
 reader per file). :mod:`sumo_ayss.analysis` reads no file: :func:`analyse_runs` hands it the
-loaded runs and each case's cross-play matrix (:func:`load_crossplay`), one analysis per case
-for whoever needs it (the report, rank).
+loaded runs and each case's cross-play matrix
+(:func:`~sumo_ayss.report.episodes.load_crossplay`), one analysis per case for whoever needs
+it (the report, rank).
 
 Nothing here raises on a missing or unreadable file: :func:`load_run` records a sentence per
 problem in :attr:`Run.problems` and leaves the field empty, so a report on a run that has not
@@ -27,21 +28,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sumo_ayss.analysis.case import CaseAnalysis, CaseOptions, analyse_case
-from sumo_ayss.analysis.crossplay import CrossplayInput, CrossplayMatrix, crossplay_matrix
+from sumo_ayss.analysis.harm import EpisodeStats, HarmScale
 from sumo_ayss.cases import case_names, case_of_indicator
 from sumo_ayss.config import RewardConfig, build
-from sumo_ayss.errors import AyssError, ConfigError, TableError
+from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.report.checks import Training, read_training
+from sumo_ayss.report.episodes import harm_scale_of, load_crossplay, read_episode_stats
 from sumo_ayss.run_folder import (
     AYSS_CSV,
     AYSS_SCHEMA,
     CONFIG_YAML,
-    CROSSPLAY_SCHEMA,
     EVAL_CSV,
     OUTCOME_JSON,
     SPCP_JSON,
     VERSIONS_JSON,
-    CaseFolder,
     Estimate,
     Outcome,
     OutcomeSubset,
@@ -71,10 +71,8 @@ __all__ = [
     "analyse_runs",
     "find_run_dirs",
     "group_runs",
-    "load_crossplay",
     "load_run",
     "read_ayss",
-    "read_crossplay_matrix",
     "read_eval_curve",
     "read_outcome",
 ]
@@ -165,6 +163,10 @@ class Run:
         ayss: The AYSS samples, or None.
         versions: Package versions the run used (``versions.json``), or empty.
         training: Training budget and SPCP state (:func:`~sumo_ayss.report.checks.read_training`).
+        harm_scale: The constants that turn this run's episodes into harm (from the reward
+            and the episode length in ``config.yaml``), or None.
+        episodes: The outcome episodes reduced to harm, crashes and mobility (from
+            ``outcome.csv``), or None.
         problems: One sentence per missing or unreadable file.
     """
 
@@ -180,6 +182,8 @@ class Run:
     ayss: AyssSamples | None = None
     versions: dict[str, str] = field(default_factory=dict)
     training: Training = field(default_factory=Training)
+    harm_scale: HarmScale | None = None
+    episodes: EpisodeStats | None = None
     problems: list[str] = field(default_factory=list)
 
     @property
@@ -313,6 +317,9 @@ def load_run(path: str | Path) -> Run:
         )
     attempt(folder.spcp_json, read_spcp, "spcp")
     attempt(folder.outcome_json, read_outcome, "outcome")
+    if run.harm_scale is not None:
+        scale = run.harm_scale
+        attempt(folder.outcome_csv, lambda p: read_episode_stats(p, scale), "episodes")
     attempt(folder.ayss_csv, read_ayss, "ayss")
     if folder.versions.is_file():  # optional: no problem recorded when absent
         try:
@@ -348,6 +355,11 @@ def _load_config(run: Run, folder: RunFolder) -> None:
         run.reward = build(RewardConfig, env.get("reward") or {}, "env.reward", run.path)
     except (ConfigError, TypeError) as exc:
         run.problems.append(f"{CONFIG_YAML}: reward section invalid ({exc})")
+        return
+    try:
+        run.harm_scale = harm_scale_of(run.reward, env)
+    except (ConfigError, TypeError, ValueError) as exc:
+        run.problems.append(f"{CONFIG_YAML}: episode timing invalid ({exc})")
 
 
 def _check_ayss(run: Run) -> None:
@@ -366,60 +378,12 @@ def _check_ayss(run: Run) -> None:
 # --------------------------------------------------------------------------- cases
 
 
-def read_crossplay_matrix(path: Path) -> CrossplayMatrix:
-    """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of a case folder's
-    ``crossplay.csv`` (read against :data:`~sumo_ayss.run_folder.CROSSPLAY_SCHEMA`).
-
-    Raises:
-        TableError: If the file is missing or does not follow the schema.
-        ConfigError: If the design is not complete and balanced
-            (:func:`~sumo_ayss.analysis.crossplay.crossplay_matrix`).
-    """
-    c = read_table(path, CROSSPLAY_SCHEMA).columns
-    return crossplay_matrix(
-        c["vut"], c["opponent_vut"], c["opponent_seed"], c["episode_return"], c["collided"]
-    )
-
-
-def load_crossplay(runs: Mapping[str, Sequence[Run]]) -> CrossplayInput:
-    """The cross-play table of one case's runs: ``crossplay.csv`` of the case folder they lie
-    in (the parent of the VUT folders), read against
-    :data:`~sumo_ayss.run_folder.CROSSPLAY_SCHEMA`; never raises.
-
-    Args:
-        runs: ``{vut: runs}`` of one case.
-
-    Returns:
-        The :class:`~sumo_ayss.analysis.crossplay.CrossplayInput`: the matrix and its path,
-        or why there is none (no table, runs in several case folders, an unreadable table
-        or one whose design is not complete and balanced).
-    """
-    case_dirs = sorted({Path(r.path).parent.parent for rs in runs.values() for r in rs})
-    if len(case_dirs) != 1:
-        folders = ", ".join(map(str, case_dirs))
-        return CrossplayInput(
-            missing=f"no cross-play table: the runs lie in several case folders ({folders})"
-        )
-    path = CaseFolder(case_dirs[0]).crossplay_csv
-    if not path.is_file():
-        return CrossplayInput()
-    try:
-        matrix = read_crossplay_matrix(path)
-    except (TableError, ConfigError) as exc:
-        return CrossplayInput(
-            path=path,
-            missing=f"the cross-play table is unreadable ({exc})",
-            problem=f"{path}: {exc}",
-        )
-    return CrossplayInput(matrix, path)
-
-
 def analyse_runs(
     runs: Sequence[Run], options: CaseOptions, *, paper: bool = True
 ) -> list[CaseAnalysis]:
     """The analysis of every case among ``runs``, each computed once, in :func:`group_runs`
     order (:func:`~sumo_ayss.analysis.case.analyse_case` on the case's runs and its
-    cross-play table, :func:`load_crossplay`).
+    cross-play table, :func:`~sumo_ayss.report.episodes.load_crossplay`).
 
     Args:
         runs: Loaded runs (any cases and VUTs).

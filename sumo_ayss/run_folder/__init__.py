@@ -45,6 +45,7 @@ from __future__ import annotations
 from sumo_ayss.run_folder.crossplay import (
     CrossplayOpponent,
     CrossplayRecord,
+    DiagonalCheck,
     read_crossplay_json,
     write_crossplay_json,
 )
@@ -179,6 +180,7 @@ __all__ = [
     "Column",
     "CrossplayOpponent",
     "CrossplayRecord",
+    "DiagonalCheck",
     "Estimate",
     "Outcome",
     "OutcomeRecord",

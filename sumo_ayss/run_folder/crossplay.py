@@ -6,10 +6,16 @@ It lies in the case folder ``<out>/<case>/`` (:class:`~.layout.CaseFolder`), bes
 
     {"stage": "crossplay", "case": "cut_in", "n": 200, "seed": 4242,
      "opponents": [{"vut": "pi1", "seed": 0, "spcp_sha256": "..."}, ...],
-     "vuts": ["pi1", "pi2"], "wall_s": 812.4}
+     "vuts": ["pi1", "pi2"], "wall_s": 812.4, "rollout": "outcome",
+     "diagonal": [{"vut": "pi1", "seed": 0, "n": 200, "n_equal": 200}, ...]}
 
 ``n`` and ``seed`` are the scenario set (:func:`~sumo_ayss.envs.odd.sample_initial_conditions`)
-and, with the opponents, what a rerun compares before skipping the case.
+and, with the opponents and ``rollout``, what a rerun compares before skipping the case.
+``rollout`` names how the episodes were driven: ``"outcome"`` (the outcome stage's single
+env, :mod:`sumo_ayss.scenarios.crossplay`) or ``"pairs"`` (many pairs in one simulation,
+how tables were made before issue 21; such a table is re-run). ``diagonal`` is the check
+that each SPCP, driven against its own VUT, reproduced its run's ``outcome.csv``: per run,
+how many of the ``n`` episodes were equal (absent in older records).
 
 Imports neither SUMO nor torch.
 """
@@ -25,7 +31,19 @@ from typing import Any
 from sumo_ayss.errors import TableError
 from sumo_ayss.run_folder.jsonio import read_json, write_json
 
-__all__ = ["CrossplayOpponent", "CrossplayRecord", "read_crossplay_json", "write_crossplay_json"]
+__all__ = [
+    "ROLLOUT",
+    "CrossplayOpponent",
+    "CrossplayRecord",
+    "DiagonalCheck",
+    "read_crossplay_json",
+    "write_crossplay_json",
+]
+
+#: How the cross-play stage drives its episodes now (see the module docstring).
+ROLLOUT = "outcome"
+#: What a record without ``rollout`` was driven by.
+_LEGACY_ROLLOUT = "pairs"
 
 
 @dataclass(frozen=True)
@@ -44,6 +62,32 @@ class CrossplayOpponent:
 
 
 @dataclass(frozen=True)
+class DiagonalCheck:
+    """One SPCP against its own VUT in cross-play, compared with its run's outcome table.
+
+    Attributes:
+        vut: The VUT (and the VUT the SPCP was trained against).
+        seed: The run's training seed.
+        n: Episodes compared.
+        n_equal: Episodes equal in every column both tables hold (return, collision, final
+            headway, decisions, near-miss pay, mobility), exactly.
+    """
+
+    vut: str
+    seed: int
+    n: int
+    n_equal: int
+
+    @property
+    def ok(self) -> bool:
+        return self.n_equal == self.n
+
+    @property
+    def share_differing(self) -> float:
+        return (self.n - self.n_equal) / self.n if self.n else 0.0
+
+
+@dataclass(frozen=True)
 class CrossplayRecord:
     """``crossplay.json``.
 
@@ -54,6 +98,8 @@ class CrossplayRecord:
         opponents: The SPCP pool, in the order of the table.
         vuts: The VUTs driven against, in the order of the table.
         wall_s: Wall time of the rollouts, s.
+        rollout: How the episodes were driven (:data:`ROLLOUT` now).
+        diagonal: The diagonal check per run (empty in records written before it).
     """
 
     case: str
@@ -62,10 +108,14 @@ class CrossplayRecord:
     opponents: tuple[CrossplayOpponent, ...]
     vuts: tuple[str, ...]
     wall_s: float
+    rollout: str = ROLLOUT
+    diagonal: tuple[DiagonalCheck, ...] = ()
 
     def same_inputs(self, other: CrossplayRecord) -> bool:
-        """Whether ``other`` ran the same scenarios against the same SPCPs (a rerun skips)."""
-        return (self.n, self.seed, self.opponents) == (other.n, other.seed, other.opponents)
+        """Whether ``other`` ran the same scenarios against the same SPCPs the same way (a
+        rerun skips)."""
+        mine = (self.n, self.seed, self.opponents, self.rollout)
+        return mine == (other.n, other.seed, other.opponents, other.rollout)
 
 
 def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
@@ -80,6 +130,8 @@ def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
             "opponents": [dataclasses.asdict(o) for o in record.opponents],
             "vuts": list(record.vuts),
             "wall_s": round(record.wall_s, 3),
+            "rollout": record.rollout,
+            "diagonal": [dataclasses.asdict(d) for d in record.diagonal],
         },
     )
 
@@ -118,6 +170,22 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
     vuts = _field(data, "vuts", list, where)
     if not all(isinstance(v, str) for v in vuts):
         raise TableError(f"{where}: vuts: expected a list of names, got {vuts!r}")
+    diagonal = []
+    for i, item in enumerate(data.get("diagonal", [])):
+        at = f"{where}: diagonal[{i}]"
+        if not isinstance(item, Mapping):
+            raise TableError(f"{at}: expected an object, got {item!r}")
+        diagonal.append(
+            DiagonalCheck(
+                _field(item, "vut", str, at),
+                _field(item, "seed", int, at),
+                _field(item, "n", int, at),
+                _field(item, "n_equal", int, at),
+            )
+        )
+    rollout = data.get("rollout", _LEGACY_ROLLOUT)
+    if not isinstance(rollout, str):
+        raise TableError(f"{where}: rollout: expected str, got {rollout!r}")
     return CrossplayRecord(
         case=_field(data, "case", str, where),
         n=_field(data, "n", int, where),
@@ -125,4 +193,6 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
         opponents=tuple(opponents),
         vuts=tuple(vuts),
         wall_s=float(_field(data, "wall_s", (int, float), where)),
+        rollout=rollout,
+        diagonal=tuple(diagonal),
     )

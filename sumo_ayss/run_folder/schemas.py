@@ -55,6 +55,24 @@ OUTCOME_SCHEMA = TableSchema(
             "headway h after the last step (POV rear minus VUT front; < 0 = overlap)",
         ),
         Column("n_steps", "int", "-", "decisions taken (25 for a full 5 s episode)"),
+        Column(
+            "near_miss_pay",
+            "float",
+            "-",
+            "adversarial reward paid over the episode, the sum of alpha_A·R_A; the collision "
+            "term excluded (read from episode_return in files written before this column)",
+            nullable=True,
+            since=True,
+        ),
+        Column(
+            "vut_mean_speed_mps",
+            "float",
+            "m/s",
+            "the VUT's mobility: mean of its speed at the end of each decision (NaN in files "
+            "written before this column)",
+            nullable=True,
+            since=True,
+        ),
     ),
 )
 
@@ -146,5 +164,23 @@ CROSSPLAY_SCHEMA = TableSchema(
             "headway h after the last step (POV rear minus VUT front; < 0 = overlap)",
         ),
         Column("n_steps", "int", "-", "decisions in the episode"),
+        Column(
+            "near_miss_pay",
+            "float",
+            "-",
+            "adversarial reward paid over the episode, the sum of alpha_A·R_A; the collision "
+            "term excluded (read from episode_return in files written before this column)",
+            nullable=True,
+            since=True,
+        ),
+        Column(
+            "vut_mean_speed_mps",
+            "float",
+            "m/s",
+            "the VUT's mobility: mean of its speed at the end of each decision (NaN in files "
+            "written before this column)",
+            nullable=True,
+            since=True,
+        ),
     ),
 )

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -67,6 +68,9 @@ class Column:
         allow_inf: ±inf allowed (float columns only).
         choices: Allowed values of a ``str`` column, or a function returning them (asked at
             each check); ``None`` = any text.
+        since: A column added after files were written (``nullable`` float only): a file
+            without it reads as all-NaN (the writer's version predates it, and the reader
+            says "not recorded"); one *with* it is checked like any other column.
     """
 
     name: str
@@ -76,6 +80,11 @@ class Column:
     nullable: bool = False
     allow_inf: bool = False
     choices: tuple[str, ...] | Callable[[], tuple[str, ...]] | None = None
+    since: bool = False
+
+    def __post_init__(self) -> None:
+        if self.since and not (self.dtype == "float" and self.nullable):
+            raise ValueError(f"column {self.name}: 'since' needs a nullable float column")
 
     def allowed(self) -> tuple[str, ...] | None:
         """The allowed values now (:attr:`choices`, called when it is a function)."""
@@ -164,10 +173,15 @@ class Table:
 
 
 def table_from_rows(schema: TableSchema, rows: Sequence[Mapping[str, Any]]) -> Table:
-    """Build a :class:`Table` from row dicts holding exactly the schema's columns."""
+    """Build a :class:`Table` from row dicts holding exactly the schema's columns (a column
+    marked ``since`` may be left out: NaN, not recorded)."""
+    late = [c.name for c in schema.columns if c.since]
     for i, row in enumerate(rows):
-        _check_names(schema, list(row), f"{schema.name} row {i}")
-    return Table(schema, {c.name: [row[c.name] for row in rows] for c in schema.columns})
+        _check_names(schema, [*row, *(n for n in late if n not in row)], f"{schema.name} row {i}")
+    return Table(
+        schema,
+        {c.name: [row.get(c.name, math.nan) for row in rows] for c in schema.columns},
+    )
 
 
 def _check_names(schema: TableSchema, names: Sequence[str], where: str) -> None:
@@ -296,7 +310,8 @@ def read_table(path: str | Path, schema: TableSchema) -> Table:
     if not rows:
         raise TableError(f"{path}: empty file, expected a header with {schema.names}")
     header, body = rows[0], rows[1:]
-    _check_names(schema, header, str(path))
+    late = [c.name for c in schema.columns if c.since and c.name not in header]
+    _check_names(schema, header + late, str(path))
     if len(set(header)) != len(header):
         raise TableError(f"{path}: duplicate column names in header {header}")
     for i, row in enumerate(body):
@@ -309,6 +324,8 @@ def read_table(path: str | Path, schema: TableSchema) -> Table:
         arr = _parse_column(col, cells[j], path)
         _check_values(col, arr, str(path))
         columns[name] = arr
+    for name in late:  # written before the column existed
+        columns[name] = np.full(len(body), np.nan)
     return Table(schema, {name: columns[name] for name in schema.names})
 
 

@@ -9,12 +9,24 @@ on the same outcome scenarios. Each SPCP is then a block: the difference between
 is read within one opponent (same network, same scenarios), which removes the opponent's
 own quality from the comparison (:mod:`sumo_ayss.analysis.crossplay`).
 
-:func:`run_crossplay` rolls each opponent greedily over the ``n`` initial conditions of
-``seed`` (by default those of the outcome stage, so the diagonal "own SPCP vs own VUT" is
-the outcome table), ``n_envs`` episodes at a time in one SUMO simulation
-(:class:`~sumo_ayss.envs.vec_env.PairVecEnv`, bit-identical per pair to the single env).
-One row per (VUT, opponent, scenario) goes to
+:func:`run_crossplay` drives each opponent against each VUT exactly as the outcome stage
+drives a VUT's own SPCP (:func:`~sumo_ayss.scenarios.outcome.run_outcome`): a fresh single
+env of the VUT's config with SUMO seed = the opponent's training seed (the outcome stage
+uses the run's seed), the ``n`` initial conditions of ``seed`` in order, the greedy policy
+called on one observation per step. The diagonal "own SPCP vs own VUT" is therefore the
+outcome table episode for episode, for every VUT law, action step and random stream (a
+stochastic SUMO model draws the same numbers in both), and the cross-play stage checks it
+(:func:`diagonal_check`). Within a seed block every VUT meets the same SUMO seed (common
+random numbers). One row per (VUT, opponent, scenario) goes to
 :data:`~sumo_ayss.run_folder.CROSSPLAY_SCHEMA`.
+
+Why not the vec env (many pairs in one simulation, about 4x faster here): a pair placed
+there is a different SUMO object path (insertion while waiting) and a batch of N
+observations gives the Q-network other last float bits than a batch of one (measured: all
+5,000 of 5,000 rows differ, by up to 4e-6, between batch sizes 1 and 50), which flips the
+greedy action at near-ties; stochastic models draw from streams shared by all pairs. Each
+is a way for cross-play to drive another vehicle than the one the opponents were trained
+and scored against (issue 21).
 """
 
 from __future__ import annotations
@@ -29,11 +41,11 @@ import numpy as np
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, Table
-from sumo_ayss.scenarios.rollout import Policy
+from sumo_ayss.errors import ConfigError, DiagonalMismatchError
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, DiagonalCheck, Table, table_from_rows
+from sumo_ayss.scenarios.rollout import Policy, run_episodes
 
-__all__ = ["Opponent", "run_crossplay"]
+__all__ = ["DIAGONAL_COLUMNS", "Opponent", "check_diagonal", "diagonal_check", "run_crossplay"]
 
 
 @dataclass(frozen=True)
@@ -70,7 +82,6 @@ def run_crossplay(
     *,
     n: int,
     seed: int,
-    n_envs: int = 50,
     progress: Callable[[str], None] | None = None,
 ) -> Table:
     """Every opponent against every VUT on ``n`` common scenarios.
@@ -79,57 +90,121 @@ def run_crossplay(
         envs: VUT name -> its env config (identical but for the VUT).
         opponents: The SPCP pool.
         n: Scenarios per (VUT, opponent), >= 1.
-        seed: Seed of :func:`~sumo_ayss.envs.odd.sample_initial_conditions`.
-        n_envs: Pairs simulated at once, >= 1.
+        seed: Seed of :func:`~sumo_ayss.envs.odd.sample_initial_conditions` (the outcome
+            stage's).
         progress: Called with one line per (VUT, opponent) done.
 
     Returns:
         The cross-play table, VUTs in the given order, then opponents, then scenarios.
     """
-    from sumo_ayss.envs.vec_env import PairVecEnv
+    from sumo_ayss.envs import make_env
 
     if not envs or not opponents:
         raise ConfigError("cross-play needs at least one VUT and one opponent SPCP")
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise ConfigError(f"n: expected an integer >= 1, got {n!r}")
     _same_but_vut(envs)
-    cols: dict[str, list[object]] = {c.name: [] for c in CROSSPLAY_SCHEMA.columns}
+    rows: list[dict[str, object]] = []
     for vut, cfg in envs.items():
         scenarios = sample_initial_conditions(cfg.odd, n, seed)
-        venv = PairVecEnv(cfg, n_envs=min(n_envs, n), sumo_seed=seed)
-        try:
-            for opp in opponents:
-                t0 = time.perf_counter()
-                policy = opp.load(venv.envs[0])
-                traces = venv.run_scenarios(policy, scenarios)
-                for j, tr in enumerate(traces):
-                    last = tr.infos[-1]
-                    cols["vut"].append(vut)
-                    cols["opponent_vut"].append(opp.vut)
-                    cols["opponent_seed"].append(opp.seed)
-                    cols["scenario"].append(j)
-                    total = 0.0
-                    for r in tr.rewards:  # summed as run_episode does: diagonal == outcome
-                        total += float(r)
-                    cols["episode_return"].append(total)
-                    cols["collided"].append(bool(last["collision"]))
-                    cols["final_headway_m"].append(float(last["headway_m"]))
-                    cols["n_steps"].append(len(tr.rewards))
-                if progress is not None:
-                    mean = float(np.mean(cols["episode_return"][-n:]))  # type: ignore[arg-type]
-                    progress(
-                        f"{vut} vs SPCP {opp.vut}/seed_{opp.seed}: mean return {mean:.2f} "
-                        f"({time.perf_counter() - t0:.1f} s)"
-                    )
-        finally:
-            venv.close()
-    return Table(
-        CROSSPLAY_SCHEMA,
-        {
-            **{k: cols[k] for k in ("vut", "opponent_vut", "episode_return", "final_headway_m")},
-            "opponent_seed": np.array(cols["opponent_seed"], dtype=np.int64),
-            "scenario": np.array(cols["scenario"], dtype=np.int64),
-            "collided": np.array(cols["collided"], dtype=bool),
-            "n_steps": np.array(cols["n_steps"], dtype=np.int64),
-        },
+        for opp in opponents:
+            t0 = time.perf_counter()
+            env = make_env(cfg, sumo_seed=opp.seed)  # as the outcome stage: a fresh SUMO
+            try:
+                policy = opp.load(env)
+                episodes = run_episodes(env, policy, scenarios)
+            finally:
+                env.close()
+            for j, e in enumerate(episodes):
+                rows.append(
+                    {
+                        "vut": vut,
+                        "opponent_vut": opp.vut,
+                        "opponent_seed": opp.seed,
+                        "scenario": j,
+                        "episode_return": e.episode_return,
+                        "collided": e.collided,
+                        "final_headway_m": e.final_headway_m,
+                        "n_steps": e.n_steps,
+                        "near_miss_pay": e.near_miss_pay,
+                        "vut_mean_speed_mps": e.vut_mean_speed_mps,
+                    }
+                )
+            if progress is not None:
+                mean = float(np.mean([e.episode_return for e in episodes]))
+                crashes = sum(e.collided for e in episodes)
+                progress(
+                    f"{vut} vs SPCP {opp.vut}/seed_{opp.seed}: mean return {mean:.2f}, "
+                    f"{crashes}/{n} crashes ({time.perf_counter() - t0:.1f} s)"
+                )
+    return table_from_rows(CROSSPLAY_SCHEMA, rows)
+
+
+#: Columns of a cross-play row compared with the same episode of ``outcome.csv``.
+DIAGONAL_COLUMNS = (
+    "episode_return",
+    "collided",
+    "final_headway_m",
+    "n_steps",
+    "near_miss_pay",
+    "vut_mean_speed_mps",
+)
+
+
+def diagonal_check(crossplay: Table, vut: str, seed: int, outcome: Table) -> DiagonalCheck:
+    """Compares the SPCP of run (``vut``, ``seed``) against its own VUT with its outcome table.
+
+    Episodes are matched by scenario index; values must be equal exactly (both come from
+    the same rollout code on the same SUMO seed). A column that one of the tables does not
+    hold (NaN throughout: written before the column existed) is left out.
+
+    Raises:
+        ConfigError: If the cross-play table has no rows for that opponent against that VUT.
+    """
+    rows = (
+        (crossplay["vut"] == vut)
+        & (crossplay["opponent_vut"] == vut)
+        & (crossplay["opponent_seed"] == seed)
     )
+    idx = np.flatnonzero(rows)
+    if idx.size == 0:
+        raise ConfigError(f"cross-play table: no episodes of SPCP {vut}/seed_{seed} against {vut}")
+    cols = [c for c in DIAGONAL_COLUMNS if not (_absent(crossplay, c) or _absent(outcome, c))]
+    position = {int(sc): i for i, sc in enumerate(outcome["scenario"].tolist())}
+    n_equal = 0
+    for row, sc in zip(idx.tolist(), crossplay["scenario"][idx].tolist(), strict=True):
+        i = position.get(int(sc))
+        n_equal += i is not None and all(_same(crossplay[c][row], outcome[c][i]) for c in cols)
+    return DiagonalCheck(vut, seed, int(idx.size), int(n_equal))
+
+
+def _absent(table: Table, col: str) -> bool:
+    """A float column with no value at all: the file was written before the column existed."""
+    values = table[col]
+    return values.dtype.kind == "f" and bool(np.isnan(values).all())
+
+
+def _same(a: object, b: object) -> bool:
+    """Exactly equal (NaN equal to NaN)."""
+    return bool(a == b) or (isinstance(a, float) and isinstance(b, float) and a != a and b != b)
+
+
+def check_diagonal(checks: Sequence[DiagonalCheck], case: str) -> None:
+    """Refuse a cross-play table whose diagonal did not reproduce the outcome tables.
+
+    Raises:
+        DiagonalMismatchError: naming each VUT and run that differed and by how much.
+    """
+    bad = [c for c in checks if not c.ok]
+    if bad:
+        parts = "; ".join(
+            f"{c.vut} (seed {c.seed}): {c.n - c.n_equal} of {c.n} episodes differ "
+            f"({100 * c.share_differing:.1f} %)"
+            for c in bad
+        )
+        raise DiagonalMismatchError(
+            f"cross-play of {case} drove a VUT differently from the outcome stage: an SPCP "
+            f"against its own VUT did not reproduce its outcome.csv: {parts}. Its verdict "
+            "would be about another vehicle than the one its opponents were trained against; "
+            "the cross-play table is kept for inspection but not ranked"
+        )

@@ -11,7 +11,8 @@ One row per episode goes to the outcome table (:data:`~sumo_ayss.run_folder.
 OUTCOME_SCHEMA`); :func:`summarize_outcome` reduces it to
 
 * crash rate and lane-change rate: proportions with a Wilson score interval
-  (:func:`wilson_interval`), which stays inside [0, 1] and is informative at 0 crashes;
+  (:func:`~sumo_ayss.analysis.stats.wilson_interval`), which stays inside [0, 1] and is
+  informative at 0 crashes;
 * mean episode reward and mean final headway: Student t intervals
   (:func:`sumo_ayss.analysis.stats.mean_ci`);
 * for cut-in, also the paper's Table III reading: mean reward and headway over the episodes
@@ -24,14 +25,13 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
-from statistics import NormalDist
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 from tqdm import tqdm
 
-from sumo_ayss.analysis.stats import check_level, mean_ci
+from sumo_ayss.analysis.stats import mean_ci, wilson_interval
 from sumo_ayss.cases import get_case
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
@@ -49,7 +49,6 @@ __all__ = [
     "outcome_table",
     "run_outcome",
     "summarize_outcome",
-    "wilson_interval",
 ]
 
 #: Episodes per SPCP (paper: 200).
@@ -59,41 +58,6 @@ DEFAULT_OUTCOME_SEED = 4242
 
 
 # --------------------------------------------------------------------------- statistics
-
-
-def wilson_interval(count: int, n: int, level: float = 0.95) -> tuple[float, float]:
-    """Wilson score interval of a binomial proportion ``count / n``.
-
-    ``(p + z²/2n ± z·sqrt(p(1-p)/n + z²/4n²)) / (1 + z²/n)`` with ``p = count / n`` and
-    ``z`` the standard normal ``(1 + level) / 2`` quantile. Unlike the Wald interval it
-    does not collapse to a point at 0 or n successes: at ``count = 0`` it is
-    ``[0, z² / (n + z²)]``.
-
-    Args:
-        count: Successes, ``0 <= count <= n``.
-        n: Trials, >= 1.
-        level: Confidence level in (0, 1).
-
-    Returns:
-        ``(lo, hi)`` as fractions in [0, 1].
-
-    Raises:
-        ConfigError: If ``n < 1``, ``count`` is outside ``[0, n]`` or ``level`` is invalid.
-    """
-    level = check_level(level)
-    if isinstance(n, bool) or int(n) != n or n < 1:
-        raise ConfigError(f"n: expected an integer >= 1, got {n!r}")
-    if isinstance(count, bool) or int(count) != count or not 0 <= count <= n:
-        raise ConfigError(f"count: expected an integer in [0, {n}], got {count!r}")
-    z = NormalDist().inv_cdf(0.5 * (1.0 + level))
-    p = count / n
-    z2n = z * z / n
-    denom = 1.0 + z2n
-    centre = (p + 0.5 * z2n) / denom
-    half = z / denom * math.sqrt(p * (1.0 - p) / n + z * z / (4.0 * n * n))
-    lo = 0.0 if count == 0 else max(0.0, centre - half)
-    hi = 1.0 if count == n else min(1.0, centre + half)
-    return lo, hi
 
 
 @dataclass(frozen=True)
@@ -221,6 +185,8 @@ def outcome_table(
             "lane_changed": np.array([e.lane_changed for e in episodes], dtype=bool),
             "final_headway_m": [e.final_headway_m for e in episodes],
             "n_steps": np.array([e.n_steps for e in episodes], dtype=np.int64),
+            "near_miss_pay": [e.near_miss_pay for e in episodes],
+            "vut_mean_speed_mps": [e.vut_mean_speed_mps for e in episodes],
         },
     )
 

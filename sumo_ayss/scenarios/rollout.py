@@ -8,8 +8,9 @@ any callable from a batch of observations ``(N, obs_dim)`` to actions ``(N,)``.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -22,13 +23,26 @@ Policy = Callable[[npt.NDArray[np.float32]], npt.NDArray[np.integer]]
 
 @dataclass(frozen=True)
 class EpisodeResult:
-    """One episode. Headways in m; ``lane_changed`` is False in car-following."""
+    """One episode.
+
+    Attributes:
+        episode_return: Sum of the rewards R (a collision step pays ``-alpha_collision``).
+        collided: The episode ended in a collision.
+        final_headway_m: Headway h after the last step [m].
+        n_steps: Decisions taken.
+        lane_changed: The POV started a lane change (always False in car-following).
+        near_miss_pay: Sum of ``alpha_A·R_A`` over the episode: the return without the
+            collision term (a collision step pays no R_A).
+        vut_mean_speed_mps: Mean of the VUT's speed at the end of each decision [m/s].
+    """
 
     episode_return: float
     collided: bool
     final_headway_m: float
     n_steps: int
     lane_changed: bool
+    near_miss_pay: float = math.nan
+    vut_mean_speed_mps: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -55,16 +69,42 @@ def run_episode(env: PairEnv, policy: Policy, ic: InitialCondition) -> EpisodeRe
     base = env.unwrapped
     assert isinstance(base, PairEnv)
     obs, _ = base.reset(options={"initial_condition": ic})
-    total, steps, changed = 0.0, 0, False
+    rewards: list[float] = []
+    infos: list[dict[str, Any]] = []
     while True:
         action = int(np.asarray(policy(obs[None, :])).reshape(-1)[0])
         obs, reward, terminated, truncated, info = base.step(action)
-        total += float(reward)
-        steps += 1
-        changed = changed or bool(info.get("lane_change_started", False))
+        rewards.append(float(reward))
+        infos.append(info)
         if terminated or truncated:
             break
-    return EpisodeResult(total, bool(info["collision"]), float(info["headway_m"]), steps, changed)
+    return episode_result(rewards, infos)
+
+
+def episode_result(rewards: Sequence[float], infos: Sequence[Mapping[str, Any]]) -> EpisodeResult:
+    """The :class:`EpisodeResult` of one episode's rewards and step infos (in order).
+
+    The one tabulation of an episode, whichever env ran it (the single env here, the pairs
+    of a :class:`~sumo_ayss.envs.vec_env.PairVecEnv` in training's evaluation).
+    """
+    total = pay = speed_sum = 0.0
+    changed = False
+    for reward, info in zip(rewards, infos, strict=True):
+        total += float(reward)
+        if not info["collision"]:
+            pay += float(reward)
+        speed_sum += float(info["vut_speed_mps"])
+        changed = changed or bool(info.get("lane_change_started", False))
+    last = infos[-1]
+    return EpisodeResult(
+        total,
+        bool(last["collision"]),
+        float(last["headway_m"]),
+        len(rewards),
+        changed,
+        near_miss_pay=pay,
+        vut_mean_speed_mps=speed_sum / len(rewards),
+    )
 
 
 def run_episodes(

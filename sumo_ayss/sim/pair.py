@@ -125,11 +125,31 @@ class VehiclePair:
             libsumo.vehicle.moveTo(self.vut, f"{self.edge}_{p.vut_lane}", p.vut_pos_m)
             libsumo.vehicle.setPreviousSpeed(self.pov, p.pov_speed_mps)
             libsumo.vehicle.setPreviousSpeed(self.vut, p.vut_speed_mps)
+            self._start_vut_decisions()
         except SUMO_ERRORS as e:
             raise SimulationError(
                 f"placing pair {self.prefix} at {p} failed ({e}); was it inserted? "
                 "(a vehicle SUMO could not insert is silently kept waiting)"
             ) from e
+
+    def _start_vut_decisions(self) -> None:
+        """The VUT's first decision is the episode's first step, then one every
+        ``actionStepLength`` (the testbed's semantics of SUMO's action step; DESIGN.md).
+
+        SUMO's driver decides only at *action points*, every ``actionStepLength``; between
+        them it keeps its last acceleration. Where the first action point falls depends on
+        how the vehicle entered the simulation (SUMO: ``MSVehicle::isActionStep``,
+        ``(t - myLastActionTime) % actionStepLength == 0``): a vehicle inserted by a step
+        and moved into place (the single env) decides in the episode's first step, as one
+        departing from a route file does; one placed while still waiting for insertion (the
+        vec env) did not, and drove its first second blind (issue 21: 62 % crashes against
+        5 %). ``setActionStepLength(id, length, resetActionOffset=True)`` schedules the next
+        action point immediately, so every path starts the VUT's decisions alike. A VUT
+        whose action step equals the step length decides every step: nothing to align.
+        """
+        length = libsumo.vehicle.getActionStepLength(self.vut)
+        if length > libsumo.simulation.getDeltaT() + 1e-9:
+            libsumo.vehicle.setActionStepLength(self.vut, length, True)
 
     def remove(self) -> None:
         """Remove the pair's vehicles if they are still in the simulation."""

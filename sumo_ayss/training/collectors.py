@@ -33,8 +33,8 @@ from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.envs.vec_env import EpisodeTrace, PairVecEnv
-from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, run_episodes
+from sumo_ayss.envs.vec_env import PairVecEnv
+from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, episode_result, run_episodes
 
 #: SB3's rollout locals as a callback sees them (``BaseCallback.locals``); None outside.
 Rollout = MutableMapping[str, Any]
@@ -220,17 +220,4 @@ def evaluate_on_vec(
     which can only matter at exact ties of two actions' Q-values. ``vec`` needs a
     :meth:`~PairVecEnv.reset` afterwards.
     """
-    return [_episode_result(trace) for trace in vec.run_scenarios(policy, scenarios)]
-
-
-def _episode_result(trace: EpisodeTrace) -> EpisodeResult:
-    """The :class:`EpisodeResult` of a trace, as ``run_episode`` tabulates an episode."""
-    total = 0.0
-    changed = False
-    for reward, info in zip(trace.rewards, trace.infos, strict=True):
-        total += float(reward)
-        changed = changed or bool(info.get("lane_change_started", False))
-    last = trace.infos[-1]
-    return EpisodeResult(
-        total, bool(last["collision"]), float(last["headway_m"]), len(trace.rewards), changed
-    )
+    return [episode_result(t.rewards, t.infos) for t in vec.run_scenarios(policy, scenarios)]

@@ -1,4 +1,5 @@
-"""Cross-play ranking on synthetic matrices with a known answer."""
+"""Cross-play ranking on synthetic matrices with a known answer (cell values stand for the
+mean harm per episode; the harm itself is tested in test_harm.py)."""
 
 from __future__ import annotations
 
@@ -66,7 +67,8 @@ def test_matrix_means_and_balance():
     m = crossplay_matrix(*_table(m0))
     assert m.vuts == ("v0", "v1")
     assert m.opponents == (("v0", 0), ("v0", 1), ("v0", 2), ("v1", 0), ("v1", 1), ("v1", 2))
-    np.testing.assert_allclose(m.returns, m0)
+    np.testing.assert_allclose(m.harm, m0)
+    assert np.isnan(m.returns).all() and np.isnan(m.mobility).all()  # not given
     assert m.n_scenarios == 2
     assert m.crash_rate[0, 0] == 0.5 and m.crash_rate[1].sum() == 0.0
     vut, ov, os_, ret, col = _table(m0)
@@ -75,7 +77,7 @@ def test_matrix_means_and_balance():
     with pytest.raises(ConfigError, match="lengths differ"):
         crossplay_matrix(vut, ov, os_, ret[:-1], col)
     ret[3] = math.nan
-    with pytest.raises(ConfigError, match="non-finite"):
+    with pytest.raises(ConfigError, match="harm has non-finite"):
         crossplay_matrix(vut, ov, os_, ret, col)
 
 
@@ -152,8 +154,8 @@ def test_sentence_names_mode_amount_and_blocks():
     m = crossplay_matrix(*_table(_null_or_ladder(rng, [0.0, 3.0], noise=0.05)))
     rows, _ = rank_crossplay(m)
     text = crossplay_sentence(rows[0].vs_next)
-    assert text.startswith("[crossplay mode] v0 is safer than v1: the pooled SPCPs extract ")
-    assert "more reward per episode from v1 than from v0" in text
+    assert text.startswith("[crossplay mode] v0 is safer than v1: the pooled SPCPs bring about ")
+    assert "more harm per episode against v1 than against v0" in text
     assert "paired t-test over 3 training seeds" in text
     text = crossplay_sentence(rank_crossplay(m, blocks="opponent")[0][0].vs_next, "opponent")
     assert "paired t-test over 6 opponent SPCPs" in text

@@ -29,6 +29,7 @@ from sumo_ayss.report.__main__ import main
 from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     CROSSPLAY_SCHEMA,
+    OUTCOME_SCHEMA,
     CaseFolder,
     RunConfig,
     RunFolder,
@@ -124,12 +125,36 @@ def make_run(
         header = StageHeader(str(folder.path), case, vut, seed, None)
         settings = {"n": 200, "seed": 4242}
         write_outcome_json(folder.outcome_json, header, settings, {}, summary.as_dict(), 1.0)
+        write_table(folder.outcome_csv, _outcome_table(summary, outcome_rng))
     if "ayss" in files:
         _write_ayss(folder.ayss_csv, case, vut, rng, n_samples)
     if "versions" in files:
         versions = {"python": "3.11.2", "eclipse-sumo": "1.28.0", "numpy": np.__version__}
         write_versions(folder.versions, versions)
     return folder.path
+
+
+def _outcome_table(summary: OutcomeSummary, rng: np.random.Generator) -> Table:
+    """Episodes whose mean return and crash count follow ``summary`` (crashes first)."""
+    n, crashes = summary.n_episodes, summary.crash_rate.count
+    pay = np.clip(rng.normal(summary.mean_return.mean, 0.5, n), 0.0, 24.9)
+    crashed = np.arange(n) < crashes
+    return Table(
+        OUTCOME_SCHEMA,
+        {
+            "scenario": np.arange(n),
+            "v_pov0_mps": np.full(n, 20.0),
+            "v_vut0_mps": np.full(n, 20.0),
+            "gap0_m": np.full(n, 10.0),
+            "episode_return": np.where(crashed, pay - 10.0, pay),
+            "collided": crashed,
+            "lane_changed": np.full(n, summary.lane_change_rate is not None),
+            "final_headway_m": np.full(n, summary.mean_final_headway_m.mean),
+            "n_steps": np.full(n, 25),
+            "near_miss_pay": pay,
+            "vut_mean_speed_mps": np.full(n, 20.0),
+        },
+    )
 
 
 def make_crossplay(case_dir: Path, vuts: Sequence[str], seeds: Sequence[int], n: int = 20) -> Path:
@@ -147,9 +172,10 @@ def make_crossplay(case_dir: Path, vuts: Sequence[str], seeds: Sequence[int], n:
                     cols["opponent_vut"].append(o_vut)
                     cols["opponent_seed"].append(o_seed)
                     cols["scenario"].append(k)
-                    cols["episode_return"].append(
-                        19.4 + EXPOSURE.get(vut, 0.0) + level + rng.normal(0.0, 0.3)
-                    )
+                    pay = 19.4 + EXPOSURE.get(vut, 0.0) + level + rng.normal(0.0, 0.3)
+                    cols["episode_return"].append(pay)
+                    cols["near_miss_pay"].append(pay)
+                    cols["vut_mean_speed_mps"].append(20.0)
                     cols["collided"].append(False)
     for c in CROSSPLAY_SCHEMA.columns:  # the columns the ranking does not read
         if not cols[c.name]:
@@ -423,11 +449,11 @@ def test_crossplay_section_and_headline_from_the_case_table(tmp_path: Path) -> N
     html = write_report([root], options=FAST)
     text = html.read_text(encoding="utf-8")
     verdicts = text.split('id="inputs"')[0]
-    assert "[crossplay mode] pi2 is safer than pi1: the pooled SPCPs extract" in verdicts
+    assert "[crossplay mode] pi2 is safer than pi1: the pooled SPCPs bring about" in verdicts
     assert "Ranking (crossplay mode), safest first: pi2 &gt; pi1" in verdicts
     assert "Ranking (exposure mode), safest first: pi2" in verdicts
     assert "(i) Cross-play ranking" in text and "paired t-test over training-seed blocks" in text
-    assert "Ranking by cross-play exposure X" in text
+    assert "Ranking by cross-play harm H" in text
     assert (html.parent / "car_following_crossplay_by_opponent.png").is_file()
     md = (html.parent / "summary.md").read_text(encoding="utf-8")
     assert "car_following_crossplay_by_opponent.png" in md
@@ -435,7 +461,8 @@ def test_crossplay_section_and_headline_from_the_case_table(tmp_path: Path) -> N
 
 def test_crossplay_needs_two_vuts_and_a_table_of_these_runs(tmp_path: Path) -> None:
     from sumo_ayss.analysis.case import analyse_case
-    from sumo_ayss.report.load import group_runs, load_crossplay
+    from sumo_ayss.report.episodes import load_crossplay
+    from sumo_ayss.report.load import group_runs
 
     root = tmp_path / "runs"
     dirs = [make_run(root, "cut_in", "pi1", s) for s in range(2)]
@@ -455,7 +482,8 @@ def test_crossplay_needs_two_vuts_and_a_table_of_these_runs(tmp_path: Path) -> N
 def test_the_loader_hands_analysis_the_crossplay_table_or_why_there_is_none(tmp_path: Path) -> None:
     """analysis/ reads no file: :func:`load_crossplay` reads the case's crossplay.csv."""
     from sumo_ayss.analysis.case import analyse_case
-    from sumo_ayss.report.load import group_runs, load_crossplay
+    from sumo_ayss.report.episodes import load_crossplay
+    from sumo_ayss.report.load import group_runs
 
     root = tmp_path / "runs"
     dirs = [make_run(root, "cut_in", v, s) for v in ("pi1", "pi2") for s in range(2)]

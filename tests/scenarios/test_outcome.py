@@ -12,6 +12,7 @@ import numpy.typing as npt
 import pytest
 import yaml
 
+from sumo_ayss.analysis.stats import wilson_interval
 from sumo_ayss.config import AyssConfig, load_experiment
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.odd import sample_initial_conditions
@@ -28,7 +29,6 @@ from sumo_ayss.scenarios.outcome import (
     Proportion,
     run_outcome,
     summarize_outcome,
-    wilson_interval,
 )
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.train import train

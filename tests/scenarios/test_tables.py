@@ -35,6 +35,8 @@ def outcome_rows() -> list[dict[str, object]]:
             "lane_changed": False,
             "final_headway_m": -0.3 if i == 1 else 1.7,
             "n_steps": 7 if i == 1 else 25,
+            "near_miss_pay": 3.25 if i == 1 else 12.345678901234567,
+            "vut_mean_speed_mps": 1.0 / 3.0 + i,
         }
         for i in range(3)
     ]
@@ -141,7 +143,7 @@ def test_ragged_rows_bad_bools_and_missing_files_are_refused(tmp_path: Path) -> 
     write_table(path, table_from_rows(OUTCOME_SCHEMA, outcome_rows()))
     lines = path.read_text().splitlines()
     path.write_text("\n".join([*lines[:2], lines[2] + ",9", *lines[3:]]) + "\n")
-    with pytest.raises(TableError, match="row 1 has 10 cells, header has 9"):
+    with pytest.raises(TableError, match="row 1 has 12 cells, header has 11"):
         read_table(path, OUTCOME_SCHEMA)
     rows = [line.split(",") for line in lines]
     rows[1][OUTCOME_SCHEMA.names.index("collided")] = "2"
@@ -180,3 +182,18 @@ def test_json_summary_is_strict_json(tmp_path: Path) -> None:
         read_json(tmp_path / "bad.json")
     with pytest.raises(TableError, match="not found"):
         read_json(tmp_path / "missing.json")
+
+
+def test_a_file_written_before_a_late_column_reads_it_as_not_recorded(tmp_path: Path) -> None:
+    """``near_miss_pay`` and ``vut_mean_speed_mps`` came later (issue 22): an older
+    outcome.csv without them reads, with NaN there; any other missing column is refused."""
+    path = tmp_path / "old.csv"
+    write_table(path, table_from_rows(OUTCOME_SCHEMA, outcome_rows()))
+    lines = [line.split(",")[:-2] for line in path.read_text().splitlines()]
+    path.write_text("\n".join(",".join(r) for r in lines) + "\n")
+    old = read_table(path, OUTCOME_SCHEMA)
+    assert np.isnan(old["near_miss_pay"]).all() and np.isnan(old["vut_mean_speed_mps"]).all()
+    assert old["episode_return"].tolist() == [r["episode_return"] for r in outcome_rows()]
+    path.write_text("\n".join(",".join(r[:-1]) for r in lines) + "\n")  # n_steps gone too
+    with pytest.raises(TableError, match=r"missing column\(s\) \['n_steps'\]"):
+        read_table(path, OUTCOME_SCHEMA)

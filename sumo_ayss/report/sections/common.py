@@ -2,17 +2,27 @@
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
 
 from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_prob
+from sumo_ayss.analysis.harm import VutOutcome
 from sumo_ayss.analysis.ranking import SafetyIndex
 from sumo_ayss.analysis.seeds import SeedComparison
 from sumo_ayss.report.blocks import Table
 from sumo_ayss.report.load import Estimate, Run
 
-__all__ = ["display_path", "fmt_est", "seed_points_text", "seeds_text"]
+__all__ = [
+    "TIMID_NOTE",
+    "crash_cell",
+    "display_path",
+    "fmt_est",
+    "mobility_cell",
+    "seed_points_text",
+    "seeds_text",
+]
 
 
 def fmt_est(e: Estimate | None, digits: int = 2, scale: float = 1.0, unit: str = "") -> str:
@@ -59,3 +69,29 @@ def pairs_table(pairs: Sequence[SeedComparison], score: str, pct: str, alpha: fl
     head = ("A", "B", f"{score}_B − {score}_A ({pct} CI)", "test", "p", significant)
     numeric = (False, False, True, False, True, False)
     return Table("Pairwise comparisons (A ranked above B)", head, rows, numeric)
+
+
+TIMID_NOTE = (
+    "A VUT marked TIMID drove at a mean speed below 80 % of the median VUT's over the same "
+    "episodes: it may owe its low harm to standing still rather than to driving safely."
+)
+"""What a TIMID flag means (:data:`sumo_ayss.analysis.harm.MOBILITY_FLOOR`)."""
+
+
+def crash_cell(o: VutOutcome | None) -> str:
+    """``"11.6 % (10.2–13.2 %), 209/1800"``, or "—"."""
+    if o is None or not o.episodes:
+        return "—"
+    return (
+        f"{100 * o.crash_rate:.1f} % ({100 * o.crash_lo:.1f}–{100 * o.crash_hi:.1f} %), "
+        f"{o.crashes}/{o.episodes}"
+    )
+
+
+def mobility_cell(o: VutOutcome | None) -> str:
+    """``"21.3 m/s"``, ``"4.2 m/s (TIMID)"``, "not recorded" or "—"."""
+    if o is None:
+        return "—"
+    if not math.isfinite(o.mobility):
+        return "not recorded"
+    return f"{o.mobility:.1f} m/s" + (" (TIMID)" if o.timid else "")

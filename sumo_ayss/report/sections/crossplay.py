@@ -19,7 +19,13 @@ from sumo_ayss.report.blocks import (
     Table,
 )
 from sumo_ayss.report.crossplay_figure import crossplay_figure
-from sumo_ayss.report.sections.common import display_path, pairs_table
+from sumo_ayss.report.sections.common import (
+    TIMID_NOTE,
+    crash_cell,
+    display_path,
+    mobility_cell,
+    pairs_table,
+)
 
 __all__ = ["crossplay_blocks"]
 
@@ -37,13 +43,17 @@ def crossplay_blocks(
     blocks.append(
         Paragraph(
             "Each SPCP of this case (one per VUT and training seed) drives against every VUT "
-            "of the case on the same outcome scenarios. A VUT's cross-play exposure X is the "
-            "mean episode reward this pool of opponents extracts from it; lower X is safer. "
-            "Because every opponent meets every VUT, a difference between two VUTs is read "
-            "within each opponent. Two VUTs are compared by a paired t-test over "
+            "of the case on the same outcome scenarios, exactly as the outcome stage drives "
+            "it. A VUT's cross-play harm H is the mean harm per episode this pool of opponents "
+            "brings about against it: 1 for an episode that ends in a collision, else the "
+            "near-miss reward paid over the most an episode can pay. Lower H is safer; a "
+            "collision is never the VUT's gain. Because every opponent meets every VUT, a "
+            "difference between two VUTs is read within each opponent. Two VUTs are compared "
+            "by a paired t-test over "
             f"{BLOCK_WORDS.get(a.crossplay_blocks, a.crossplay_blocks)}."
         )
     )
+    blocks.append(_diagonal_block(a))
     m = a.crossplay
     if m is None or not a.crossplay_rows:
         reason = a.crossplay_missing or "no cross-play ranking"
@@ -58,48 +68,87 @@ def crossplay_blocks(
     path = crossplay_figure(
         order,
         m.opponents,
-        m.returns,
+        m.harm,
         m.vuts,
         colors,
         out_dir / f"{a.case}_crossplay_by_opponent.png",
-        title=f"{a.info.title}: cross-play, reward per opponent (lower = safer)",
+        title=f"{a.info.title}: cross-play, harm per opponent (lower = safer)",
     )
     where = display_path(a.crossplay_path, out_dir) if a.crossplay_path is not None else ""
     blocks.append(
         FigureBlock(
             path,
-            "Mean episode reward (reward/episode, over "
-            f"{m.n_scenarios} scenarios) that each opponent SPCP extracts from each VUT, VUTs "
-            "in cross-play ranking order (safest left); colour: the VUT the opponent was "
-            "trained against, line style: its training seed. Lines that fall from left to "
-            f"right agree with the ranking. Table: {where}.",
+            f"Mean harm per episode (over {m.n_scenarios} scenarios) that each opponent SPCP "
+            "brings about against each VUT, VUTs in cross-play ranking order (safest left); "
+            "colour: the VUT the opponent was trained against, line style: its training "
+            "seed. Lower is safer, so lines that rise from left to right agree with the "
+            f"ranking. Table: {where}.",
         )
     )
+    outcomes = a.outcomes.get("crossplay", {})
     rows = []
     for r in a.crossplay_rows:
         nxt = r.vs_next
-        ci = fmt_interval(r.lo, r.hi)
+        ci = fmt_interval(r.lo, r.hi, 3)
+        o = outcomes.get(r.name)
         rows.append(
             (
                 str(r.rank),
                 r.name,
-                f"{fmt_num(r.mean)} ({ci})" if ci else fmt_num(r.mean),
+                f"{fmt_num(r.mean, 3)} ({ci})" if ci else fmt_num(r.mean, 3),
                 str(r.n_seeds),
                 f"{nxt.test}, p {fmt_p(nxt.p)}" if nxt else "—",
                 ("yes" if nxt.significant else "no") if nxt else "—",
+                crash_cell(o),
+                mobility_cell(o),
             )
         )
     blocks.append(
         Table(
-            "Ranking by cross-play exposure X (mean episode reward of the pooled SPCPs), "
-            "safest first",
-            ("rank", "VUT", f"X ({pct} CI)", "blocks", "test vs next", "significant vs next"),
+            "Ranking by cross-play harm H (mean harm per episode of the pooled SPCPs), "
+            "safest first; crash rate and mean VUT speed over the same episodes",
+            (
+                "rank",
+                "VUT",
+                f"H ({pct} CI)",
+                "blocks",
+                "test vs next",
+                "significant vs next",
+                "crash rate (Wilson 95 % CI, episodes pooled)",
+                "mean speed",
+            ),
             tuple(rows),
-            (True, False, True, True, False, False),
+            (True, False, True, True, False, False, True, True),
         )
     )
+    if any(o.timid for o in outcomes.values()):
+        blocks.append(Callout("Timid VUT", (TIMID_NOTE,), "warning"))
+    blocks.append(pairs_table(a.crossplay_pairs, "H", pct, options.welch_alpha))
     blocks.append(pairs_table(a.crossplay_pairs, "X", pct, options.welch_alpha))
     blocks.append(
         BulletList(tuple(crossplay_sentence(c, a.crossplay_blocks) for c in a.crossplay_pairs))
     )
     return blocks
+
+
+def _diagonal_block(a: CaseAnalysis) -> Block:
+    """The diagonal check: every SPCP against its own VUT reproduced its outcome table."""
+    checks = a.crossplay_diagonal
+    if not checks:
+        return Callout(
+            "Diagonal not checked",
+            (
+                "This cross-play table predates the check that each SPCP, driven against its "
+                "own VUT, reproduces its run's outcome table episode for episode (run "
+                "python -m sumo_ayss.crossplay <config> --force to check it).",
+            ),
+            "warning",
+        )
+    equal = sum(c[3] for c in checks)
+    total = sum(c[2] for c in checks)
+    return Paragraph(
+        f"Diagonal check: each of the {len(checks)} SPCPs, driven against its own VUT, "
+        f"reproduced its run's outcome table episode for episode ({equal} of {total} "
+        "episodes equal): cross-play drove the same vehicles the SPCPs were trained and "
+        "scored against."
+    )
