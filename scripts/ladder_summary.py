@@ -1,16 +1,22 @@
-"""Summarise a ladder study: Kendall's τ and significance per ladder, case and run.
+"""Summarise ladder studies: Kendall's τ, significance and crash rates per ladder, case, run.
 
     python scripts/ladder_summary.py results/ladders
 
 Reads every ``<root>/<ladder>_<run>/order_check.json`` and ``ranking.csv`` written by
 ``python -m sumo_ayss.rank`` (with ``expected_order``), prints a Markdown table (one row per
 ladder, case, run and mode: τ, ends significant with p, significant adjacent pairs, the
-ranking), writes it to ``<root>/summary.md`` and draws ``<root>/per_seed_exposure.png``: one
-panel per ladder and case, the per-seed exposure of every VUT in the known order (safest
-left), one line per training seed, both runs side by side. Where ``<study>/<case>/
-crossplay.csv`` exists it also draws ``<root>/crossplay_by_opponent.png``: one panel per
-ladder and case, per run, each opponent SPCP's mean episode reward across the VUTs in the
-known order.
+ranking, each VUT's crash rate in the known order, TIMID flags), writes it to
+``<root>/summary.md`` and draws two figures:
+
+* ``<root>/per_seed_harm.png``: one panel per ladder and case, the per-seed harm of each
+  VUT's own SPCPs (exposure mode) in the known order (safest left), one line per training
+  seed, the runs side by side;
+* ``<root>/crossplay_by_opponent.png`` (where ``<study>/<case>/crossplay.csv`` exists): one
+  panel per ladder, case and run, each opponent SPCP's mean harm per episode across the
+  VUTs in the known order.
+
+Harm: :mod:`sumo_ayss.analysis.harm` (1 for a collision, else near-miss pay over the most an
+episode can pay; lower = safer).
 """
 
 from __future__ import annotations
@@ -26,17 +32,25 @@ mpl.use("Agg")
 from matplotlib.figure import Figure
 
 from sumo_ayss.atomic import atomic_write_text
-from sumo_ayss.report.load import read_crossplay_matrix
-from sumo_ayss.run_folder import CaseFolder, RunFolder, case_dir_for, read_outcome_json, seed_of_dir
+from sumo_ayss.report.episodes import load_crossplay
+from sumo_ayss.report.load import group_runs, load_run
 
 
-def _per_seed(study: Path, case: str, vut: str) -> dict[int, float]:
-    out = {}
-    for run in sorted((study / case / vut).glob("seed_*")):
-        folder, seed = RunFolder(run), seed_of_dir(run)
-        if seed is not None and folder.outcome_json.is_file():
-            out[seed] = read_outcome_json(folder.outcome_json).outcome.mean_return.value
-    return out
+def _runs(study: Path, case: str) -> dict[str, list]:
+    """The study's loaded runs of one case, by VUT."""
+    dirs = sorted((study / case).glob("*/seed_*"))
+    return group_runs([load_run(d) for d in dirs]).get(case, {})
+
+
+def _crash_cells(study: Path, case: str, mode: str, expected: list[str]) -> tuple[str, str]:
+    """``"19.8 / 11.6 / 5.7 %"`` in the known order, and the TIMID VUTs, from ranking.csv."""
+    with (study / "ranking.csv").open() as f:
+        rows = {r["vut"]: r for r in csv.DictReader(f) if r["case"] == case and r["mode"] == mode}
+    if not all(rows.get(v, {}).get("crash_rate") for v in expected):
+        return "—", "—"
+    rates = " / ".join(f"{100 * float(rows[v]['crash_rate']):.1f}" for v in expected) + " %"
+    timid = [v for v in expected if rows[v].get("timid") == "True"]
+    return rates, ", ".join(timid) or "none"
 
 
 def main(root: Path) -> None:
@@ -45,104 +59,106 @@ def main(root: Path) -> None:
         sys.exit(f"no <study>/order_check.json under {root}")
     lines = [
         "| ladder | case | run (seeds) | mode | Kendall τ | ends significant (p) | significant "
-        "adjacent pairs | ranking, safest first |",
-        "|---|---|---|---|---:|---|---:|---|",
+        "adjacent pairs | ranking, safest first | crash rate, known order | TIMID |",
+        "|---|---|---|---|---:|---|---:|---|---|---|",
     ]
     panels: dict[tuple[str, str], list[tuple[str, Path, list[str]]]] = {}
     for study in studies:
         check = json.loads((study / "order_check.json").read_text())
         ladder, _, run = study.name.rpartition("_")
-        with (study / "ranking.csv").open() as f:
-            seeds = {
-                r["case"]: r["n_seeds"]
-                for r in csv.DictReader(f)
-                if r.get("mode", "exposure") == "exposure"
-            }
         for c in check["cases"]:
-            seed_list = sorted(_per_seed(study, c["case"], check["expected"][0]))
+            runs = _runs(study, c["case"])
+            seeds = sorted({r.seed for rs in runs.values() for r in rs if r.seed is not None})
+            per_vut = max((len(rs) for rs in runs.values()), default=0)
+            rates, timid = _crash_cells(study, c["case"], c["mode"], check["expected"])
             lines.append(
-                f"| {ladder} | {c['case']} | {run} ({', '.join(map(str, seed_list))}; "
-                f"{seeds.get(c['case'], '?')} per VUT) | {c.get('mode', 'exposure')} | "
-                f"{c['tau']:.2f} | "
+                f"| {ladder} | {c['case']} | {run} ({', '.join(map(str, seeds))}; "
+                f"{per_vut} per VUT) | {c['mode']} | {c['tau']:.2f} | "
                 f"{'yes' if c['ends_significant'] else 'no'} ({c['ends_p']:.3g}) | "
-                f"{c['significant_adjacent']} of {c['adjacent']} | {' > '.join(c['order'])} |"
+                f"{c['significant_adjacent']} of {c['adjacent']} | {' > '.join(c['order'])} | "
+                f"{rates} | {timid} |"
             )
-            runs = panels.setdefault((ladder, c["case"]), [])
-            if all(r[1] != study for r in runs):  # one panel entry per run, whatever the modes
-                runs.append((run, study, check["expected"]))
+            entries = panels.setdefault((ladder, c["case"]), [])
+            if all(e[1] != study for e in entries):  # one entry per run, whatever the modes
+                entries.append((run, study, check["expected"]))
     table = "\n".join(lines) + "\n"
     print(table)
     atomic_write_text(root / "summary.md", table)
+    per_seed_figure(root, panels)
+    crossplay_figure(root, panels)
 
-    fig = Figure(figsize=(5.2 * len(panels), 4.4), layout="constrained")
+
+def per_seed_figure(
+    root: Path, panels: dict[tuple[str, str], list[tuple[str, Path, list[str]]]]
+) -> None:
+    """``<root>/per_seed_harm.png``: each VUT's own SPCPs, harm per seed, known order."""
+    fig = Figure(figsize=(4.6 * len(panels), 4.2), layout="constrained")
     axes = fig.subplots(1, len(panels), squeeze=False)[0]
-    for ax, ((ladder, case), runs) in zip(axes, sorted(panels.items()), strict=True):
-        for k, (run, study, expected) in enumerate(runs):
-            scores = {v: _per_seed(study, case, v) for v in expected}
+    for ax, ((ladder, case), entries) in zip(axes, sorted(panels.items()), strict=True):
+        for k, (run, study, expected) in enumerate(entries):
+            runs = _runs(study, case)
+            scores = {
+                v: {r.seed: r.episodes.mean_harm for r in runs.get(v, []) if r.episodes}
+                for v in expected
+            }
             seeds = sorted({s for v in expected for s in scores[v]})
-            offset = 0.12 * (k - (len(runs) - 1) / 2)
+            offset = 0.12 * (k - (len(entries) - 1) / 2)
             for seed in seeds:
                 xs = [i + offset for i, v in enumerate(expected) if seed in scores[v]]
                 ys = [scores[v][seed] for v in expected if seed in scores[v]]
-                ax.plot(
-                    xs,
-                    ys,
-                    marker="o",
-                    ms=4,
-                    lw=1,
-                    color=f"C{k}",
-                    alpha=0.8,
-                    label=f"run {run}" if seed == seeds[0] else None,
-                )
-        ax.set_xticks(range(len(runs[0][2])), runs[0][2])
+                label = f"run {run}" if seed == seeds[0] else None
+                ax.plot(xs, ys, marker="o", ms=4, lw=1, color=f"C{k}", alpha=0.8, label=label)
+        ax.set_xticks(range(len(entries[0][2])), entries[0][2])
         ax.set_title(f"{ladder}, {case}")
         ax.set_xlabel("VUT, known order (safest left)")
-        ax.set_ylabel("exposure E per seed (lower = safer)")
+        ax.set_ylabel("harm per episode, own SPCP per seed (lower = safer)")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    fig.savefig(root / "per_seed_exposure.png", dpi=110)
-    print(f"wrote {root / 'summary.md'} and {root / 'per_seed_exposure.png'}")
-    crossplay_figure(root, panels)
+    fig.savefig(root / "per_seed_harm.png", dpi=100)
+    print(f"wrote {root / 'summary.md'} and {root / 'per_seed_harm.png'}")
 
 
 def crossplay_figure(
     root: Path, panels: dict[tuple[str, str], list[tuple[str, Path, list[str]]]]
 ) -> None:
-    """``<root>/crossplay_by_opponent.png``: per ladder and case, per run, each opponent's
-    mean episode reward across the VUTs in the known order (when crossplay.csv exists)."""
-    cells = [
-        (ladder, case, run, expected, read_crossplay_matrix(path))
-        for (ladder, case), runs in sorted(panels.items())
-        for run, study, expected in runs
-        if (path := CaseFolder(case_dir_for(study, case)).crossplay_csv).is_file()
-    ]
+    """``<root>/crossplay_by_opponent.png``: per ladder, case and run, each opponent's mean
+    harm per episode across the VUTs in the known order (where a usable table exists)."""
+    cells = []
+    for (ladder, case), entries in sorted(panels.items()):
+        for run, study, expected in entries:
+            found = load_crossplay(_runs(study, case))
+            if found.matrix is not None:
+                cells.append((ladder, case, run, expected, found.matrix))
     if not cells:
         return
-    fig = Figure(figsize=(4.6 * len(cells), 4.4), layout="constrained")
-    axes = fig.subplots(1, len(cells), squeeze=False)[0]
-    for ax, (ladder, case, run, expected, m) in zip(axes, cells, strict=True):
+    cols = 4
+    n_rows = (len(cells) + cols - 1) // cols
+    fig = Figure(figsize=(4.4 * cols, 4.0 * n_rows), layout="constrained")
+    axes = fig.subplots(n_rows, cols, squeeze=False).ravel()
+    for ax in axes[len(cells) :]:
+        ax.set_visible(False)
+    for ax, (ladder, case, run, expected, m) in zip(axes, cells, strict=False):
         order = [v for v in expected if v in m.vuts]
         rows = [m.vuts.index(v) for v in order]
         for j, (vut, seed) in enumerate(m.opponents):
-            color = f"C{order.index(vut) if vut in order else 9}"
             ax.plot(
                 range(len(order)),
-                m.returns[rows, j],
+                m.harm[rows, j],
                 marker="o",
                 ms=3,
                 lw=1,
-                color=color,
+                color=f"C{order.index(vut) if vut in order else 9}",
                 alpha=0.8,
                 ls=("-", "--", ":", "-.")[seed % 4],
                 label=f"vs {vut}, seed {seed}",
             )
         ax.set_xticks(range(len(order)), order)
-        ax.set_title(f"{ladder}, {case}, run {run}")
+        ax.set_title(f"{ladder}, {case}, run {run}", fontsize=10)
         ax.set_xlabel("VUT, known order (safest left)")
-        ax.set_ylabel("mean episode reward per opponent (reward/episode)")
+        ax.set_ylabel("harm per episode, per opponent")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=6, ncol=2)
-    fig.savefig(root / "crossplay_by_opponent.png", dpi=110)
+        ax.legend(fontsize=5, ncol=2)
+    fig.savefig(root / "crossplay_by_opponent.png", dpi=90)
     print(f"wrote {root / 'crossplay_by_opponent.png'}")
 
 
