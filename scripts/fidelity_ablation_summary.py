@@ -21,8 +21,9 @@ from sumo_ayss.atomic import atomic_write_text
 
 MODES = ("crossplay", "exposure", "paper")
 UNITS = {
-    "crossplay": "reward/episode extracted by the pooled SPCPs",
-    "exposure": "reward/episode extracted by each VUT's own SPCPs",
+    "crossplay": "harm per episode the pooled SPCPs bring about (1 = a collision; "
+    "sumo_ayss.analysis.harm)",
+    "exposure": "harm per episode each VUT's own SPCPs bring about",
     "paper": "safety index in the AYSS (car-following: how much harder the SPCPs brake "
     "[m/s²]; cut-in: how much lower their Δv̄ is [m/s]; the more aggressive SPCP marks the "
     "safer VUT)",
@@ -44,13 +45,15 @@ def _cell(rows: dict[str, dict[str, str]] | None) -> str:
         return "—"
     pi1, pi2 = float(rows["pi1"]["score"]), float(rows["pi2"]["score"])
     # Orient by the score's stated direction (paper mode: "higher = safer"; cross-play and
-    # exposure: reward extracted, "lower = safer"), so that positive = pi2 safer.
-    diff = pi2 - pi1 if "higher = safer" in rows["pi1"]["unit"] else pi1 - pi2
+    # exposure: harm, "lower = safer"), so that positive = pi2 safer.
+    higher_safer = "higher = safer" in rows["pi1"]["unit"]
+    diff = pi2 - pi1 if higher_safer else pi1 - pi2
     top = rows["pi1"] if rows["pi1"]["rank"] == "1" else rows["pi2"]
     p = top["p_vs_next"]
     sig = "**sig.**" if top["significant_vs_next"] == "True" else "n.s."
     p_text = f"p {float(p):.2g}" if p else "no test"
-    return f"{diff:+.2f} ({p_text}, {sig})"
+    digits = 2 if higher_safer else 3  # harm lies in [0, 1]
+    return f"{diff:+.{digits}f} ({p_text}, {sig})"
 
 
 def main(out: Path, studies: list[tuple[str, Path]]) -> None:
