@@ -287,7 +287,7 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -
 def exposure_sentence(c: SeedComparison) -> str:
     """The exposure-mode verdict sentence of one comparison."""
     return verdict_sentence(
-        c, higher_is_safer=False, score=EXPOSURE_SCORE, unit="", mode="exposure"
+        c, higher_is_safer=False, score=EXPOSURE_SCORE, unit="", mode="exposure", digits=3
     )
 
 

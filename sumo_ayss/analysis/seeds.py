@@ -286,7 +286,13 @@ def kendall_tau(order: Sequence[str], truth: Sequence[str]) -> float:
 
 
 def verdict_sentence(
-    c: SeedComparison, *, higher_is_safer: bool, score: str, unit: str, mode: str
+    c: SeedComparison,
+    *,
+    higher_is_safer: bool,
+    score: str,
+    unit: str,
+    mode: str,
+    digits: int = 2,
 ) -> str:
     """One quotable sentence for a seed-level comparison.
 
@@ -298,6 +304,7 @@ def verdict_sentence(
             ``{more_less}`` filled in here.
         unit: Unit appended to the amount ("" for none).
         mode: Analysis mode named at the start of the sentence.
+        digits: Decimals of the amount and its interval.
     """
     pct = f"{100 * c.level:g} %"
     if c.test == "paired t":
@@ -310,9 +317,10 @@ def verdict_sentence(
     # stated amount: of B - A when B scores higher, of A - B otherwise.
     b_higher = c.difference < 0
     lo, hi = (-c.hi, -c.lo) if b_higher else (c.lo, c.hi)
-    ci = fmt_interval(lo, hi, missing="interval undefined")
+    ci = fmt_interval(lo, hi, digits, missing="interval undefined")
     stats = f"{pct} CI {ci}; {how}, p {fmt_p(c.p, undefined='undefined')}"
-    amount = fmt_num(abs(c.difference), minus="-", missing="nan") + (f" {unit}" if unit else "")
+    amount = fmt_num(abs(c.difference), digits, minus="-", missing="nan")
+    amount += f" {unit}" if unit else ""
     what = score.format(amount=amount, more_less="more" if b_higher else "less")
     if c.significant and (c.difference > 0) == higher_is_safer:
         return (
