@@ -16,10 +16,10 @@ rows come first and which ranking the report's verdicts use; the rows of every o
 available for a case follow, each tagged with its mode:
 
 * ``crossplay`` (default): the pipeline then runs every SPCP of a case against every VUT
-  (:mod:`sumo_ayss.crossplay`) and ranks by the mean episode reward the pooled SPCPs extract
-  (lower = safer), a paired t-test over training-seed blocks; available wherever
-  ``<out>/<case>/crossplay.csv`` exists;
-* ``exposure`` (always available): the mean episode reward each VUT's own SPCPs extract
+  (:mod:`sumo_ayss.crossplay`) and ranks by the mean harm per episode the pooled SPCPs bring
+  about (:mod:`sumo_ayss.analysis.harm`; lower = safer), a paired t-test over training-seed
+  blocks; available wherever ``<out>/<case>/crossplay.csv`` exists;
+* ``exposure`` (always available): the mean harm per episode of each VUT's own SPCPs
   (lower = safer), a paired t-test over shared seeds;
 * ``paper`` (in paper mode only, the AYSS bootstrap is slow): the paper's AYSS
   aggressiveness index (:func:`sumo_ayss.analysis.ranking.safety_index`).

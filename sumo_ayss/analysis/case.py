@@ -3,9 +3,10 @@
 :func:`analyse_case` turns the runs of one case (any objects shaped like
 :class:`sumo_ayss.report.load.Run`) into a :class:`CaseAnalysis`: the paper mode (AYSS
 safety index per VUT, hierarchical bootstrap, pairwise verdicts under
-:func:`~.significance.pair_verdict`), the exposure mode (seed-level ranking of the mean
-episode reward the SPCPs extract), the cross-play mode (the case's cross-play matrix, which
-its loader read from ``crossplay.csv``, :mod:`.crossplay`) and the premise check. Both the
+:func:`~.significance.pair_verdict`), the exposure mode (seed-level ranking of the mean harm
+per episode of each VUT's own SPCPs, :mod:`.harm`), the cross-play mode (the case's
+cross-play matrix, which its loader read from ``crossplay.csv``, :mod:`.crossplay`) and the
+premise check. Both the
 report and :mod:`sumo_ayss.rank` read it; the pipeline analyses each case once and hands the
 analysis to both. Nothing here reads a file, draws or renders.
 """

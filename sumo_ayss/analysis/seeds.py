@@ -1,7 +1,7 @@
 """Seed-level comparison and ranking of VUTs (numpy and the stdlib only).
 
-One training seed of one VUT gives one SPCP; its score (a scalar, e.g. the mean episode
-reward it extracts over the common outcome scenarios) is **one observation**. Samples inside
+One training seed of one VUT gives one SPCP; its score (a scalar, e.g. the mean harm per
+episode it brings about over the common outcome scenarios) is **one observation**. Samples inside
 a seed (episodes, AYSS draws) are not independent replications of the VUT's safety: they
 share that seed's training, so only seeds carry the run-to-run spread.
 
@@ -233,8 +233,8 @@ def rank_seeds(
 
     Args:
         scores: One :class:`SeedScores` per VUT (distinct names).
-        higher_is_safer: Orientation of the score (False for an exposure, where a lower
-            score means the SPCP extracted less from the VUT).
+        higher_is_safer: Orientation of the score (False for harm, where a lower score
+            means the SPCP brought about less against the VUT).
         level: Confidence level of every interval.
         alpha: Significance threshold of every comparison.
 
@@ -300,7 +300,7 @@ def verdict_sentence(
         c: The comparison (A ranked above B).
         higher_is_safer: Orientation of the score.
         score: What the score is, as "their SPCPs ..." completes it, e.g.
-            ``"extract {amount} {more_less} reward per episode"`` with ``{amount}`` and
+            ``"bring about {amount} {more_less} harm per episode"`` with ``{amount}`` and
             ``{more_less}`` filled in here.
         unit: Unit appended to the amount ("" for none).
         mode: Analysis mode named at the start of the sentence.

@@ -57,8 +57,9 @@ CUT_IN = register_case(
         ),
         exposure_caution=(
             "Caution: in cut-in, exposure mode has NOT recovered a known safety order: on the "
-            "minGap ladder (results/ladders) the SPCPs extracted more reward from the VUTs "
-            "with larger gaps, not less (docs/ranking.md). Treat this verdict as unvalidated."
+            "minGap and time-headway ladders (results/ladders) each VUT's own SPCPs differ "
+            "more than the VUTs do, and no ladder was ranked (docs/ranking.md). Treat this "
+            "verdict as unvalidated; cross-play is."
         ),
         one_decision_note=(
             "Cut-in, one decision: the POV starts its lane change from the centre of its own "

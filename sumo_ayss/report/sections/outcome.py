@@ -20,7 +20,13 @@ from sumo_ayss.report.blocks import (
     Table,
 )
 from sumo_ayss.report.load import Outcome
-from sumo_ayss.report.sections.common import fmt_est, pairs_table
+from sumo_ayss.report.sections.common import (
+    TIMID_NOTE,
+    crash_cell,
+    fmt_est,
+    mobility_cell,
+    pairs_table,
+)
 
 __all__ = ["exposure_blocks", "outcome_blocks", "premise_blocks"]
 
@@ -154,54 +160,63 @@ def exposure_blocks(
         return [*blocks, Paragraph("No exposure: no outcome summaries in this case yet.")]
     pct = f"{100 * options.level:g} %"
     scores = a.exposure_scores
+    outcomes = a.outcomes.get("exposure", {})
     path = figures.seed_scores_figure(
         a.exposure_rows,
         scores,
         colors,
         out_dir / f"{a.case}_exposure_by_seed.png",
-        ylabel="adversarial exposure E (mean episode reward)",
-        title=f"{a.info.title}: exposure per seed (lower = safer)",
+        ylabel="harm per episode of the VUT's own SPCP",
+        title=f"{a.info.title}: exposure harm per seed (lower = safer)",
     )
     blocks.append(
         FigureBlock(
             path,
-            f"Exposure E of every seed's SPCP (grey: one line per training seed), safest VUT "
-            f"on the left; diamonds: seed mean with its {pct} t-interval over seeds.",
+            f"Harm per episode of every seed's own SPCP (grey: one line per training seed), "
+            f"safest VUT on the left; diamonds: seed mean with its {pct} t-interval over "
+            "seeds.",
         )
     )
     rows = []
     for r in a.exposure_rows:
         nxt = r.vs_next
-        per_seed = ", ".join(f"s{k}: {fmt_num(v)}" for k, v in scores[r.name].items())
+        per_seed = ", ".join(f"s{k}: {fmt_num(v, 3)}" for k, v in scores[r.name].items())
+        ci = fmt_interval(r.lo, r.hi, 3)
+        o = outcomes.get(r.name)
         rows.append(
             (
                 str(r.rank),
                 r.name,
-                f"{fmt_num(r.mean)} ({fmt_interval(r.lo, r.hi)})"
-                if fmt_interval(r.lo, r.hi)
-                else fmt_num(r.mean),
+                f"{fmt_num(r.mean, 3)} ({ci})" if ci else fmt_num(r.mean, 3),
                 per_seed,
                 str(r.n_seeds),
                 f"{nxt.test}, p {fmt_p(nxt.p)}" if nxt else "—",
                 ("yes" if nxt.significant else "no") if nxt else "—",
+                crash_cell(o),
+                mobility_cell(o),
             )
         )
     blocks.append(
         Table(
-            "Ranking by exposure E (mean episode reward per SPCP), safest first",
+            "Ranking by exposure harm (mean harm per episode of each VUT's own SPCPs), safest "
+            "first; crash rate and mean VUT speed over the same episodes",
             (
                 "rank",
                 "VUT",
-                f"E ({pct} CI)",
-                "per-seed E",
+                f"harm ({pct} CI)",
+                "per-seed harm",
                 "seeds",
                 "test vs next",
                 "significant vs next",
+                "crash rate (Wilson 95 % CI, episodes pooled)",
+                "mean speed",
             ),
             tuple(rows),
-            (True, False, True, True, True, False, False),
+            (True, False, True, True, True, False, False, True, True),
         )
     )
-    blocks.append(pairs_table(a.exposure_pairs, "E", pct, options.welch_alpha))
+    if any(o.timid for o in outcomes.values()):
+        blocks.append(Callout("Timid VUT", (TIMID_NOTE,), "warning"))
+    blocks.append(pairs_table(a.exposure_pairs, "harm", pct, options.welch_alpha))
     blocks.append(BulletList(tuple(exposure_sentence(c) for c in a.exposure_pairs)))
     return blocks
