@@ -170,20 +170,22 @@ def test_sumo_defaults_that_draw_random_numbers_are_named() -> None:
 
 VUT_DRAWS = st.one_of(
     st.builds(
-        lambda model, asl, tau, decel, extra, gap: sumo_vut(
+        lambda model, asl, tau, decel, extra, gap, startup: sumo_vut(
             model,
             actionStepLength=asl,
             tau=tau,
             decel=decel,
             emergencyDecel=decel + extra,
             minGap=gap,
+            startupDelay=startup,
         ),
-        st.sampled_from(["IDM", "Krauss", "EIDM", "ACC", "W99", "KraussPS", "IDMM"]),
+        st.sampled_from(["IDM", "Krauss", "EIDM", "ACC", "CACC", "KraussPS", "IDMM"]),
         st.sampled_from([0.2, 0.4, 0.6, 1.0]),
         st.floats(0.5, 2.0),
         st.floats(3.0, 6.0),
         st.floats(0.0, 4.0),
         st.floats(1.0, 15.0),
+        st.sampled_from([0.0, 0.5, 1.0]),
     ),
     st.builds(acc_vut, st.floats(0.8, 2.5)),
     st.sampled_from(["hwenv_pi1", "hwenv_pi2"]),
@@ -196,12 +198,18 @@ VUT_DRAWS = st.one_of(
     derandomize=True,
     suppress_health_check=[HealthCheck.too_slow],
 )
-@given(vut=VUT_DRAWS, case=st.sampled_from(["car_following", "cut_in"]))
-def test_any_vut_the_catalog_accepts_is_one_vehicle(vut: VehicleType | str, case: str) -> None:
+@given(vut=VUT_DRAWS, case=st.sampled_from(["car_following", "cut_in"]), slow=st.booleans())
+def test_any_vut_the_catalog_accepts_is_one_vehicle(
+    vut: VehicleType | str, case: str, slow: bool
+) -> None:
+    """``slow``: starts at 0-5 m/s (VUT) and 0-10 m/s (POV), where startupDelay acts."""
     if isinstance(vut, str):  # a built-in: highway-env's law
         cfg = dataclasses.replace(EnvConfig(case=case), vut=vut)  # type: ignore[arg-type]
     else:
         cfg = config_with(case, vut)
+    if slow:
+        odd = dataclasses.replace(cfg.odd, vut_speed_mps=(0.0, 5.0), pov_speed_mps=(0.0, 10.0))
+        cfg = dataclasses.replace(cfg, odd=odd)
     assert_one_vehicle(cfg)
 
 
