@@ -203,4 +203,7 @@ def test_the_braking_ladder_in_cut_in_ranks_d9_d6_d45() -> None:
     rows, _pairs = rank_crossplay(m)
     assert [r.name for r in rows] == ["d9", "d6", "d45"]
     crashes = {v: m.crashes(v)[0] for v in m.vuts}
-    assert crashes["d45"] > crashes["d6"] > crashes["d9"]
+    assert crashes == {"d45": 356, "d6": 209, "d9": 102}  # 19.8 / 11.6 / 5.7 % of 1,800
+    # the reward the opponents extracted (the score before issue 22) ranked d45 safest
+    reward = dict(zip(m.vuts, m.returns.mean(axis=1).tolist(), strict=True))
+    assert min(reward, key=reward.__getitem__) == "d45"
