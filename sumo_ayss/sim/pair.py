@@ -134,7 +134,7 @@ class VehiclePair:
 
     def _start_vut_decisions(self) -> None:
         """The VUT's first decision is the episode's first step, then one every
-        ``actionStepLength`` (the testbed's semantics of SUMO's action step; DESIGN.md).
+        ``actionStepLength`` (the testbed's semantics of SUMO's action step; docs/ranking.md).
 
         SUMO's driver decides only at *action points*, every ``actionStepLength``; between
         them it keeps its last acceleration. Where the first action point falls depends on
