@@ -10,7 +10,7 @@ rank configs/ladders/min_gap.yaml --out results/ladders/min_gap_a
 rank configs/ladders/min_gap.yaml --seeds 100 101 102 --out results/ladders/min_gap_b
 rank configs/ladders/time_headway.yaml --out results/ladders/time_headway_a
 rank configs/ladders/time_headway.yaml --seeds 100 101 102 --out results/ladders/time_headway_b
-for study in braking reaction; do
+for study in braking reaction acc_time_gap; do
   for run in a b; do
     if [ -d "results/ladders/${study}_${run}" ]; then
       seeds=(201 202 203); [ "$run" = b ] && seeds=(301 302 303)
