@@ -119,25 +119,59 @@ def check_out_dir(path: Path, where: str) -> None:
             return
 
 
-def check_sumo_network(path: Path, where: str) -> None:
-    """Refuse a file that is not a SUMO ``.net.xml`` before libsumo loads it.
+def check_sumo_network(
+    path: Path, where: str, edge: str = "", min_lanes: int = 1, case: str = ""
+) -> None:
+    """Refuse a file that is not a SUMO ``.net.xml`` the envs can drive on, before libsumo
+    loads it.
 
     libsumo dies with a segmentation fault (no message) on some XML files that are not SUMO
-    networks, so the root element (``<net>``) is checked here, in Python, first.
+    networks (another root element than ``<net>``, an ``<edge>`` without ``<lane>``), and
+    with a ``TraCIException`` when the edge its route names is missing; so the file is
+    checked here, in Python, first.
+
+    Args:
+        path: The network file.
+        where: The field that names it (``env.network``), first word of every message.
+        edge: The edge the envs drive on (``road``); empty: not checked.
+        min_lanes: The lanes ``edge`` needs (the case's lanes: 1 car-following, 2 cut-in).
+        case: The case that needs them, for the message.
     """
     import xml.etree.ElementTree as ET
 
+    head = f"{where}: {path}"
+    root = ""
+    road_lanes: int | None = None
     try:
-        for _event, elem in ET.iterparse(path, events=("start",)):
+        for event, elem in ET.iterparse(path, events=("start", "end")):
             tag = elem.tag.rpartition("}")[2]
-            if tag != "net":
-                raise ConfigError(
-                    f"{where}: {path} is not a SUMO network (root element <{tag}>, expected "
-                    "<net>; build one with netconvert)"
-                )
-            return
+            if not root:
+                root = tag
+                if tag != "net":
+                    raise ConfigError(
+                        f"{head} is not a SUMO network (root element <{tag}>, expected "
+                        "<net>; build one with netconvert)"
+                    )
+                continue
+            if event != "end" or tag != "edge":
+                continue
+            lanes = sum(1 for child in elem if child.tag.rpartition("}")[2] == "lane")
+            require(lanes > 0, f"{head}: edge {elem.get('id')!r} has no lanes (<lane> elements)")
+            if elem.get("id") == edge and elem.get("function", "normal") != "internal":
+                road_lanes = lanes
+            elem.clear()
     except ET.ParseError as e:
-        raise ConfigError(f"{where}: {path} is not valid XML ({e})") from e
+        raise ConfigError(f"{head} is not valid XML ({e})") from e
     except OSError as e:
         raise ConfigError(f"{where}: cannot read {path} ({e})") from e
-    raise ConfigError(f"{where}: {path} is empty, not a SUMO network")
+    require(bool(root), f"{head} is empty, not a SUMO network")
+    if not edge:
+        return
+    require(
+        road_lanes is not None,
+        f"{head} has no edge {edge!r} (the road the envs drive on, with >= {min_lanes} lane(s))",
+    )
+    require(
+        road_lanes is not None and road_lanes >= min_lanes,
+        f"{head}: edge {edge!r} has {road_lanes} lane(s), case {case!r} needs >= {min_lanes}",
+    )

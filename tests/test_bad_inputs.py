@@ -137,6 +137,49 @@ def test_network_that_is_not_a_sumo_network_is_refused_before_libsumo(tmp_path: 
         EnvConfig(network=tmp_path / "missing.net.xml")
 
 
+_ROAD = (
+    '<edge id="road" from="s" to="e">'
+    '<lane id="road_0" index="0" speed="30" length="1000" shape="0,-1.6 1000,-1.6"/></edge>'
+)
+NETWORK_CASES: list[tuple[str, str, str, str]] = [
+    # (id, case, <net> content, expected part of the message); libsumo segfaults on the
+    # first two and raises a TraCIException ("Unknown edge 'road'") on the third.
+    ("no lanes", "car_following", '<edge id="road" from="s" to="e"/>', "edge 'road' has no lanes"),
+    (
+        "a laneless extra edge",
+        "car_following",
+        _ROAD + '<edge id="x" from="s" to="e"></edge>',
+        "edge 'x' has no lanes",
+    ),
+    ("no edges", "car_following", "", "has no edge 'road' (the road the envs drive on"),
+    ("another edge", "car_following", _ROAD.replace('"road', '"street'), "has no edge 'road'"),
+    ("one lane for cut-in", "cut_in", _ROAD, "edge 'road' has 1 lane(s), case 'cut_in' needs >= 2"),
+]
+
+
+@pytest.mark.parametrize(
+    ("case", "content", "expected"),
+    [c[1:] for c in NETWORK_CASES],
+    ids=[c[0] for c in NETWORK_CASES],
+)
+def test_network_without_the_road_the_case_needs_is_refused(
+    tmp_path: Path, case: str, content: str, expected: str
+) -> None:
+    net = _yaml(tmp_path, f'<net version="1.20">{content}</net>\n', "bad.net.xml")
+    with pytest.raises(ConfigError) as info:
+        load_experiment(_yaml(tmp_path, f"env: {{case: {case}, network: {net}}}"))
+    message = _one_line(info.value)
+    assert message.startswith(f"env.network: {net}") and expected in message
+
+
+def test_the_built_in_networks_pass_the_network_check() -> None:
+    from sumo_ayss.sim.network import NETWORK_DIR
+
+    EnvConfig(case="car_following", network=NETWORK_DIR / "straight_2lane.net.xml")
+    EnvConfig(case="cut_in", network=NETWORK_DIR / "straight_2lane.net.xml")
+    EnvConfig(case="car_following", network=NETWORK_DIR / "straight_1lane.net.xml")
+
+
 def test_yaml_reader_names_the_file_and_line_of_a_duplicate(tmp_path: Path) -> None:
     path = _yaml(tmp_path, "a: 1\nb: 2\na: 3\n")
     with pytest.raises(ConfigError) as info:

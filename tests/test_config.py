@@ -88,9 +88,11 @@ def test_bad_input_names_the_field(tmp_path: Path, data: dict, match: str) -> No
 
 
 def test_paths_resolve_relative_to_the_yaml_file(tmp_path: Path) -> None:
+    from sumo_ayss.sim.network import NETWORK_DIR
+
     net = tmp_path / "nets" / "my.net.xml"
     net.parent.mkdir()
-    net.write_text("<net/>")
+    net.write_text((NETWORK_DIR / "straight_1lane.net.xml").read_text())
     cfg_file = tmp_path / "sub" / "exp.yaml"
     cfg_file.parent.mkdir()
     cfg_file.write_text("env:\n  network: ../nets/my.net.xml\n")

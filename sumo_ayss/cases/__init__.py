@@ -39,6 +39,7 @@ from sumo_ayss.cases.cut_in import CUT_IN
 from sumo_ayss.cases.registry import (
     BASE_OBSERVATION,
     OUTCOME_COLUMNS,
+    ROAD_EDGE,
     Case,
     Indicator,
     PaperRow,
@@ -61,6 +62,7 @@ __all__ = [
     "CUT_IN",
     "DEFAULT_CASE",
     "OUTCOME_COLUMNS",
+    "ROAD_EDGE",
     "Case",
     "Indicator",
     "PaperRow",

@@ -17,6 +17,7 @@ from sumo_ayss.validation import require, suggest
 __all__ = [
     "BASE_OBSERVATION",
     "OUTCOME_COLUMNS",
+    "ROAD_EDGE",
     "Case",
     "Indicator",
     "PaperRow",
@@ -29,6 +30,10 @@ __all__ = [
     "registered_cases",
     "unregister_case",
 ]
+
+#: The edge every case's pair drives on (its network's only edge, built-in or ``env.network``);
+#: lane ``road_0`` is the rightmost, and a case needs :attr:`Case.lanes` lanes of it.
+ROAD_EDGE = "road"
 
 #: The observation columns every case starts with (the AYSS Monte Carlo samples them):
 #: POV speed [m/s], VUT speed [m/s], headway h [m] (POV rear bumper minus VUT front bumper).

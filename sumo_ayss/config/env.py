@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar, Literal
 
-from sumo_ayss.cases import DEFAULT_CASE, case_names, get_case
+from sumo_ayss.cases import DEFAULT_CASE, ROAD_EDGE, case_names, get_case
 from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE, VehicleType
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.frozen import FrozenMap
@@ -324,7 +324,8 @@ class EnvConfig:
             path = Path(self.network)
             object.__setattr__(self, "network", path)
             require(path.is_file(), f"{s}.network: file not found: {path}")
-            check_sumo_network(path, f"{s}.network")
+            lanes = get_case(self.case).lanes
+            check_sumo_network(path, f"{s}.network", ROAD_EDGE, lanes, self.case)
         top = self.actuator.max_speed_mps
         require(
             self.odd.pov_speed_mps[1] <= top,

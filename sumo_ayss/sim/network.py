@@ -12,6 +12,7 @@ import os
 import subprocess
 from pathlib import Path
 
+from sumo_ayss.cases import ROAD_EDGE as ROAD_EDGE  # the only edge of every built-in network
 from sumo_ayss.cases import get_case, registered_cases
 from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE, vtypes_xml
 from sumo_ayss.config import PROJECT_ROOT, Case
@@ -19,8 +20,6 @@ from sumo_ayss.errors import SimulationError
 
 NETWORK_DIR = PROJECT_ROOT / "networks"
 
-#: The only edge of every built-in network; lane ``road_0`` is the rightmost.
-ROAD_EDGE = "road"
 ROAD_LENGTH_M = 1000.0
 SPEED_LIMIT_MPS = 30.0
 LANE_WIDTH_M = 3.2

@@ -334,8 +334,7 @@ def test_vec_env_api(make_vec) -> None:
 def test_bad_configuration_is_refused(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match="n_envs"):
         PairVecEnv(EnvConfig(), 0)
-    net = tmp_path / "x.net.xml"
-    net.write_text("<net/>")
+    net = NETWORK_DIR / "straight_1lane.net.xml"  # a valid network: the vec env builds its own
     with pytest.raises(ConfigError, match="network"):
         PairVecEnv(EnvConfig(network=net), 2)
 
