@@ -282,7 +282,7 @@ def ensure(
             old = json.loads(existing.read_text(encoding="utf-8"))
             if old.get("fingerprint") == fp:
                 return dict(old)
-        except (OSError, json.JSONDecodeError):
+        except (OSError, ValueError, AttributeError):  # unreadable, not JSON, not an object
             pass
     _, meta = compute(env, vuts, **kwargs)
     write_outputs(meta, out)

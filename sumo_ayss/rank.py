@@ -360,6 +360,8 @@ def main(argv: Sequence[str] | None = None) -> None:
         plan_jobs,
         run_pipeline,
     )
+    from sumo_ayss.report.__main__ import STRICT_HELP
+    from sumo_ayss.report.checks import input_problems
 
     parser = argparse.ArgumentParser(
         prog=prog("python -m sumo_ayss.rank"), description=__doc__.splitlines()[0]
@@ -384,6 +386,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         "or cross-play (cross-play rows appear where <out>/<case>/crossplay.csv exists)",
     )
     parser.add_argument("--no-live", action="store_true", help="no live table (log lines)")
+    parser.add_argument("--strict", action="store_true", help=STRICT_HELP)
     args = parser.parse_args(argv)
     console = configure_logging(not args.no_live)
     result = None
@@ -423,6 +426,14 @@ def main(argv: Sequence[str] | None = None) -> None:
     else:
         for line in final_messages(result):
             print(line)
+    problems = input_problems(analyses)
+    for line in problems:
+        print(f"WARNING: {line}", file=sys.stderr)
+    if complete and args.strict and problems:
+        sys.exit(
+            f"error: --strict: {len(problems)} problem(s) in the input files (the WARNING "
+            "lines above); the ranking was written"
+        )
     sys.exit(0 if complete else 1)
 
 

@@ -740,3 +740,145 @@ def test_report_out_pointing_at_a_file_is_refused(
         main([str(trained_run[1]), "--out", str(file)])
     assert isinstance(info.value.code, str) and "--out: " in info.value.code
     assert file.read_text() == "precious\n"
+
+
+# ------------------------------------------------------------------ damaged case folders
+
+
+def _garble(path: Path) -> None:
+    path.write_bytes(b"\xff\xfe\x00garbled \x9c\x80 bytes\n" * 5)
+
+
+def _cut(path: Path) -> None:
+    data = path.read_bytes()
+    path.write_bytes(data[: data.index(b",", len(data) // 2) + 1])  # a short last row
+
+
+def _nan_cell(path: Path) -> None:
+    lines = path.read_text().splitlines()
+    head, first = lines[0].split(","), lines[1].split(",")
+    first[head.index("episode_return")] = "nan"
+    path.write_text("\n".join([lines[0], ",".join(first), *lines[2:]]) + "\n")
+
+
+def _text_cell(path: Path) -> None:
+    lines = path.read_text().splitlines()
+    cells = lines[1].split(",")
+    cells[1] = "oops"  # mean_return
+    path.write_text("\n".join([lines[0], ",".join(cells), *lines[2:]]) + "\n")
+
+
+def _header_only(path: Path) -> None:
+    path.write_text(path.read_text().splitlines()[0] + "\n")
+
+
+PI1 = "car_following/pi1/seed_0"
+#: (id, file under the output folder, damage, expected part of the console warning); the
+#: report and ``rank --no-run`` exit 0 with a warning on the console, and non-zero with
+#: ``--strict``. ``config only`` is a half-written run folder (rank skips unfinished runs).
+CASE_FOLDER_DAMAGE: list[tuple[str, str, Corruption, str]] = [
+    ("garbled crossplay.csv", "car_following/crossplay.csv", _garble, "not UTF-8 text"),
+    ("truncated crossplay.csv", "car_following/crossplay.csv", _cut, "cells, header has"),
+    ("nan in crossplay.csv", "car_following/crossplay.csv", _nan_cell, "NaN not allowed"),
+    ("text in eval.csv", f"{PI1}/eval.csv", _text_cell, "eval.csv: 1 candidate row(s)"),
+    ("header-only ayss.csv", f"{PI1}/ayss.csv", _header_only, "ayss.csv: no rows"),
+    ("config only", "car_following/pi3/seed_0", lambda p: None, "eval.csv missing"),
+]
+
+
+def _case_folder(root: Path, name: str, damage: Corruption) -> Path:
+    """A synthetic output folder (two VUTs, two seeds, a cross-play table), one file damaged."""
+    from tests.report.test_report import make_crossplay, make_run
+
+    for vut in ("pi1", "pi2"):
+        for seed in (0, 1):
+            make_run(root, "car_following", vut, seed)
+    make_crossplay(root / "car_following", ["pi1", "pi2"], [0, 1])
+    if name.startswith("car_following/pi3"):
+        make_run(root, "car_following", "pi3", 0, files=("config",))
+    damage(root / name)
+    return root / name
+
+
+@pytest.mark.parametrize(
+    ("name", "damage", "expected"),
+    [c[1:] for c in CASE_FOLDER_DAMAGE],
+    ids=[c[0] for c in CASE_FOLDER_DAMAGE],
+)
+def test_report_warns_on_the_console_naming_a_damaged_file(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    name: str,
+    damage: Corruption,
+    expected: str,
+) -> None:
+    from sumo_ayss.report.__main__ import main
+
+    root = tmp_path / "runs"
+    damaged = _case_folder(root, name, damage)
+    args = [str(root), "--out", str(tmp_path / "report"), "--n-boot", "100"]
+    main(args)  # exit 0: the report is written, the problem is in it and on the console
+    err = capsys.readouterr().err
+    warned = [line for line in err.splitlines() if line.startswith("WARNING: ")]
+    assert any(expected in line and str(damaged) in line for line in warned), err
+    assert (tmp_path / "report" / "report.html").is_file()
+    with pytest.raises(SystemExit) as info:
+        main([*args, "--strict"])
+    code = info.value.code
+    assert isinstance(code, str) and "--strict" in code and "\n" not in code
+
+
+def _rank_pipeline(tmp_path: Path) -> Path:
+    from sumo_ayss.config import PROJECT_ROOT
+
+    experiment = PROJECT_ROOT / "configs" / "car_following.yaml"
+    grid = {"cases": ["car_following"], "vuts": ["pi1", "pi2"], "seeds": [0, 1]}
+    pipeline = {"grid": grid, "experiments": {"car_following": str(experiment)}, "out": "runs"}
+    return _yaml(tmp_path, yaml.safe_dump(pipeline), "pipeline.yaml")
+
+
+@pytest.mark.parametrize(
+    ("name", "damage", "expected"),
+    [c[1:] for c in CASE_FOLDER_DAMAGE[:5]],
+    ids=[c[0] for c in CASE_FOLDER_DAMAGE[:5]],
+)
+def test_rank_no_run_warns_on_the_console_naming_a_damaged_file(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    name: str,
+    damage: Corruption,
+    expected: str,
+) -> None:
+    from sumo_ayss.rank import main
+
+    damaged = _case_folder(tmp_path / "runs", name, damage)
+    args = [str(_rank_pipeline(tmp_path)), "--no-run", "--no-live"]
+    with pytest.raises(SystemExit) as info:
+        main(args)
+    assert info.value.code == 0
+    err = capsys.readouterr().err
+    warned = [line for line in err.splitlines() if line.startswith("WARNING: ")]
+    assert any(expected in line and str(damaged) in line for line in warned), err
+    with pytest.raises(SystemExit) as info:
+        main([*args, "--strict"])
+    assert info.value.code not in (0, None)
+
+
+def test_a_garbled_table_or_json_file_is_a_table_error_naming_it(tmp_path: Path) -> None:
+    from sumo_ayss.errors import TableError
+    from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, read_table
+    from sumo_ayss.run_folder.jsonio import read_json
+
+    path = tmp_path / "crossplay.csv"
+    _garble(path)
+    with pytest.raises(TableError, match=r"crossplay\.csv: not UTF-8 text"):
+        read_table(path, CROSSPLAY_SCHEMA)
+    _garble(tmp_path / "crossplay.json")
+    with pytest.raises(TableError, match=r"crossplay\.json: not UTF-8 text"):
+        read_json(tmp_path / "crossplay.json")
+    with pytest.raises(TableError, match="cannot read"):
+        read_json(tmp_path)  # a folder
+    from sumo_ayss.report.discriminability import read_record
+
+    _garble(tmp_path / "discriminability.json")
+    assert read_record(tmp_path / "discriminability.json") is None  # logged, not raised

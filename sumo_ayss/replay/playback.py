@@ -99,7 +99,13 @@ def _scenario(scenario_dir: Path) -> tuple[Path, dict[str, Any]]:
             f"{scenario_dir}: not a scenario folder (no {SUMOCFG_FILE} / {SCENARIO_FILE}); "
             "write one with `python -m sumo_ayss.replay export RUN_DIR --ayss-row K --out DIR`"
         )
-    return cfg, json.loads(info_path.read_text())
+    try:
+        info = json.loads(info_path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as e:  # ValueError: not JSON or not UTF-8
+        raise ConfigError(f"{info_path}: unreadable scenario record ({e})") from None
+    if not isinstance(info, dict):
+        raise ConfigError(f"{info_path}: expected a JSON object, got {type(info).__name__}")
+    return cfg, info
 
 
 def replay_headless(scenario_dir: str | Path, output: str | Path | None = None) -> ReplayCheck:

@@ -1,9 +1,12 @@
 """Command line of the report stage.
 
-    python -m sumo_ayss.report RUNS_ROOT_OR_RUN_FOLDER... [--out DIR] [--title TEXT]
+    python -m sumo_ayss.report RUNS_ROOT_OR_RUN_FOLDER... [--out DIR] [--title TEXT] [--strict]
 
 Writes ``report.html`` (self-contained), ``summary.md`` and the PNG figures into ``--out``
-(default ``<first path>/report``) and prints the path of ``report.html``.
+(default ``<first path>/report``) and prints the path of ``report.html``. Each missing,
+unreadable or empty input file the report lists under "Missing or incomplete data" is also
+printed to stderr as a ``WARNING:`` line naming the file; with ``--strict`` (for CI) any such
+problem makes the exit status non-zero (the report is still written).
 """
 
 from __future__ import annotations
@@ -17,7 +20,15 @@ from pathlib import Path
 from sumo_ayss.cli import prog
 from sumo_ayss.config import check_out_dir
 from sumo_ayss.errors import AyssError
-from sumo_ayss.report.document import DEFAULT_TITLE, ReportOptions, write_report
+from sumo_ayss.report.checks import input_problems
+from sumo_ayss.report.document import DEFAULT_TITLE, ReportOptions, load_runs, write_report_for
+from sumo_ayss.report.load import analyse_runs
+
+#: ``--strict``'s help, also quoted by ``rank --strict``.
+STRICT_HELP = (
+    "exit non-zero when an input file is missing, unreadable or empty (each is printed as a "
+    "WARNING line naming the file, and listed in the report); for CI"
+)
 
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
@@ -47,6 +58,7 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
         "--n-boot", type=int, default=defaults.n_boot, help="bootstrap replicates per VUT"
     )
     parser.add_argument("--seed", type=int, default=defaults.rng_seed, help="bootstrap seed")
+    parser.add_argument("--strict", action="store_true", help=STRICT_HELP)
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress")
     return parser.parse_args(argv)
 
@@ -68,12 +80,23 @@ def main(argv: Sequence[str] | None = None) -> None:
         )
         if args.out is not None:
             check_out_dir(args.out, "--out")
-        path = write_report(args.paths, args.out, title=args.title, options=options)
+        runs = load_runs(args.paths)
+        analyses = analyse_runs(runs, options)
+        out = args.out if args.out is not None else args.paths[0] / "report"
+        path = write_report_for(runs, out, analyses=analyses, title=args.title, options=options)
     except AyssError as exc:
         sys.exit(f"error: {exc}")
     except OSError as exc:  # e.g. a folder that cannot be written
         sys.exit(f"error: cannot write the report: {exc}")
+    problems = input_problems(analyses)
+    for line in problems:
+        print(f"WARNING: {line}", file=sys.stderr)
     print(path)
+    if args.strict and problems:
+        sys.exit(
+            f"error: --strict: {len(problems)} problem(s) in the input files (the WARNING "
+            f"lines above); the report was written to {path}"
+        )
 
 
 if __name__ == "__main__":

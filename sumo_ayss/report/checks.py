@@ -14,6 +14,9 @@ the AYSS tables.
   budget is below :data:`TRUSTED_TIMESTEPS` or SPCPs may still be improving.
 - :func:`mixing_problems` — runs that must not be pooled: the same (case, VUT, seed) twice,
   or runs of one case whose configurations differ other than by VUT and seed.
+- :func:`input_problems` — the missing, unreadable or empty input files of analysed cases,
+  one console line each naming the file (``report`` and ``rank`` print them; ``--strict``
+  makes them an error).
 
 Imports neither SUMO nor torch.
 """
@@ -24,14 +27,18 @@ import contextlib
 import hashlib
 import json
 import math
+import os
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.errors import AyssError
 from sumo_ayss.run_folder import RunFolder, read_eval_rows, read_run_config, read_spcp
+
+if TYPE_CHECKING:
+    from sumo_ayss.analysis.case import CaseAnalysis
 
 TRUSTED_TIMESTEPS = 100_000
 """Training transitions per run below which verdicts are flagged as not to be trusted: the
@@ -210,3 +217,27 @@ def mixing_problems(
             f"{case}: runs with different training budgets or configurations — " + "; ".join(parts)
         )
     return out
+
+
+def input_problems(analyses: Sequence[CaseAnalysis]) -> list[str]:
+    """The problems of the analysed cases' input files, one console line each.
+
+    They are the lines of the report's "Missing or incomplete data" callouts
+    (:attr:`~sumo_ayss.analysis.case.CaseAnalysis.problems`), each naming its file: a run's
+    problem starts with the file's name (``eval.csv missing``) and is joined to the run
+    folder's path; a case's own problem (an unreadable cross-play table, which names its
+    file) is prefixed with the case.
+    """
+    from sumo_ayss.analysis.case import run_label
+
+    lines = []
+    for a in analyses:
+        own = list(a.problems)
+        for members in a.runs.values():
+            for run in members:
+                for problem in run.problems:
+                    lines.append(f"{run.path}{os.sep}{problem}")
+                    with contextlib.suppress(ValueError):
+                        own.remove(f"{run_label(run)}: {problem}")
+        lines += [p if p.startswith(os.sep) else f"{a.case}: {p}" for p in own]
+    return lines

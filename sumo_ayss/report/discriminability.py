@@ -43,7 +43,7 @@ def read_record(path: Path) -> dict[str, Any] | None:
         return None
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError) as e:
+    except (OSError, ValueError) as e:  # ValueError: not JSON or not UTF-8
         logger.warning("unreadable %s: %s", path, e)
         return None
     needed = {"pairs", "h_edges_m", "v_edges_mps", "vuts", "mean_response_mps2"}

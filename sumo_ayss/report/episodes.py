@@ -119,7 +119,7 @@ def load_crossplay(runs: Mapping[str, Sequence[Run]]) -> CrossplayInput:
             return CrossplayInput(
                 path=path,
                 missing=f"the cross-play record is unreadable ({exc})",
-                problem=f"{folder.crossplay_json}: {exc}",
+                problem=str(exc),  # names the file
             )
         diagonal = tuple((d.vut, d.seed, d.n, d.n_equal) for d in record.diagonal)
         rollout = record.rollout
@@ -137,9 +137,10 @@ def load_crossplay(runs: Mapping[str, Sequence[Run]]) -> CrossplayInput:
     try:
         matrix = read_crossplay_matrix(path, scale)
     except (TableError, ConfigError) as exc:
+        text = str(exc)  # a TableError names the file already
         return CrossplayInput(
             path=path,
             missing=f"the cross-play table is unreadable ({exc})",
-            problem=f"{path}: {exc}",
+            problem=text if text.startswith(str(path)) else f"{path}: {text}",
         )
     return CrossplayInput(matrix, path, diagonal=diagonal, rollout=rollout)

@@ -326,6 +326,7 @@ def load_run(path: str | Path) -> Run:
             run.versions = read_versions(folder.versions)
         except AyssError as exc:
             run.problems.append(f"{VERSIONS_JSON} unreadable ({exc})")
+    _check_empty(run)
     _check_ayss(run)
     run.training = read_training(run_dir)
     return run
@@ -360,6 +361,15 @@ def _load_config(run: Run, folder: RunFolder) -> None:
         run.harm_scale = harm_scale_of(run.reward, env)
     except (ConfigError, TypeError, ValueError) as exc:
         run.problems.append(f"{CONFIG_YAML}: episode timing invalid ({exc})")
+
+
+def _check_empty(run: Run) -> None:
+    """Notes a table that was read but holds no row (a header only: a half-written run)."""
+    curve = run.eval_curve
+    if curve is not None and curve.step.size == 0 and not curve.n_dropped:
+        run.problems.append(f"{EVAL_CSV}: no rows (header only), so no learning curve")
+    if run.ayss is not None and len(run.ayss) == 0:
+        run.problems.append(f"{AYSS_CSV}: no rows (header only), so no AYSS sample")
 
 
 def _check_ayss(run: Run) -> None:

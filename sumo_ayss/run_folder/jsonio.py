@@ -53,15 +53,20 @@ def read_json(path: str | Path) -> dict[str, Any]:
     """Read a summary written by :func:`write_json`.
 
     Raises:
-        TableError: If the file is missing, not JSON, or not a JSON object.
+        TableError: If the file is missing or unreadable, not UTF-8 JSON, or not a JSON
+            object.
     """
     path = Path(path)
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise TableError(f"{path}: summary file not found") from None
+    except UnicodeDecodeError as exc:
+        raise TableError(f"{path}: not UTF-8 text, not JSON ({exc})") from None
     except json.JSONDecodeError as exc:
         raise TableError(f"{path}: not valid JSON ({exc})") from None
+    except OSError as exc:
+        raise TableError(f"{path}: cannot read ({exc})") from None
     if not isinstance(data, dict):
         raise TableError(f"{path}: expected a JSON object, got {type(data).__name__}")
     return data

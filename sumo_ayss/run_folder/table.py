@@ -297,16 +297,21 @@ def read_table(path: str | Path, schema: TableSchema) -> Table:
         The validated :class:`Table` (columns in schema order).
 
     Raises:
-        TableError: If the file is missing or empty, a column is missing or unexpected, a
-            row has the wrong number of cells, a cell does not parse as its column's dtype,
-            or a value breaks the column's NaN / inf / choices rules. The message names the
-            file, the column and the (0-based data) row.
+        TableError: If the file is missing, empty or not UTF-8 text, a column is missing or
+            unexpected, a row has the wrong number of cells, a cell does not parse as its
+            column's dtype, or a value breaks the column's NaN / inf / choices rules. The
+            message names the file, the column and the (0-based data) row.
     """
     path = Path(path)
     if not path.is_file():
         raise TableError(f"{path}: table file not found")
-    with path.open(newline="", encoding="utf-8") as f:
-        rows = list(csv.reader(f))
+    try:
+        with path.open(newline="", encoding="utf-8") as f:
+            rows = list(csv.reader(f))
+    except UnicodeDecodeError as e:
+        raise TableError(f"{path}: not UTF-8 text, not a table ({e})") from None
+    except (OSError, csv.Error) as e:
+        raise TableError(f"{path}: cannot read the table ({e})") from None
     if not rows:
         raise TableError(f"{path}: empty file, expected a header with {schema.names}")
     header, body = rows[0], rows[1:]
