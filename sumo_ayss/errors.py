@@ -36,3 +36,7 @@ class DiagonalMismatchError(AyssError, RuntimeError):
     """Cross-play drove a VUT differently from the outcome stage: an SPCP against its own VUT
     did not reproduce its run's outcome table (the message names the VUT, the run and the
     share of differing episodes)."""
+
+
+class LockError(AyssError, RuntimeError):
+    """Another live process holds the lock of an output folder (the message names its PID)."""

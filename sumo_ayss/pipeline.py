@@ -55,6 +55,7 @@ from typing import TYPE_CHECKING, Any, Literal, NamedTuple
 from sumo_ayss.cli import prog
 from sumo_ayss.config import PipelineConfig, check_out_dir, load_experiment, load_pipeline, to_dict
 from sumo_ayss.errors import AyssError, ConfigError
+from sumo_ayss.folder_lock import output_lock
 from sumo_ayss.grid_local import run_grid_local
 from sumo_ayss.jobs import JobSpec
 from sumo_ayss.progress import JobStatus
@@ -202,13 +203,29 @@ def run_pipeline(
     """Run the grid, then load every finished job's run folder, analyse each case once and
     write the report; return the statuses, the report, the loaded runs and the analyses.
 
+    The output folder is locked while it runs (:func:`sumo_ayss.folder_lock.output_lock`):
+    a second pipeline on it is refused with a :class:`~sumo_ayss.errors.LockError` naming
+    the holder's PID.
+
     ``live``: show a live table when standard output is a terminal (``console``: the
     :class:`rich.console.Console` to draw it on, default a new one); job events are logged
     either way.
     """
     jobs = plan_jobs(cfg)
     check_out_dir(cfg.out, "out")
-    cfg.out.mkdir(parents=True, exist_ok=True)
+    with output_lock(cfg.out):  # one writer per output folder
+        return _run_locked(cfg, jobs, backend, address, live, console)
+
+
+def _run_locked(
+    cfg: PipelineConfig,
+    jobs: list[JobSpec],
+    backend: Backend,
+    address: str | None,
+    live: bool,
+    console: Any,
+) -> PipelineResult:
+    """:func:`run_pipeline` once the output folder's lock is held."""
     from sumo_ayss.atomic import atomic_write_json
 
     atomic_write_json(cfg.out / "pipeline.json", _relative_paths(to_dict(cfg), cfg.out))

@@ -123,10 +123,13 @@ def test_sigkill_then_rerun_finishes_without_redoing_finished_stages(tmp_path: P
         os.kill(proc.pid, signal.SIGKILL)
     finally:
         proc.wait()
+    lock = tmp_path / "runs" / "pipeline.lock"
+    assert lock.read_text() == f"{proc.pid}\n"  # left by the killed pipeline: stale
     finished = {p: p.read_bytes() for p in first.glob("*.csv")}
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     assert "report:" in done.stdout
+    assert "taking over the stale lock" in done.stderr and not lock.exists()
     for p, data in finished.items():  # completed stages were not redone
         assert p.read_bytes() == data, p
     log = (first / "job.log").read_text()

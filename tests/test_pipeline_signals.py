@@ -95,6 +95,7 @@ def test_a_signal_stops_running_and_queued_jobs_within_seconds(tmp_path: Path, s
     assert stop_s < 10.0, stop_s
     assert "rerun the same command to resume" in output
     assert len(_run_dirs(out)) == 1  # the three queued jobs never started
+    assert not (out / "pipeline.lock").exists()  # the output folder's lock was released
     before = _snapshot(out)
     time.sleep(3.0)  # nothing runs on invisibly
     assert _snapshot(out) == before
