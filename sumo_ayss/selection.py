@@ -7,11 +7,14 @@ scenarios. Criteria are pluggable (:data:`CRITERIA`); ties are broken in favour 
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from sumo_ayss.errors import ConfigError
+
+logger = logging.getLogger(__name__)
 
 Row = Mapping[str, Any]
 
@@ -34,17 +37,27 @@ CRITERIA: dict[str, Callable[[Row], float]] = {
 
 @dataclass(frozen=True)
 class Selection:
-    """The chosen candidate, its score, and a sentence saying why."""
+    """The chosen candidate, its score, and a sentence saying why.
+
+    ``no_signal``: every one of two or more candidates scored the same, so the evaluation
+    could not tell them apart and the earliest was taken (e.g. an ODD that pins the VUT at
+    0 m/s: no opponent earns any reward); written to ``spcp.json`` with the rest.
+    """
 
     index: int
     step: int
     score: float
     criterion: str
     reason: str
+    no_signal: bool = False
 
 
-def select_spcp(rows: Sequence[Row], criterion: str = "mean_reward") -> Selection:
+def select_spcp(rows: Sequence[Row], criterion: str = "mean_reward", run: str = "") -> Selection:
     """Argmax of ``criterion`` over ``rows`` (each with ``step`` and the criterion's columns).
+
+    When two or more candidates all score the same, the selection has no signal: it says so
+    in the reason and :attr:`Selection.no_signal`, and logs a warning naming ``run`` (the
+    run folder).
 
     Raises:
         ConfigError: unknown criterion or empty table.
@@ -63,4 +76,17 @@ def select_spcp(rows: Sequence[Row], criterion: str = "mean_reward") -> Selectio
         f"candidate at step {step} has the highest {criterion} ({best:.4f}) of {len(rows)} "
         f"candidates" + (f"; {ties} tied, the earliest wins" if ties > 1 else "")
     )
-    return Selection(index, step, best, criterion, reason)
+    no_signal = len(rows) > 1 and ties == len(rows)
+    if no_signal:
+        reason += "; no signal: every candidate scored the same"
+        logger.warning(
+            "%s: all %d SPCP candidates scored %.4f on %s: the evaluation cannot tell them "
+            "apart (no signal; e.g. an ODD in which no opponent can earn reward), so the "
+            "earliest (step %d) is the SPCP; check env.odd and env.reward",
+            run or "this run",
+            len(rows),
+            best,
+            criterion,
+            step,
+        )
+    return Selection(index, step, best, criterion, reason, no_signal)

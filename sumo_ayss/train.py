@@ -310,7 +310,7 @@ class Trainer:
     # -- selection -----------------------------------------------------------------------
 
     def select(self) -> dict[str, Any]:
-        choice = select_spcp(self.rows, self.cfg.train.selection)
+        choice = select_spcp(self.rows, self.cfg.train.selection, str(self.run_dir))
         row = self.rows[choice.index]
         atomic_copy(self.run_dir / row["checkpoint"], self.folder.spcp_zip)
         record = {**dataclasses.asdict(choice), "checkpoint": row["checkpoint"], "row": row}

@@ -93,6 +93,10 @@ _NONNEG: dict[str, Any] = {"low": 0.0}
 _UNIT: dict[str, Any] = {"low": 0.0, "high": 1.0}
 _SWITCH: dict[str, Any] = {"low": 0.0, "high": 1.0, "integer": True}
 
+_LENGTH = (
+    "vehicle length; ours: <= 30 m, above any truck with trailers on European roads "
+    "(18.75 m): a longer body is a unit slip"
+)
 #: Unit, meaning and range of every parameter in :data:`COMMON_PARAMS` and
 #: :data:`MODEL_PARAMS`.
 PARAM_SPECS: Mapping[str, ParamSpec] = MappingProxyType(
@@ -109,7 +113,7 @@ PARAM_SPECS: Mapping[str, ParamSpec] = MappingProxyType(
         "tau": _p("s", "desired time headway (driver reaction time)", **_POS, source="SUMO"),
         "startupDelay": _p("s", "delay when starting from standstill", **_NONNEG),
         "minGap": _p("m", "standstill gap, bumper to bumper", **_NONNEG, source="SUMO"),
-        "length": _p("m", "vehicle length", **_POS, source="SUMO"),
+        "length": _p("m", _LENGTH, **_POS, high=30.0, source="ours"),  # SUMO: > 0 only
         "width": _p("m", "vehicle width", **_POS, source="SUMO"),
         "height": _p("m", "vehicle height (drawing only)", **_POS),
         "maxSpeed": _p("m/s", "maximum speed of the vehicle", **_POS, source="SUMO"),

@@ -108,6 +108,13 @@ EXPERIMENT_CASES: list[tuple[str, str, str]] = [
     ),
     ("top level a list", "- 1\n- 2\n", "top level must be a mapping"),
     ("invalid YAML", "env: {case: [\n", "invalid YAML"),
+    (
+        "1000 m long vehicle",
+        "env: {vuts: {long: {params: {length: 1000}}}, vut: long}",
+        "env.vuts.long.params.length must be in (0, 30], got 1000.0; allowed: (0, 30] m",
+    ),
+    ("null VUT entry", "env: {vuts: {pi1: null}}", "env.vuts.pi1 is null"),
+    ("null new VUT entry", "env: {vuts: {mine: null}, vut: mine}", "env.vuts.mine is null"),
 ]
 
 
@@ -188,6 +195,26 @@ def test_yaml_reader_names_the_file_and_line_of_a_duplicate(tmp_path: Path) -> N
     assert str(path) in message and "first at line 1" in message and "line 3" in message
 
 
+def test_spcp_selection_without_signal_warns_naming_the_run(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """A cut-in ODD that pins the VUT at 0 m/s: every candidate scores 0 (no signal)."""
+    from sumo_ayss.selection import select_spcp
+
+    rows = [{"step": s, "mean_return": 0.0, "crash_rate": 0.0} for s in (200, 400, 600)]
+    with caplog.at_level("WARNING"):
+        choice = select_spcp(rows, run="runs/cut_in/pi1/seed_0")
+    assert choice.index == 0 and choice.no_signal
+    assert "no signal" in choice.reason
+    assert "runs/cut_in/pi1/seed_0: all 3 SPCP candidates scored 0.0000" in caplog.text
+    caplog.clear()
+    rows[1]["mean_return"] = 0.5
+    with caplog.at_level("WARNING"):
+        choice = select_spcp(rows, run="runs/x")
+    assert choice.index == 1 and not choice.no_signal and not caplog.text
+    assert not select_spcp(rows[:1]).no_signal  # one candidate: nothing to compare
+
+
 # ------------------------------------------------------------------ pipeline files
 
 PIPELINE_CASES: list[tuple[str, str, str]] = [
@@ -207,6 +234,7 @@ PIPELINE_CASES: list[tuple[str, str, str]] = [
     ("huge seed", "grid: {seeds: [4294967296]}", "grid.seeds[] must be an integer in"),
     ("duplicate grid", "grid: {seeds: [0]}\ngrid: {seeds: [1]}", "duplicate key 'grid'"),
     ("inf override", "total_timesteps: .inf", "total_timesteps must be an integer"),
+    ("null VUT entry", "vuts: {mine: null}", "vuts.mine is null"),
 ]
 
 
@@ -882,3 +910,110 @@ def test_a_garbled_table_or_json_file_is_a_table_error_naming_it(tmp_path: Path)
 
     _garble(tmp_path / "discriminability.json")
     assert read_record(tmp_path / "discriminability.json") is None  # logged, not raised
+
+
+# ------------------------------------------------------------------ one writer per output folder
+
+
+def _tiny_pipeline(tmp_path: Path) -> tuple[Path, Path]:
+    """A one-job pipeline YAML and its output folder (the job is never run here)."""
+    exp = _yaml(tmp_path, yaml.safe_dump({"env": {"case": "car_following"}}), "cf.yaml")
+    out = tmp_path / "runs"
+    grid = {"cases": ["car_following"], "vuts": ["pi1", "pi2"], "seeds": [0]}
+    data = {"grid": grid, "experiments": {"car_following": str(exp)}, "out": str(out)}
+    return _yaml(tmp_path, yaml.safe_dump(data), "pipeline.yaml"), out
+
+
+def _default_sigint() -> None:
+    """SIGINT back to its default in a child (ignored in a background test run)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def test_a_second_writer_on_a_locked_output_folder_is_refused_naming_the_holder(
+    tmp_path: Path,
+) -> None:
+    import subprocess
+    import sys
+
+    from sumo_ayss.pipeline import main as pipeline_main
+    from sumo_ayss.rank import main as rank_main
+
+    pipe, out = _tiny_pipeline(tmp_path)
+    holder = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"])
+    try:
+        out.mkdir()
+        lock = out / "pipeline.lock"
+        lock.write_text(f"{holder.pid}\n")
+        for main in (pipeline_main, rank_main):
+            with pytest.raises(SystemExit) as info:
+                main([str(pipe), "--no-live"])
+            code = info.value.code
+            assert isinstance(code, str) and code.startswith("error: ") and "\n" not in code
+            assert f"another pipeline (PID {holder.pid}) is writing this output folder" in code
+        assert lock.read_text() == f"{holder.pid}\n"  # left to its holder
+        assert sorted(p.name for p in out.iterdir()) == ["pipeline.lock"]  # nothing written
+    finally:
+        holder.kill()
+        holder.wait()
+
+
+def test_a_stale_lock_is_taken_over_with_a_log_line(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    import os
+    import subprocess
+    import sys
+
+    from sumo_ayss.folder_lock import output_lock
+
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    lock = tmp_path / "pipeline.lock"
+    for stale in (f"{dead.pid}\n", "not a pid\n"):
+        lock.write_text(stale)
+        os.utime(lock, (0, 0))  # an old file, not one being written now
+        with caplog.at_level("WARNING"), output_lock(tmp_path) as held:
+            assert held == lock.resolve() and lock.read_text() == f"{os.getpid()}\n"
+        assert "taking over the stale lock" in caplog.text
+        assert not lock.exists()  # released at the end
+    assert f"PID {dead.pid} no longer runs" in caplog.text
+    with pytest.raises(RuntimeError), output_lock(tmp_path):
+        raise RuntimeError("a failing stage")
+    assert not lock.exists()  # released on an exception
+
+
+@pytest.mark.parametrize("signum", ["SIGINT", "SIGTERM"])
+def test_two_processes_one_lock_released_on_a_signal(tmp_path: Path, signum: str) -> None:
+    import signal
+    import subprocess
+    import sys
+
+    from sumo_ayss.errors import LockError
+    from sumo_ayss.folder_lock import output_lock
+
+    code = (
+        "import sys, time\nfrom sumo_ayss.folder_lock import output_lock\n"
+        "with output_lock(sys.argv[1]):\n    print('held', flush=True)\n    time.sleep(60)\n"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code, str(tmp_path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=_default_sigint,
+    )
+    try:
+        assert proc.stdout is not None and proc.stdout.readline().strip() == "held"
+        with pytest.raises(LockError, match=f"PID {proc.pid}"), output_lock(tmp_path):
+            pass
+        proc.send_signal(getattr(signal, signum))
+        proc.wait(timeout=10)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert not (tmp_path / "pipeline.lock").exists()
+    with output_lock(tmp_path):  # free again
+        pass

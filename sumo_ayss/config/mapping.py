@@ -82,8 +82,14 @@ def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> A
             raise ConfigError(f"{where} must be a mapping, got {value!r}")
         # A catalog of VUTs extends the built-ins; any other mapping (e.g. the pipeline's
         # ``experiments``) replaces its default whole, so ``{}`` never falls back silently.
-        merged = dict(default or {}) if args and args[1] is VehicleType else {}
+        catalog = bool(args) and args[1] is VehicleType
+        merged = dict(default or {}) if catalog else {}
         for k, v in value.items():
+            if catalog and v is None:  # would silently keep the built-in (or the default)
+                raise ConfigError(
+                    f"{where}.{k} is null: give a vehicle type (a mapping with model, params, "
+                    "description, controller) or leave the entry out"
+                )
             merged[str(k)] = _convert(args[1], v, f"{where}.{k}", base_dir, merged.get(str(k)))
         return merged
     raise ConfigError(f"{where}: unsupported type {tp!r}")  # pragma: no cover
