@@ -22,6 +22,7 @@ import contextvars
 import hashlib
 import importlib
 import importlib.util
+import inspect
 import sys
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
@@ -73,7 +74,8 @@ class ControllerSpec:
         target: ``"package.module:attr"`` (imported with :mod:`importlib`; the module must be
             importable, e.g. from the working directory or an installed package) or
             ``"path/to/file.py:attr"`` (a file, relative to the working directory).
-            ``attr`` may be dotted (``module:Class.factory``).
+            ``attr`` may be dotted (``module:Outer.Inner``); it must name a class with an
+            ``acceleration(state)`` method, checked before the class is instantiated.
         max_accel_mps2: Largest acceleration the vehicle can realise [m/s²], > 0.
         max_decel_mps2: Largest deceleration the vehicle can realise [m/s²], a positive
             number (commands below ``-max_decel_mps2`` are clipped to it).
@@ -112,12 +114,13 @@ class ControllerSpec:
         if not isinstance(self.params, Mapping):
             raise ConfigError(f"{where}.params must be a mapping, got {self.params!r}")
 
-    def resolve(self, where: str = "controller") -> Any:
-        """The object ``target`` names (a class or factory), imported.
+    def resolve(self, where: str = "controller") -> type:
+        """The class ``target`` names, imported; nothing of it is called.
 
         Raises:
-            ConfigError: The target cannot be imported, or imports are not allowed here
-                (inside ``controller_imports(False)``: a run folder opened untrusted).
+            ConfigError: The target cannot be imported, imports are not allowed here
+                (``controller_imports(False)``: a run folder opened untrusted), or it is not
+                a class with a callable ``acceleration`` (``subprocess:getoutput`` is not).
         """
         if not _CONTROLLER_IMPORTS.get():
             raise ConfigError(
@@ -141,15 +144,28 @@ class ControllerSpec:
                     f"{attr_part!r}"
                 )
             obj = getattr(obj, part)
-        if not callable(obj):
-            raise ConfigError(f"{where}.target {self.target!r} is not callable")
+        method = inspect.getattr_static(obj, "acceleration", None)  # runs no descriptor
+        if isinstance(method, staticmethod | classmethod):
+            method = method.__func__
+        if not inspect.isclass(obj) or not callable(method):
+            kind = "function" if inspect.isroutine(obj) else type(obj).__name__
+            what = (
+                f"the class {obj.__name__}, which has no"
+                if inspect.isclass(obj)
+                else f"a {kind}, not a class with an"
+            )
+            raise ConfigError(
+                f"{where}.target {self.target!r} is {what} acceleration(state) method (see "
+                "sumo_ayss.controllers.Controller)"
+            )
         return obj
 
     def build(self, where: str = "controller") -> Any:
-        """A new controller instance: ``target(**params)``, checked for ``acceleration``."""
-        factory = self.resolve(where)
+        """A new controller instance: ``target(**params)``; the target is checked to be a
+        class with ``acceleration`` first (:meth:`resolve`), the instance after."""
+        cls = self.resolve(where)
         try:
-            controller = factory(**dict(self.params))
+            controller = cls(**dict(self.params))
         except Exception as e:  # user code: report whatever it raised, with the field
             raise ConfigError(
                 f"{where}.params {dict(self.params)!r} rejected by {self.target!r} "

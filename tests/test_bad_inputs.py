@@ -365,6 +365,36 @@ def test_controller_numbers_of_numpy_and_int_types_are_accepted() -> None:
     assert bound_acceleration(2, 3.0, 6.0) == 2.0
 
 
+def test_a_controller_target_is_checked_before_it_is_called(tmp_path: Path) -> None:
+    """Not a class, or a class without ``acceleration``: refused before anything runs."""
+    from sumo_ayss.catalog import ControllerSpec
+
+    marker = tmp_path / "ran"
+    module = tmp_path / "odd_controllers.py"
+    module.write_text(
+        f"import pathlib\nMARK = pathlib.Path({str(marker)!r})\n"
+        "def make(**kw):\n    MARK.touch()\n"
+        "class NoAccel:\n    def __init__(self):\n        MARK.touch()\n"
+        "class AccelNotCallable:\n    acceleration = 3.0\n"
+        "    def __init__(self):\n        MARK.touch()\n"
+    )
+    cases = [
+        ("subprocess:getoutput", {"cmd": f"touch {marker}"}, "is a function, not a class"),
+        (f"{module}:make", {}, "is a function, not a class"),
+        (f"{module}:MARK", {}, "is a PosixPath, not a class"),
+        (f"{module}:NoAccel", {}, "has no acceleration(state) method"),
+        (f"{module}:AccelNotCallable", {}, "has no acceleration(state) method"),
+    ]
+    for target, params, expected in cases:
+        spec = ControllerSpec(target, 3.0, 6.0, params=params)
+        with pytest.raises(ConfigError) as info:
+            spec.build("env.vuts.mine.controller")
+        message = _one_line(info.value)
+        assert message.startswith(f"env.vuts.mine.controller.target {target!r}"), message
+        assert expected in message and "(see sumo_ayss.controllers.Controller)" in message
+        assert not marker.exists(), target  # nothing was called
+
+
 class ReturnsNan:
     def acceleration(self, state: Any) -> float:
         return math.nan

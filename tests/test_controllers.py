@@ -151,7 +151,7 @@ def test_vehicle_type_mapping_round_trip() -> None:
         ),
         (
             {"target": "math:pi", "max_accel_mps2": 3, "max_decel_mps2": 6},
-            r"'math:pi' is not callable",
+            r"'math:pi' is a float, not a class",
         ),
         (
             {"target": "builtins:dict", "max_accel_mps2": 3, "max_decel_mps2": 6},
