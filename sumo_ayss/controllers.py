@@ -61,7 +61,7 @@ import numbers
 from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 from sumo_ayss.catalog import ControllerSpec, VehicleType
-from sumo_ayss.errors import AyssError
+from sumo_ayss.errors import ControllerError
 from sumo_ayss.sim.pair import VehiclePair, VutSensing
 
 __all__ = [
@@ -72,10 +72,6 @@ __all__ = [
     "bound_acceleration",
     "commanded_speed",
 ]
-
-
-class ControllerError(AyssError, RuntimeError):
-    """A user controller returned something that cannot be executed (NaN, inf, no number)."""
 
 
 class ControllerInput(NamedTuple):

@@ -38,5 +38,11 @@ class DiagonalMismatchError(AyssError, RuntimeError):
     share of differing episodes)."""
 
 
+class ControllerError(AyssError, RuntimeError):
+    """A user controller raised, or returned something that cannot be executed (NaN, inf, no
+    number); the message names the controller. Deterministic for a given seed and path, so
+    the pipeline does not retry a job that failed with it."""
+
+
 class LockError(AyssError, RuntimeError):
     """Another live process holds the lock of an output folder (the message names its PID)."""

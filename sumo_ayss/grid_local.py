@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
-from sumo_ayss.jobs import JobSpec, run_job
+from sumo_ayss.jobs import NOT_RETRIED, JobSpec, run_job
 from sumo_ayss.progress import GridProgress, JobStatus, format_duration
 from sumo_ayss.run_folder import RunFolder
 
@@ -126,14 +126,15 @@ def run_grid_local(
                 except Exception as e:  # a job's failure is data here
                     s.error = "".join(traceback.format_exception_only(e)).strip()
                     s.stage = ""
-                    if s.attempts <= retries:
+                    if s.attempts <= retries and not isinstance(e, NOT_RETRIED):
                         s.state = "queued"
                         queue.appendleft(s)
                         logger.warning(progress.line(s, f"failed ({s.error}); will retry"))
                     else:
                         s.state = "failed"
                         log = RunFolder(s.spec.run_dir).job_log
-                        logger.error(progress.line(s, f"FAILED: {s.error} (log: {log})"))
+                        why = " (not retried: it fails again)" if s.attempts <= retries else ""
+                        logger.error(progress.line(s, f"FAILED{why}: {s.error} (log: {log})"))
                     continue
                 logger.info(progress.finished(s, result))
             if display is not None:

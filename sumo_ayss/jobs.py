@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.config import AyssConfig, ExperimentConfig
+from sumo_ayss.errors import ControllerError
 from sumo_ayss.run_folder import (
     RunFolder,
     read_evaluate_done,
@@ -26,6 +27,12 @@ from sumo_ayss.run_folder import (
 )
 
 logger = logging.getLogger("sumo_ayss.pipeline")
+
+#: Failures a retry would repeat, so the schedulers do not retry them: a user controller
+#: that raised or returned no number does so again on the same seed and path (the retry
+#: resumes from the last candidate and drives the same episodes); a retry only delayed the
+#: pipeline's exit by the time to get there again (18-40 s in issue 23).
+NOT_RETRIED: tuple[type[BaseException], ...] = (ControllerError,)
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.errors import ConfigError
-from sumo_ayss.jobs import JobSpec, run_job
+from sumo_ayss.jobs import NOT_RETRIED, JobSpec, run_job
 from sumo_ayss.progress import JobStatus
 from sumo_ayss.run_folder import RunFolder
 
@@ -116,7 +116,8 @@ def run_grid_ray(jobs: Sequence[JobSpec], retries: int, address: str | None) -> 
                 logger.info("ray job %s done", s.spec.name)
             except Exception as e:  # a job's failure is data here
                 s.error = "".join(traceback.format_exception_only(e)).strip()[-2000:]
-                if s.attempts <= retries:
+                cause = getattr(e, "cause", e)  # a RayTaskError wraps the job's exception
+                if s.attempts <= retries and not isinstance(cause, NOT_RETRIED):
                     logger.warning("ray job %s failed (%s); retrying", s.spec.name, s.error)
                     submit(s)
                 else:

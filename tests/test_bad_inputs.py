@@ -443,6 +443,44 @@ def test_a_misbehaving_controller_stops_the_episode_with_its_name(
         env.close()
 
 
+@pytest.mark.sumo
+def test_a_controller_failure_in_a_pipeline_job_is_not_retried(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A controller that raises mid-run raises again on a retry (same seed, same path): the
+    retry only delayed the pipeline's exit (by 18-40 s in the issue, 21.8 s measured)."""
+    from sumo_ayss.pipeline import load_pipeline, run_pipeline
+
+    module = tmp_path / "late.py"
+    module.write_text(
+        "class RaisesLater:\n    def __init__(self, after):\n        self.after = after\n"
+        "        self.calls = 0\n    def acceleration(self, state):\n"
+        "        self.calls += 1\n        if self.calls > self.after:\n"
+        "            raise RuntimeError('late failure')\n        return 0.0\n"
+    )
+    controller = {"target": f"{module}:RaisesLater", "params": {"after": 150}}
+    vut = {"controller": {**controller, "max_accel_mps2": 3.0, "max_decel_mps2": 6.0}}
+    experiment = {
+        "env": {"vut": "late", "vuts": {"late": vut}},
+        "agent": TINY_AGENT,
+        "train": {"total_timesteps": 600, "eval_every": 300, "n_eval_scenarios": 2},
+    }
+    exp = _yaml(tmp_path, yaml.safe_dump(experiment), "exp.yaml")
+    pipeline = {
+        "grid": {"cases": ["car_following"], "vuts": ["late"], "seeds": [0]},
+        "experiments": {"car_following": str(exp)},
+        "out": str(tmp_path / "runs"),
+        "workers": 1,
+        "retries": 1,
+    }
+    cfg = load_pipeline(_yaml(tmp_path, yaml.safe_dump(pipeline), "pipeline.yaml"))
+    with caplog.at_level("INFO", logger="sumo_ayss.pipeline"):
+        (status,), report, *_ = run_pipeline(cfg, live=False)
+    assert status.state == "failed" and status.attempts == 1 and report is None
+    assert status.error is not None and "ControllerError" in status.error
+    assert "late failure" in status.error and "not retried" in caplog.text
+
+
 # ------------------------------------------------------------------ env contract
 
 
