@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import numbers
 from collections.abc import Collection, Iterable
 from pathlib import Path
 from typing import Any
@@ -107,6 +108,22 @@ def check_seed(seed: Any, where: str) -> int:
     """``seed`` as an int in [0, SEED_MAX], else a :class:`ConfigError` naming ``where``."""
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= SEED_MAX:
         raise ConfigError(f"{where} must be an integer in [0, {SEED_MAX}], got {seed!r}")
+    return int(seed)
+
+
+def check_sumo_seed(seed: Any) -> int | None:
+    """``seed`` as an int in [0, SEED_MAX] for SUMO's ``--seed`` (numpy integers too, not a
+    bool), or None (the env draws one); else a :class:`ConfigError` naming ``sumo_seed``."""
+    if seed is None:
+        return None
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
+        ok = False
+    else:
+        ok = 0 <= int(seed) <= SEED_MAX
+    if not ok:
+        raise ConfigError(
+            f"sumo_seed must be an integer in [0, {SEED_MAX}] (SUMO's --seed), got {seed!r}"
+        )
     return int(seed)
 
 

@@ -514,6 +514,40 @@ def test_reset_refuses_an_unrealisable_initial_condition(
         env.close()
 
 
+@pytest.mark.parametrize(
+    "value",
+    [-5, "x", 2**40, 2**31, True, 1.5, "3"],
+    ids=["negative", "text", "2**40", "2**31", "bool", "float", "digit text"],
+)
+def test_a_bad_sumo_seed_is_refused_when_the_env_is_built(value: Any) -> None:
+    from sumo_ayss.envs.car_following import CarFollowingEnv
+    from sumo_ayss.envs.vec_env import PairVecEnv
+
+    expected = f"sumo_seed must be an integer in [0, 2147483647] (SUMO's --seed), got {value!r}"
+    for build in (
+        lambda: CarFollowingEnv(sumo_seed=value),
+        lambda: PairVecEnv(EnvConfig(), 2, sumo_seed=value),
+    ):
+        with pytest.raises(ConfigError) as info:
+            build()
+        assert expected in _one_line(info.value)
+
+
+def test_sumo_seeds_at_the_ends_of_the_range_are_accepted() -> None:
+    import numpy as np
+
+    from sumo_ayss.envs.car_following import CarFollowingEnv
+    from sumo_ayss.envs.vec_env import PairVecEnv
+
+    for value in (0, 2**31 - 1, np.int64(7), None):
+        env = CarFollowingEnv(sumo_seed=value)
+        assert env.sumo_seed == value and (value is None or type(env.sumo_seed) is int)
+        env.close()
+        vec = PairVecEnv(EnvConfig(), 2, sumo_seed=value)
+        assert vec.sumo_seed == value
+        vec.close()
+
+
 def test_bad_sumo_arguments_fail_with_a_simulation_error() -> None:
     from sumo_ayss.envs.car_following import CarFollowingEnv
 

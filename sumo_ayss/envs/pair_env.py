@@ -35,6 +35,7 @@ from sumo_ayss.sim.actuator import next_speed, pov_acceleration
 from sumo_ayss.sim.network import ROAD_EDGE, ROAD_LENGTH_M, network_path
 from sumo_ayss.sim.pair import PairPlacement, VehiclePair
 from sumo_ayss.sim.session import SumoSession
+from sumo_ayss.validation import check_sumo_seed
 
 #: Front-bumper position of the VUT at the start of every episode [m].
 VUT_START_POS_M = 150.0
@@ -92,7 +93,8 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
     Args:
         config: environment configuration; defaults to :class:`EnvConfig` of the case.
         vut: shortcut to override ``config.vut`` (a name from ``config.vuts``).
-        sumo_seed: SUMO's ``--seed``; default: drawn from the env's RNG at the first reset.
+        sumo_seed: SUMO's ``--seed``, an int in [0, 2**31 - 1]; default: drawn from the
+            env's RNG at the first reset.
     """
 
     # ``metadata`` is gymnasium.Env's own, ``{"render_modes": []}``: no rendering.
@@ -119,6 +121,7 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         sumo_seed: int | None = None,
     ) -> None:
         super().__init__()
+        sumo_seed = check_sumo_seed(sumo_seed)
         config = config if config is not None else EnvConfig(case=self.CASE)
         if config.case != self.CASE:
             raise ConfigError(f"env.case must be {self.CASE!r} for {type(self).__name__}")

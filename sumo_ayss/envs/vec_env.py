@@ -80,6 +80,7 @@ from sumo_ayss.errors import ActionError, ConfigError
 from sumo_ayss.sim.network import build_parallel_network, parallel_road_edge
 from sumo_ayss.sim.pair import VehiclePair
 from sumo_ayss.sim.session import SumoSession
+from sumo_ayss.validation import check_sumo_seed
 
 #: A batch policy: observations ``(n, obs_dim)`` -> actions ``(n,)``.
 Policy = Callable[[npt.NDArray[np.float32]], npt.ArrayLike]
@@ -111,8 +112,8 @@ class PairVecEnv(VecEnv):
             the single env); ``config.network`` must be unset (the vec env builds parallel
             copies of the case's built-in road).
         n_envs: number of pairs N, >= 1.
-        sumo_seed: SUMO's ``--seed``; default: the seed given to the first reset (through
-            :meth:`seed`), or a random one.
+        sumo_seed: SUMO's ``--seed``, an int in [0, 2**31 - 1]; default: the seed given to
+            the first reset (through :meth:`seed`), or a random one.
 
     SUMO starts at the first :meth:`reset`; :meth:`close` ends it. The process's one
     simulation is owned by the vec env: a single env cannot run beside it.
@@ -125,6 +126,7 @@ class PairVecEnv(VecEnv):
         *,
         sumo_seed: int | None = None,
     ) -> None:
+        sumo_seed = check_sumo_seed(sumo_seed)
         config = config if config is not None else EnvConfig()
         if isinstance(n_envs, bool) or not isinstance(n_envs, int) or n_envs < 1:
             raise ConfigError(f"PairVecEnv needs n_envs >= 1, got {n_envs!r}")
