@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 SKIP_DIRS = {"checkpoints", "tb"}
-SKIP_FILES = {"spcp.zip", "job.log", "progress.json", "ayss.csv"}
+SKIP_FILES = {"spcp.zip", "job.log", "progress.json", "ayss.csv", "pipeline.lock"}
 
 
 def main(src: Path, dst: Path) -> None:
