@@ -50,7 +50,11 @@ def main(root: Path) -> None:
             if equal == total
             else (
                 f"; largest return difference {worst:.2g}, "
-                f"{'collisions or lengths differ' if structural else 'no collision or length differs'}"
+                + (
+                    "collisions or lengths differ"
+                    if structural
+                    else "no collision or length differs"
+                )
             )
         )
         print(f"{csv_path.parent}: {equal}/{total} diagonal episodes equal{note}")
