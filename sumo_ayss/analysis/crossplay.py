@@ -208,8 +208,6 @@ class CrossplayInput:
         diagonal: The diagonal check of the table's record, one ``(vut, seed, n, n_equal)``
             per run: its SPCP against its own VUT reproduced ``n_equal`` of the ``n``
             episodes of its outcome table; empty when the record predates the check.
-        rollout: How the table's episodes were driven (``"outcome"``: the outcome stage's
-            path; ``"pairs"``: the vec env, before issue 21); "" without a record.
     """
 
     matrix: CrossplayMatrix | None = None
@@ -217,7 +215,6 @@ class CrossplayInput:
     missing: str = ""
     problem: str = ""
     diagonal: tuple[tuple[str, int, int, int], ...] = ()
-    rollout: str = ""
 
 
 def rank_crossplay(

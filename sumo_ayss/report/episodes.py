@@ -111,7 +111,6 @@ def load_crossplay(runs: Mapping[str, Sequence[Run]]) -> CrossplayInput:
     scale = next(iter(scales))
     assert scale is not None
     diagonal: tuple[tuple[str, int, int, int], ...] = ()
-    rollout = ""
     if folder.crossplay_json.is_file():
         try:
             record = read_crossplay_json(folder.crossplay_json)
@@ -122,7 +121,6 @@ def load_crossplay(runs: Mapping[str, Sequence[Run]]) -> CrossplayInput:
                 problem=str(exc),  # names the file
             )
         diagonal = tuple((d.vut, d.seed, d.n, d.n_equal) for d in record.diagonal)
-        rollout = record.rollout
         bad = [d for d in record.diagonal if not d.ok]
         if bad:
             names = ", ".join(f"{d.vut} (seed {d.seed}: {d.n - d.n_equal}/{d.n})" for d in bad)
@@ -143,4 +141,4 @@ def load_crossplay(runs: Mapping[str, Sequence[Run]]) -> CrossplayInput:
             missing=f"the cross-play table is unreadable ({exc})",
             problem=text if text.startswith(str(path)) else f"{path}: {text}",
         )
-    return CrossplayInput(matrix, path, diagonal=diagonal, rollout=rollout)
+    return CrossplayInput(matrix, path, diagonal=diagonal)
