@@ -27,6 +27,29 @@ __all__ = [
     "OUTCOME_SCHEMA",
 ]
 
+#: Per-episode columns the harm score and mobility read (issue 22), in both episode tables
+#: (``outcome.csv``, ``crossplay.csv``); files written before them read as NaN.
+EPISODE_HARM_COLUMNS: tuple[Column, ...] = (
+    Column(
+        "near_miss_pay",
+        "float",
+        "-",
+        "adversarial reward paid over the episode, the sum of alpha_A·R_A; the collision "
+        "term excluded (read from episode_return in files written before this column)",
+        nullable=True,
+        since=True,
+    ),
+    Column(
+        "vut_mean_speed_mps",
+        "float",
+        "m/s",
+        "the VUT's mobility: mean of its speed at the end of each decision (NaN in files "
+        "written before this column)",
+        nullable=True,
+        since=True,
+    ),
+)
+
 #: ``<run>/outcome.csv``: one row per episode of the outcome stage (paper Tables II, III).
 OUTCOME_SCHEMA = TableSchema(
     "outcome",
@@ -55,24 +78,7 @@ OUTCOME_SCHEMA = TableSchema(
             "headway h after the last step (POV rear minus VUT front; < 0 = overlap)",
         ),
         Column("n_steps", "int", "-", "decisions taken (25 for a full 5 s episode)"),
-        Column(
-            "near_miss_pay",
-            "float",
-            "-",
-            "adversarial reward paid over the episode, the sum of alpha_A·R_A; the collision "
-            "term excluded (read from episode_return in files written before this column)",
-            nullable=True,
-            since=True,
-        ),
-        Column(
-            "vut_mean_speed_mps",
-            "float",
-            "m/s",
-            "the VUT's mobility: mean of its speed at the end of each decision (NaN in files "
-            "written before this column)",
-            nullable=True,
-            since=True,
-        ),
+        *EPISODE_HARM_COLUMNS,
     ),
 )
 
@@ -164,23 +170,6 @@ CROSSPLAY_SCHEMA = TableSchema(
             "headway h after the last step (POV rear minus VUT front; < 0 = overlap)",
         ),
         Column("n_steps", "int", "-", "decisions in the episode"),
-        Column(
-            "near_miss_pay",
-            "float",
-            "-",
-            "adversarial reward paid over the episode, the sum of alpha_A·R_A; the collision "
-            "term excluded (read from episode_return in files written before this column)",
-            nullable=True,
-            since=True,
-        ),
-        Column(
-            "vut_mean_speed_mps",
-            "float",
-            "m/s",
-            "the VUT's mobility: mean of its speed at the end of each decision (NaN in files "
-            "written before this column)",
-            nullable=True,
-            since=True,
-        ),
+        *EPISODE_HARM_COLUMNS,
     ),
 )
