@@ -11,6 +11,12 @@ from numpy.typing import NDArray
 
 from sumo_ayss.report.figstyle import save, seed_style, style
 
+#: Above this many VUTs the figure is a leaderboard: width capped at :data:`MAX_WIDTH_IN`,
+#: VUT labels rotated, and no per-opponent legend (colour = the VUT an opponent was trained
+#: against, line style = its seed, as the caption says).
+MANY_VUTS = 8
+MAX_WIDTH_IN = 16.0
+
 
 def crossplay_figure(
     order: Sequence[str],
@@ -41,8 +47,10 @@ def crossplay_figure(
     """
     rows = [list(vuts).index(v) for v in order]
     seeds = sorted({s for _, s in opponents})
+    many = len(order) > MANY_VUTS  # a leaderboard: bounded width, no per-opponent legend
+    width = min(5.0 + 1.6 * max(1, len(order)), MAX_WIDTH_IN)
     with style():
-        fig = Figure(figsize=(5.0 + 1.6 * max(1, len(order)), 4.6), layout="constrained")
+        fig = Figure(figsize=(width, 4.6 + (1.2 if many else 0.0)), layout="constrained")
         ax = fig.subplots()
         for j, (vut, seed) in enumerate(opponents):
             ls, marker = seed_style(seeds.index(seed))
@@ -56,11 +64,19 @@ def crossplay_figure(
                 lw=1.4,
                 label=f"SPCP of {vut}, seed {seed}",
             )
-        ax.set_xticks(range(len(order)), [f"#{k + 1} {v}" for k, v in enumerate(order)])
+        labels = [f"#{k + 1} {v}" for k, v in enumerate(order)]
+        ax.set_xticks(
+            range(len(order)),
+            labels,
+            rotation=60 if many else 0,
+            ha="right" if many else "center",
+            fontsize=7 if many else None,
+        )
         ax.set_xlim(-0.4, len(order) - 0.6 + 0.2)
         ax.set_xlabel("VUT driven against, safest first (cross-play ranking)")
         ax.set_ylabel("harm per episode (1 = collision)")
         ax.set_title(title)
         ax.grid(axis="y", alpha=0.3)
-        ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
+        if not many:  # with many opponents a legend would be longer than the plot
+            ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
         return save(fig, path)
