@@ -9,13 +9,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
-from sumo_ayss.report.figstyle import save, seed_style, style
-
-#: Above this many VUTs the figure is a leaderboard: width capped at :data:`MAX_WIDTH_IN`,
-#: VUT labels rotated, and no per-opponent legend (colour = the VUT an opponent was trained
-#: against, line style = its seed, as the caption says).
-MANY_VUTS = 8
-MAX_WIDTH_IN = 16.0
+from sumo_ayss.report.figstyle import MANY_VUTS, MAX_WIDTH_IN, save, seed_style, style
 
 
 def crossplay_figure(

@@ -10,8 +10,23 @@ import matplotlib as mpl
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-__all__ = ["DPI", "LINESTYLES", "no_data", "save", "seed_style", "style", "vut_colors"]
+__all__ = [
+    "DPI",
+    "LINESTYLES",
+    "MANY_VUTS",
+    "MAX_WIDTH_IN",
+    "no_data",
+    "save",
+    "seed_style",
+    "style",
+    "vut_colors",
+]
 
+#: Above this many VUTs a figure with one x position per VUT is a leaderboard: its width is
+#: capped at :data:`MAX_WIDTH_IN` [in], its VUT labels rotated, and a legend with one entry
+#: per opponent left out (the caption says how lines are coloured and styled).
+MANY_VUTS = 8
+MAX_WIDTH_IN = 16.0
 
 DPI = 100
 """Resolution of every PNG: 100 dpi makes a 11-inch-wide figure 1100 px, i.e. 100 % zoom."""

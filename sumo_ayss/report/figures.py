@@ -30,7 +30,16 @@ from sumo_ayss.analysis.seeds import SeedRankRow
 from sumo_ayss.cases import case_info
 from sumo_ayss.config import RewardConfig
 from sumo_ayss.plots import plot_reward_shapes
-from sumo_ayss.report.figstyle import DPI, no_data, save, seed_style, style, vut_colors
+from sumo_ayss.report.figstyle import (
+    DPI,
+    MANY_VUTS,
+    MAX_WIDTH_IN,
+    no_data,
+    save,
+    seed_style,
+    style,
+    vut_colors,
+)
 from sumo_ayss.report.load import Run
 
 __all__ = [
@@ -415,7 +424,9 @@ def seed_scores_figure(
     names = [r.name for r in rows]
     seeds = sorted({s for v in names for s in scores[v]})
     with style():
-        fig = Figure(figsize=(2.2 + 1.6 * max(1, len(names)), 4.6), layout="constrained")
+        many = len(names) > MANY_VUTS  # a leaderboard: bounded width, rotated labels
+        width = min(2.2 + 1.6 * max(1, len(names)), MAX_WIDTH_IN)
+        fig = Figure(figsize=(width, 4.6 + (1.2 if many else 0.0)), layout="constrained")
         ax = fig.subplots()
         for seed in seeds:
             xs = [i for i, v in enumerate(names) if seed in scores[v]]
@@ -445,7 +456,13 @@ def seed_scores_figure(
                 lw=2.0,
                 zorder=3,
             )
-        ax.set_xticks(range(len(names)), [f"#{r.rank} {r.name}" for r in rows])
+        ax.set_xticks(
+            range(len(names)),
+            [f"#{r.rank} {r.name}" for r in rows],
+            rotation=60 if many else 0,
+            ha="right" if many else "center",
+            fontsize=7 if many else None,
+        )
         ax.set_xlim(-0.4, len(names) - 0.4)
         ax.set_ylabel(ylabel)
         ax.set_title(title)
