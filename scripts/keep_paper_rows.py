@@ -33,9 +33,10 @@ def main(study: Path, previous: Path) -> None:
         for key in ("score", "lo", "hi", "crash_rate", "crash_lo", "crash_hi", "mobility_mps"):
             if row[key] not in ("", None):
                 row[key] = float(row[key])
-        for key in ("rank", "n_seeds", "episodes"):
+        for key in ("rank", "n_seeds", "crashes", "episodes"):
             if row[key] not in ("", None):
                 row[key] = int(row[key])
+        row["timid"] = row["timid"] == "True" if row["timid"] != "" else ""
         merged.append(row)
     check = study / "order_check.json"
     checks = json.loads(check.read_text())["cases"] if check.is_file() else []

@@ -67,15 +67,16 @@ RANKING_COLUMNS = [
     "crash_rate",
     "crash_lo",
     "crash_hi",
+    "crashes",
     "episodes",
     "mobility_mps",
     "timid",
 ]
 """``ranking.csv``'s columns. ``score``: harm per episode in cross-play and exposure mode
 (:mod:`sumo_ayss.analysis.harm`, lower = safer), the AYSS safety index in paper mode (higher
-= safer). ``crash_rate`` with its Wilson interval ``crash_lo``/``crash_hi`` (fractions) over
-``episodes``, ``mobility_mps`` (mean VUT speed) and ``timid`` (mobility below 80 % of the
-median VUT's) describe the same episodes as the score; empty in paper mode."""
+= safer). ``crash_rate`` with its Wilson interval ``crash_lo``/``crash_hi`` (fractions),
+``crashes`` of ``episodes``, ``mobility_mps`` (mean VUT speed) and ``timid`` (mobility below
+80 % of the median VUT's) describe the same episodes as the score; empty in paper mode."""
 
 
 def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> list[CaseAnalysis]:
@@ -157,6 +158,7 @@ def _seed_rows(a: CaseAnalysis, mode: str) -> list[dict[str, Any]]:
                 "crash_rate": o.crash_rate if o else "",
                 "crash_lo": o.crash_lo if o else "",
                 "crash_hi": o.crash_hi if o else "",
+                "crashes": o.crashes if o else "",
                 "episodes": o.episodes if o else "",
                 "mobility_mps": o.mobility if o else "",
                 "timid": o.timid if o else "",
@@ -328,24 +330,19 @@ def write_ranking(
 
 
 def _crash_cell(row: dict[str, Any]) -> str:
-    """``"11.6 % (10.2–13.2 %), 209/1800"``, or "" (paper mode)."""
-    if row["crash_rate"] == "":
+    """The crash rate of a ``ranking.csv`` row as the report writes it; "" in paper mode."""
+    from sumo_ayss.report.sections.common import crash_text
+
+    if row["crashes"] == "":
         return ""
-    return (
-        f"{100 * row['crash_rate']:.1f} % ({100 * row['crash_lo']:.1f}–"
-        f"{100 * row['crash_hi']:.1f} %), {round(row['crash_rate'] * row['episodes'])}/"
-        f"{row['episodes']}"
-    )
+    return crash_text(row["crashes"], row["episodes"], row["crash_lo"], row["crash_hi"])
 
 
 def _mobility_cell(row: dict[str, Any]) -> str:
-    """``"21.3 m/s"``, ``"4.2 m/s TIMID"`` (far below the others), "not recorded", or ""."""
-    mob = row["mobility_mps"]
-    if mob == "":
-        return ""
-    if not math.isfinite(mob):
-        return "not recorded"
-    return f"{mob:.1f} m/s" + (" TIMID" if row["timid"] else "")
+    """The mobility of a ``ranking.csv`` row as the report writes it; "" in paper mode."""
+    from sumo_ayss.report.sections.common import mobility_text
+
+    return "" if row["mobility_mps"] == "" else mobility_text(row["mobility_mps"], row["timid"])
 
 
 def main(argv: Sequence[str] | None = None) -> None:

@@ -71,7 +71,8 @@ class CrossplayMatrix:
         opponents: ``(trained-against VUT, training seed)`` of each opponent, sorted.
         harm: ``harm[i, j]`` = mean harm per episode of opponent j against VUT i, in [0, 1]
             (:func:`~.harm.episode_harm`); the score.
-        crash_rate: ``crash_rate[i, j]`` = share of its episodes that ended in a collision.
+        collisions: ``collisions[i, j]`` = episodes of opponent j against VUT i that ended
+            in a collision (:attr:`crash_rate` is the share).
         n_scenarios: Scenarios per cell.
         returns: ``returns[i, j]`` = mean episode reward (the reading before issue 22);
             NaN where not given.
@@ -82,7 +83,7 @@ class CrossplayMatrix:
     vuts: tuple[str, ...]
     opponents: tuple[tuple[str, int], ...]
     harm: npt.NDArray[np.float64]
-    crash_rate: npt.NDArray[np.float64]
+    collisions: npt.NDArray[np.int64]
     n_scenarios: int
     returns: npt.NDArray[np.float64]
     mobility: npt.NDArray[np.float64]
@@ -108,11 +109,15 @@ class CrossplayMatrix:
             for i, v in enumerate(self.vuts)
         ]
 
+    @property
+    def crash_rate(self) -> npt.NDArray[np.float64]:
+        """``crash_rate[i, j]`` = share of the cell's episodes that ended in a collision."""
+        return self.collisions / self.n_scenarios
+
     def crashes(self, vut: str) -> tuple[int, int]:
         """``(collisions, episodes)`` of ``vut`` against the whole pool."""
         i = self.vuts.index(vut)
-        n = self.n_scenarios * len(self.opponents)
-        return round(float(self.crash_rate[i].sum()) * self.n_scenarios), n
+        return int(self.collisions[i].sum()), self.n_scenarios * len(self.opponents)
 
     def vut_mobility(self, vut: str) -> float:
         """Mean speed [m/s] of ``vut`` over all its episodes against the pool (NaN: not
@@ -185,7 +190,7 @@ def crossplay_matrix(
         vuts,
         opps,
         harm=sums["harm"] / counts,
-        crash_rate=sums["crash"] / counts,
+        collisions=sums["crash"].astype(np.int64),
         n_scenarios=int(counts[0, 0]),
         returns=sums["ret"] / counts,
         mobility=sums["mob"] / counts,

@@ -17,9 +17,11 @@ from sumo_ayss.report.load import Estimate, Run
 __all__ = [
     "TIMID_NOTE",
     "crash_cell",
+    "crash_text",
     "display_path",
     "fmt_est",
     "mobility_cell",
+    "mobility_text",
     "seed_points_text",
     "seeds_text",
 ]
@@ -78,20 +80,26 @@ TIMID_NOTE = (
 """What a TIMID flag means (:data:`sumo_ayss.analysis.harm.MOBILITY_FLOOR`)."""
 
 
+def crash_text(crashes: int, episodes: int, lo: float, hi: float) -> str:
+    """``"11.6 % (10.2–13.2 %), 209/1800"``: a crash rate with its interval (fractions)."""
+    rate = crashes / episodes
+    return f"{100 * rate:.1f} % ({100 * lo:.1f}–{100 * hi:.1f} %), {crashes}/{episodes}"
+
+
+def mobility_text(mps: float, timid: bool) -> str:
+    """``"21.3 m/s"``, ``"4.2 m/s (TIMID)"`` or "not recorded" (NaN)."""
+    if not math.isfinite(mps):
+        return "not recorded"
+    return f"{mps:.1f} m/s" + (" (TIMID)" if timid else "")
+
+
 def crash_cell(o: VutOutcome | None) -> str:
-    """``"11.6 % (10.2–13.2 %), 209/1800"``, or "—"."""
+    """:func:`crash_text` of a VUT's outcome, or "—"."""
     if o is None or not o.episodes:
         return "—"
-    return (
-        f"{100 * o.crash_rate:.1f} % ({100 * o.crash_lo:.1f}–{100 * o.crash_hi:.1f} %), "
-        f"{o.crashes}/{o.episodes}"
-    )
+    return crash_text(o.crashes, o.episodes, o.crash_lo, o.crash_hi)
 
 
 def mobility_cell(o: VutOutcome | None) -> str:
-    """``"21.3 m/s"``, ``"4.2 m/s (TIMID)"``, "not recorded" or "—"."""
-    if o is None:
-        return "—"
-    if not math.isfinite(o.mobility):
-        return "not recorded"
-    return f"{o.mobility:.1f} m/s" + (" (TIMID)" if o.timid else "")
+    """:func:`mobility_text` of a VUT's outcome, or "—"."""
+    return "—" if o is None else mobility_text(o.mobility, o.timid)
