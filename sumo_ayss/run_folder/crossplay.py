@@ -26,7 +26,7 @@ import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from sumo_ayss.errors import TableError
 from sumo_ayss.run_folder.jsonio import read_json, write_json
@@ -42,6 +42,8 @@ __all__ = [
 
 #: How the cross-play stage drives its episodes now (see the module docstring).
 ROLLOUT = "outcome"
+_R = TypeVar("_R")
+
 #: What a record without ``rollout`` was driven by.
 _LEGACY_ROLLOUT = "pairs"
 
@@ -146,6 +148,21 @@ def _field(data: Mapping[str, Any], key: str, kind: type | tuple[type, ...], whe
     return value
 
 
+def _records(
+    data: Mapping[str, Any], key: str, where: str, cls: type[_R], kinds: tuple[type, ...]
+) -> tuple[_R, ...]:
+    """The list ``data[key]`` of JSON objects as ``cls`` records, field by field in the
+    order of ``cls``'s dataclass fields, each checked to be of its kind."""
+    out = []
+    for i, item in enumerate(_field(data, key, list, where)):
+        at = f"{where}: {key}[{i}]"
+        if not isinstance(item, Mapping):
+            raise TableError(f"{at}: expected an object, got {item!r}")
+        names = [f.name for f in dataclasses.fields(cls)]  # type: ignore[arg-type]
+        out.append(cls(*(_field(item, n, k, at) for n, k in zip(names, kinds, strict=True))))
+    return tuple(out)
+
+
 def read_crossplay_json(path: Path) -> CrossplayRecord:
     """Read ``crossplay.json``.
 
@@ -155,34 +172,15 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
     """
     data = read_json(path)
     where = str(path)
-    opponents = []
-    for i, item in enumerate(_field(data, "opponents", list, where)):
-        at = f"{where}: opponents[{i}]"
-        if not isinstance(item, Mapping):
-            raise TableError(f"{at}: expected an object, got {item!r}")
-        opponents.append(
-            CrossplayOpponent(
-                _field(item, "vut", str, at),
-                _field(item, "seed", int, at),
-                _field(item, "spcp_sha256", str, at),
-            )
-        )
+    opponents = _records(data, "opponents", where, CrossplayOpponent, (str, int, str))
     vuts = _field(data, "vuts", list, where)
     if not all(isinstance(v, str) for v in vuts):
         raise TableError(f"{where}: vuts: expected a list of names, got {vuts!r}")
-    diagonal = []
-    for i, item in enumerate(data.get("diagonal", [])):
-        at = f"{where}: diagonal[{i}]"
-        if not isinstance(item, Mapping):
-            raise TableError(f"{at}: expected an object, got {item!r}")
-        diagonal.append(
-            DiagonalCheck(
-                _field(item, "vut", str, at),
-                _field(item, "seed", int, at),
-                _field(item, "n", int, at),
-                _field(item, "n_equal", int, at),
-            )
-        )
+    diagonal = (
+        _records(data, "diagonal", where, DiagonalCheck, (str, int, int, int))
+        if "diagonal" in data
+        else ()  # a record from before the check
+    )
     rollout = data.get("rollout", _LEGACY_ROLLOUT)
     if not isinstance(rollout, str):
         raise TableError(f"{where}: rollout: expected str, got {rollout!r}")
@@ -190,9 +188,9 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
         case=_field(data, "case", str, where),
         n=_field(data, "n", int, where),
         seed=_field(data, "seed", int, where),
-        opponents=tuple(opponents),
+        opponents=opponents,
         vuts=tuple(vuts),
         wall_s=float(_field(data, "wall_s", (int, float), where)),
         rollout=rollout,
-        diagonal=tuple(diagonal),
+        diagonal=diagonal,
     )
