@@ -197,6 +197,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     import sys
 
     from sumo_ayss.analysis.crossplay import crossplay_sentence, rank_crossplay
+    from sumo_ayss.analysis.seed_intervals import seed_interval_text
     from sumo_ayss.analysis.seeds import kendall_tau
     from sumo_ayss.config import load_pipeline
     from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
@@ -224,7 +225,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             for r in rows:
                 crashes, episodes = matrix.crashes(r.name)
                 print(
-                    f"  {r.rank}. {r.name}: H = {r.mean:.3f} ({r.lo:.3f} to {r.hi:.3f}); "
+                    f"  {r.rank}. {r.name}: H = {r.mean:.3f} "
+                    f"({seed_interval_text(r.lo, r.hi, r.n_seeds, 3)}); "
                     f"crashes {crashes}/{episodes}; mean speed "
                     f"{matrix.vut_mobility(r.name):.1f} m/s"
                 )

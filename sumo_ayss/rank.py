@@ -43,6 +43,8 @@ from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.analysis.case import CaseAnalysis, exposure_sentence
 from sumo_ayss.analysis.crossplay import crossplay_sentence
+from sumo_ayss.analysis.formatting import fmt_interval, fmt_num
+from sumo_ayss.analysis.seed_intervals import seed_interval_text
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.run_folder import OUTCOME_JSON, RunFolder
@@ -306,10 +308,14 @@ def write_ranking(
     ]
     for r in rows:
         digits = 2 if r["mode"] == "paper" else 3
-        ci = f" ({r['lo']:.{digits}f} to {r['hi']:.{digits}f})" if math.isfinite(r["lo"]) else ""
+        if r["mode"] == "paper":
+            ci = fmt_interval(r["lo"], r["hi"], digits)
+        else:
+            ci = seed_interval_text(r["lo"], r["hi"], r["n_seeds"], digits)
+        ci = f" ({ci})" if ci else ""
         lines.append(
             f"| {r['case']} | {r['mode']} | {r['rank']} | {r['vut']} | "
-            f"{r['score']:.{digits}f}{ci} {r['unit']} | {r['n_seeds']} | {_crash_cell(r)} | "
+            f"{fmt_num(r['score'], digits)}{ci} {r['unit']} | {r['n_seeds']} | {_crash_cell(r)} | "
             f"{_mobility_cell(r)} | {r['vs_next']} |"
         )
     for c in checks:

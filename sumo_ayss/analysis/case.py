@@ -32,7 +32,7 @@ from sumo_ayss.analysis.crossplay import (
     rank_crossplay,
 )
 from sumo_ayss.analysis.formatting import fmt_num
-from sumo_ayss.analysis.harm import VutOutcome, vut_outcomes
+from sumo_ayss.analysis.harm import HARM_RANGE, VutOutcome, vut_outcomes
 from sumo_ayss.analysis.premise import Premise, premise_check
 from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex, rank, safety_index
 from sumo_ayss.analysis.seeds import (
@@ -234,7 +234,11 @@ def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
         out.outcomes["exposure"] = vut_outcomes(counts, options.level)
     if scores:
         out.exposure_rows, out.exposure_pairs = rank_seeds(
-            scores, higher_is_safer=False, level=options.level, alpha=options.welch_alpha
+            scores,
+            higher_is_safer=False,
+            level=options.level,
+            alpha=options.welch_alpha,
+            bounds=HARM_RANGE,
         )
     metrics: dict[str, dict[str, list[float]]] = {
         "mean_return": {},
@@ -391,14 +395,30 @@ def analyse_case(
     return out
 
 
-def seed_ranking_line(rows: Sequence[SeedRankRow]) -> str:
-    """``"a > b ≈ c"``: ``>`` where a row differs significantly from the next."""
-    if not rows:
+def ranking_line(names: Sequence[str], significant_next: Sequence[bool]) -> str:
+    """``"a > b ≈ c"``: ``>`` where a VUT differs significantly from the next, ``≈`` where
+    not. VUTs joined by ``≈`` are listed by name, so that a tie reads the same in every
+    mode (the order inside it is not a finding).
+
+    Args:
+        names: VUTs safest first.
+        significant_next: Per VUT but the last, whether it differs significantly from the
+            next one.
+    """
+    if not names:
         return ""
-    return rows[0].name + "".join(
-        (" > " if prev.significant_vs_next else " ≈ ") + row.name
-        for prev, row in itertools.pairwise(rows)
-    )
+    groups: list[list[str]] = [[names[0]]]
+    for sig, name in zip(significant_next, names[1:], strict=True):
+        if sig:
+            groups.append([name])
+        else:
+            groups[-1].append(name)
+    return " > ".join(" ≈ ".join(sorted(g)) for g in groups)
+
+
+def seed_ranking_line(rows: Sequence[SeedRankRow]) -> str:
+    """:func:`ranking_line` of a seed-level ranking."""
+    return ranking_line([r.name for r in rows], [bool(r.significant_vs_next) for r in rows[:-1]])
 
 
 def _crossplay_headline(out: CaseAnalysis) -> None:
@@ -455,9 +475,9 @@ def _headline(out: CaseAnalysis) -> None:
         return
     out.headline = top.sentence
     out.headline_kind = "safer" if top.significant else "none"
-    parts = [order[0]]
     by_pair = {(p.verdict.name_a, p.verdict.name_b): p for p in out.pairs}
+    significant = []
     for a, b in itertools.pairwise(order):
         pair = by_pair.get((a, b))
-        parts.append((" > " if pair is not None and pair.significant else " ≈ ") + b)
-    out.ranking_line = "".join(parts)
+        significant.append(pair is not None and pair.significant)
+    out.ranking_line = ranking_line(order, significant)

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
+from sumo_ayss.analysis.harm import HARM_RANGE
 from sumo_ayss.analysis.seeds import SeedComparison, SeedRankRow, SeedScores, rank_seeds
 from sumo_ayss.errors import ConfigError
 
@@ -234,7 +235,9 @@ def rank_crossplay(
         ``(rows, pairs)`` as :func:`~sumo_ayss.analysis.seeds.rank_seeds` (``n_seeds`` of a
         row = blocks behind its mean).
     """
-    return rank_seeds(m.scores(blocks), higher_is_safer=False, level=level, alpha=alpha)
+    return rank_seeds(
+        m.scores(blocks), higher_is_safer=False, level=level, alpha=alpha, bounds=HARM_RANGE
+    )
 
 
 def _fmt(x: float) -> str:

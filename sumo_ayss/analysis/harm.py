@@ -43,7 +43,11 @@ import numpy.typing as npt
 from sumo_ayss.analysis.stats import wilson_interval
 from sumo_ayss.errors import ConfigError
 
-__all__ = ["MOBILITY_FLOOR", "HarmScale", "episode_harm", "mobility_flags"]
+__all__ = ["HARM_RANGE", "MOBILITY_FLOOR", "HarmScale", "episode_harm", "mobility_flags"]
+
+HARM_RANGE = (0.0, 1.0)
+"""The possible range of a harm per episode (and of any mean of harms): intervals of a
+harm score are clipped to it."""
 
 #: A VUT whose mobility (mean speed under the same opponents and scenarios) is below this
 #: share of the median VUT's is flagged: it may be "safe" by standing still.

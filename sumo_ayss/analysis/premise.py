@@ -5,7 +5,8 @@ outcome*. When the SPCPs of two VUTs end with different outcomes (mean episode r
 rate, final headway), a difference in aggressiveness may reflect the outcome, not the VUT:
 the aggressiveness comparison is confounded. This module checks the premise per case.
 
-Rule: for each metric, every VUT's seed mean (one SPCP per seed, t-interval over seeds) is
+Rule: for each metric, every VUT's seed mean (one SPCP per seed, t-interval over seeds,
+clipped to the metric's possible range, none with fewer than three seeds) is
 computed; the premise holds for the metric when the spread of the VUT means (max - min) is
 within the metric's tolerance, and for the case when it holds for every metric. The
 tolerances are a statement of what "about the same outcome" means, not a test: they are
@@ -20,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sumo_ayss.analysis.stats import mean_ci
+from sumo_ayss.analysis.seed_intervals import UNBOUNDED, Bounds, seed_mean_ci
 from sumo_ayss.errors import ConfigError
 
 __all__ = ["PREMISE_METRICS", "Premise", "PremiseMetric", "PremiseMetricSpec", "premise_check"]
@@ -36,6 +37,8 @@ class PremiseMetricSpec:
         unit: Display unit ("" for reward, "%" for rates, "m").
         scale: Multiplier from the stored value to the display unit (100 for rates).
         tolerance: Default tolerance on the spread of VUT means, in the stored unit.
+        bounds: The metric's possible range, stored unit (``(0, 1)`` for a rate); the
+            intervals over seeds are clipped to it.
     """
 
     key: str
@@ -43,11 +46,12 @@ class PremiseMetricSpec:
     unit: str
     scale: float
     tolerance: float
+    bounds: Bounds = UNBOUNDED
 
 
 PREMISE_METRICS: tuple[PremiseMetricSpec, ...] = (
     PremiseMetricSpec("mean_return", "mean episode reward", "", 1.0, 1.0),
-    PremiseMetricSpec("crash_rate", "crash rate", "%", 100.0, 0.02),
+    PremiseMetricSpec("crash_rate", "crash rate", "%", 100.0, 0.02, (0.0, 1.0)),
     PremiseMetricSpec("mean_final_headway_m", "mean final headway", "m", 1.0, 2.0),
 )
 """Metrics of the premise check with their default tolerances: reward within 1.0 per
@@ -62,8 +66,8 @@ class PremiseMetric:
     Attributes:
         spec: Which metric.
         tolerance: Tolerance used, stored unit.
-        per_vut: VUT -> ``(mean, lo, hi, n_seeds)`` over its seeds (t-interval; NaN bounds
-            with one seed).
+        per_vut: VUT -> ``(mean, lo, hi, n_seeds)`` over its seeds (t-interval clipped to
+            the metric's possible range; NaN bounds with fewer than three seeds).
         spread: Max minus min of the VUT means; NaN with fewer than two VUTs.
         met: Whether ``spread <= tolerance`` (False when undefined).
     """
@@ -130,7 +134,7 @@ def premise_check(
         for vut, seeds in by_vut.items():
             arr = np.asarray([v for v in seeds if v is not None and math.isfinite(v)], float)
             if arr.size:
-                mean, lo, hi = mean_ci(arr, level)
+                mean, lo, hi = seed_mean_ci(arr, level, bounds=specs[key].bounds)
                 per_vut[vut] = (mean, lo, hi, int(arr.size))
         if len(per_vut) < 2:
             continue

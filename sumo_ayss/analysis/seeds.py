@@ -29,7 +29,8 @@ from typing import Literal
 import numpy as np
 
 from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
-from sumo_ayss.analysis.stats import check_level, mean_ci, student_t_sf, t_quantile
+from sumo_ayss.analysis.seed_intervals import UNBOUNDED, Bounds, seed_mean_ci
+from sumo_ayss.analysis.stats import check_level, student_t_sf, t_quantile
 from sumo_ayss.errors import ConfigError
 
 __all__ = [
@@ -78,9 +79,12 @@ class SeedScores:
         """Scores in seed order, shape ``(n_seeds,)``."""
         return np.fromiter(self.values.values(), dtype=np.float64)
 
-    def mean_ci(self, level: float = 0.95) -> tuple[float, float, float]:
-        """``(mean, lo, hi)``: the seed mean with its t-interval (NaN bounds for one seed)."""
-        return mean_ci(self.array, level)
+    def mean_ci(
+        self, level: float = 0.95, bounds: Bounds = UNBOUNDED
+    ) -> tuple[float, float, float]:
+        """``(mean, lo, hi)``: the seed mean with its t-interval clipped to ``bounds`` (NaN
+        bounds with fewer than three seeds, :func:`.seed_intervals.seed_mean_ci`)."""
+        return seed_mean_ci(self.array, level, bounds=bounds)
 
 
 @dataclass(frozen=True)
@@ -202,7 +206,8 @@ class SeedRankRow:
         rank: 1 for the safest.
         name: VUT name.
         mean: Seed mean of the score.
-        lo: Lower bound of its t-interval (NaN with one seed).
+        lo: Lower bound of its t-interval over seeds, clipped to the score's possible range
+            (NaN with fewer than three seeds: :data:`.seed_intervals.MIN_SEEDS_FOR_INTERVAL`).
         hi: Upper bound.
         n_seeds: Seeds behind the mean.
         vs_next: Comparison with the next row (this VUT as A), None for the last row.
@@ -228,6 +233,7 @@ def rank_seeds(
     higher_is_safer: bool,
     level: float = 0.95,
     alpha: float = 0.05,
+    bounds: Bounds = UNBOUNDED,
 ) -> tuple[list[SeedRankRow], list[SeedComparison]]:
     """Orders VUTs from safest to least safe by their seed-mean score.
 
@@ -237,6 +243,8 @@ def rank_seeds(
             means the SPCP brought about less against the VUT).
         level: Confidence level of every interval.
         alpha: Significance threshold of every comparison.
+        bounds: The score's possible range (``(0, 1)`` for harm per episode); each row's
+            interval is clipped to it.
 
     Returns:
         ``(rows, pairs)``: the ranking, safest first (ties broken by name), and the
@@ -258,7 +266,7 @@ def rank_seeds(
     by_pair = {(p.name_a, p.name_b): p for p in pairs}
     rows = []
     for pos, s in enumerate(order):
-        mean, lo, hi = s.mean_ci(level)
+        mean, lo, hi = s.mean_ci(level, bounds)
         nxt = by_pair.get((s.name, order[pos + 1].name)) if pos + 1 < len(order) else None
         rows.append(SeedRankRow(pos + 1, s.name, mean, lo, hi, len(s.values), nxt))
     return rows, pairs

@@ -21,9 +21,6 @@ from sumo_ayss.errors import ConfigError
 
 __all__ = ["Verdict", "compare"]
 
-_HYPHEN = "-"
-"""Sign of negative bounds in verdict sentences (ASCII, unlike the report's tables)."""
-
 
 def _fmt_h_range(h_range: tuple[float, float]) -> str:
     """``"h ≤ 5 m"`` when the range starts at 0, ``"2 m ≤ h ≤ 5 m"`` otherwise."""
@@ -89,7 +86,7 @@ class Verdict:
                 f"{self.name_b}: over {where}, the mean {self.indicator.name} of "
                 f"{self.name_b}'s SPCPs minus {self.name_a}'s is "
                 f"{self.indicator.amount(self.difference)} ({pct} CI "
-                f"{fmt_interval(self.diff_lo, self.diff_hi, minus=_HYPHEN)}; "
+                f"{fmt_interval(self.diff_lo, self.diff_hi)}; "
                 f"P({self.name_a} safer) {fmt_p(self.p_a_safer, cap_high=True)}; "
                 f"{self.n_seeds_a} vs {self.n_seeds_b} seeds)."
             )
@@ -109,7 +106,7 @@ class Verdict:
         n_s, n_o = (self.n_seeds_a, self.n_seeds_b) if a_safer else (self.n_seeds_b, self.n_seeds_a)
         return (
             f"{self.safer} is safer than {other}: its SPCPs {self.indicator.phrase(diff)} on "
-            f"average over {where} ({pct} CI {fmt_interval(lo, hi, minus=_HYPHEN)}; "
+            f"average over {where} ({pct} CI {fmt_interval(lo, hi)}; "
             f"P({self.safer} safer) {fmt_p(p, cap_high=True)}; {n_s} vs {n_o} seeds)."
         )
 

@@ -9,7 +9,29 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
-from sumo_ayss.report.figstyle import MANY_VUTS, MAX_WIDTH_IN, save, seed_style, style
+from sumo_ayss.report.figstyle import (
+    MANY_VUTS,
+    MAX_WIDTH_IN,
+    save,
+    seed_style,
+    set_wrapped_title,
+    style,
+)
+
+
+def crossplay_lines(
+    order: Sequence[str], harm: NDArray[np.float64], vuts: Sequence[str]
+) -> NDArray[np.float64]:
+    """The lines :func:`crossplay_figure` draws: ``lines[j, x]`` = the harm opponent j
+    brings about against ``order[x]`` (x = 0 the safest VUT, drawn leftmost).
+
+    Args:
+        order: VUTs safest first.
+        harm: ``harm[i, j]`` against VUT ``vuts[i]`` by opponent j.
+        vuts: The VUTs of the rows of ``harm``.
+    """
+    rows = [list(vuts).index(v) for v in order]
+    return np.asarray(harm, dtype=np.float64)[rows, :].T
 
 
 def crossplay_figure(
@@ -39,7 +61,7 @@ def crossplay_figure(
     Returns:
         ``path``.
     """
-    rows = [list(vuts).index(v) for v in order]
+    lines = crossplay_lines(order, harm, vuts)
     seeds = sorted({s for _, s in opponents})
     many = len(order) > MANY_VUTS  # a leaderboard: bounded width, no per-opponent legend
     width = min(5.0 + 1.6 * max(1, len(order)), MAX_WIDTH_IN)
@@ -50,7 +72,7 @@ def crossplay_figure(
             ls, marker = seed_style(seeds.index(seed))
             ax.plot(
                 range(len(order)),
-                [float(harm[i, j]) for i in rows],
+                lines[j],
                 color=colors.get(vut, "C0"),
                 ls=ls,
                 marker=marker,
@@ -69,7 +91,7 @@ def crossplay_figure(
         ax.set_xlim(-0.4, len(order) - 0.6 + 0.2)
         ax.set_xlabel("VUT driven against, safest first (cross-play ranking)")
         ax.set_ylabel("harm per episode (1 = collision)")
-        ax.set_title(title)
+        set_wrapped_title(ax, title, width)
         ax.grid(axis="y", alpha=0.3)
         if not many:  # with many opponents a legend would be longer than the plot
             ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))

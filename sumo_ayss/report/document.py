@@ -39,6 +39,7 @@ from sumo_ayss.report.blocks import (
 )
 from sumo_ayss.report.checks import mixing_problems, trust_warnings
 from sumo_ayss.report.figstyle import vut_colors
+from sumo_ayss.report.leaderboard import leaderboard_table
 from sumo_ayss.report.load import (
     RUN_FILES,
     Run,
@@ -120,19 +121,24 @@ def build_report(
     budgets = sorted({r.training.total_timesteps or 0 for r in runs})
     budget = ", ".join(f"{b:,}" if b else "unknown" for b in budgets)
     subtitle = (
-        f"Generated {now} from {len(runs)} run folders ({n_seeds or 'none'}); training budget "
+        f"Generated {now} from {len(runs)} run folder{'' if len(runs) == 1 else 's'} "
+        f"({n_seeds or 'none'}); training budget "
         f"{budget or 'none'} transitions per run."
     )
     blocks: list[Block] = []
     warnings = trust_warnings([(f"{r.case} {r.label}", r.training) for r in runs])
     if warnings:
         blocks.append(Callout("Read the verdicts with care", tuple(warnings), "warning"))
+    tables = [t for t in (leaderboard_table(a, options.level) for a in analyses) if t]
+    if tables:
+        blocks.append(Heading("Leaderboard", 2, "leaderboard"))
+        blocks += tables
     blocks.append(Heading("Verdicts", 2, "verdicts"))
     if not analyses:
         blocks.append(Callout("No runs", ("No run folder was found.",), "warning"))
     for a in analyses:
         blocks.append(Callout(a.info.title, verdict_lines(a, options), a.headline_kind))
-    blocks.append(Paragraph(f"Verdicts above are in {options.mode} mode. " + MODES[options.mode]))
+    blocks.append(Paragraph(modes_paragraph(analyses, options.mode)))
     blocks.append(Paragraph(significance_rule(options)))
     blocks.append(
         Paragraph(
@@ -153,6 +159,26 @@ def build_report(
     for a in analyses:
         blocks += case_blocks(a, colors, out_dir, options)
     return Report(title, subtitle, tuple(blocks))
+
+
+def modes_paragraph(analyses: Sequence[CaseAnalysis], mode: str) -> str:
+    """Which mode the verdicts above are in, as it happened: the mode asked for, the one a
+    case fell back to, or that no case had a verdict (fewer than two VUTs)."""
+    with_verdict = [a for a in analyses if len(a.runs) >= 2]
+    if not with_verdict:
+        return (
+            "No verdict: every case of this report has fewer than two VUTs, and a verdict "
+            f"compares two. Mode asked for: {mode}."
+        )
+    used = list(dict.fromkeys(a.ranking_mode for a in with_verdict))
+    text = " ".join(f"{MODES[m]}" for m in used)
+    if used == [mode]:
+        return f"Verdicts above are in {mode} mode. {text}"
+    fell_back = ", ".join(a.case for a in with_verdict if a.ranking_mode != mode)
+    return (
+        f"Verdicts above: {mode} mode was asked for; {fell_back} fell back to "
+        f"{' / '.join(m for m in used if m != mode)} mode (the verdict says why). {text}"
+    )
 
 
 def load_runs(paths: Sequence[str | Path]) -> list[Run]:

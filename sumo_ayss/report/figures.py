@@ -26,14 +26,12 @@ from numpy.typing import NDArray
 
 from sumo_ayss.analysis import binned_mean_ci
 from sumo_ayss.analysis.ranking import SafetyIndex
-from sumo_ayss.analysis.seeds import SeedRankRow
+from sumo_ayss.analysis.seed_intervals import binned_seed_means
 from sumo_ayss.cases import case_info
 from sumo_ayss.config import RewardConfig
 from sumo_ayss.plots import plot_reward_shapes
 from sumo_ayss.report.figstyle import (
     DPI,
-    MANY_VUTS,
-    MAX_WIDTH_IN,
     no_data,
     save,
     seed_style,
@@ -192,12 +190,18 @@ def _seed_arrays(run: Run) -> tuple[NDArray[np.float64], NDArray[np.float64]] | 
     return run.ayss.h, run.ayss.indicator
 
 
-def _band(ax: Axes, centers: NDArray[np.float64], stats: Any, color: str, label: str) -> None:
-    ax.plot(centers, stats.means, color=color, lw=2.2, marker="o", ms=4, label=label)
-    ok = np.isfinite(stats.lo) & np.isfinite(stats.hi)
-    ax.fill_between(
-        centers, stats.lo, stats.hi, where=ok, color=color, alpha=0.22, lw=0, interpolate=False
-    )
+def _band(
+    ax: Axes,
+    centers: NDArray[np.float64],
+    means: NDArray[np.float64],
+    lo: NDArray[np.float64],
+    hi: NDArray[np.float64],
+    color: str,
+    label: str,
+) -> None:
+    ax.plot(centers, means, color=color, lw=2.2, marker="o", ms=4, label=label)
+    ok = np.isfinite(lo) & np.isfinite(hi)
+    ax.fill_between(centers, lo, hi, where=ok, color=color, alpha=0.22, lw=0, interpolate=False)
 
 
 def indicator_figure(
@@ -210,11 +214,14 @@ def indicator_figure(
     title: str,
     level: float = 0.95,
 ) -> Path:
-    """Mean indicator vs headway with confidence bands (the paper's Fig. 4 / Fig. 6).
+    """Mean indicator vs headway with its uncertainty (the paper's Fig. 4 / Fig. 6).
 
-    Left: one line and band per VUT, all seeds pooled (per-bin Student t interval at
-    ``level``). Right: one thin line per seed, same colours. Below each: samples per bin.
-    Bins with fewer than two samples are left out.
+    Left, the primary panel: per VUT and bin, the mean over seeds of each seed's bin mean,
+    with the band between seeds (:func:`~sumo_ayss.analysis.seed_intervals.binned_seed_means`:
+    a t-interval over three or more seeds, the range of two), and each seed's own line thin:
+    the uncertainty the verdict uses. Right: the samples of all seeds pooled (per-bin
+    Student t interval at ``level``), which ignores the seed-to-seed spread. Below: samples
+    per bin and per SPCP. Bins with fewer than two samples of a seed are left out.
 
     Args:
         runs_by_vut: ``{vut: runs}`` of one case.
@@ -223,7 +230,7 @@ def indicator_figure(
         edges: Headway bin edges in m, shape ``(k + 1,)``.
         axis_label: Label of the indicator axis, with unit.
         title: Figure title.
-        level: Confidence level of the bands.
+        level: Confidence level of the intervals.
 
     Returns:
         ``path``.
@@ -232,57 +239,77 @@ def indicator_figure(
     width = float(np.min(np.diff(edges)))
     pct = f"{100 * level:g} %"
     in_range: list[tuple[str, str, int]] = []  # (vut, run label, samples in the bin range)
+    kinds: set[str] = set()
     with style():
         fig = Figure(figsize=(12.0, 6.8), layout="constrained")
         grid = fig.add_gridspec(2, 2, height_ratios=[3.0, 1.0])
-        ax_pool = fig.add_subplot(grid[0, 0])
-        ax_npool = fig.add_subplot(grid[1, 0], sharex=ax_pool)
-        ax_seed = fig.add_subplot(grid[0, 1], sharex=ax_pool, sharey=ax_pool)
+        ax_seeds = fig.add_subplot(grid[0, 0])
+        ax_npool = fig.add_subplot(grid[1, 0], sharex=ax_seeds)
+        ax_pool = fig.add_subplot(grid[0, 1], sharex=ax_seeds, sharey=ax_seeds)
         ax_nseed = fig.add_subplot(grid[1, 1])
         n_vut = max(1, len(runs_by_vut))
         for v, (vut, members) in enumerate(runs_by_vut.items()):
             color = colors[vut]
-            arrays = [a for a in (_seed_arrays(r) for r in members) if a is not None]
-            if not arrays:
-                in_range += [(vut, f"{r.label}\n(none)", 0) for r in members]
+            with_data = [(r, a) for r, a in ((r, _seed_arrays(r)) for r in members) if a]
+            in_range += [(vut, f"{r.label}\n(none)", 0) for r in members if _seed_arrays(r) is None]
+            if not with_data:
                 continue
-            h = np.concatenate([a[0] for a in arrays])
-            y = np.concatenate([a[1] for a in arrays])
-            pooled = binned_mean_ci(h, y, edges, level=level, min_count=2)
-            n_in = int(pooled.counts.sum())
-            _band(ax_pool, centers, pooled, color, f"{vut} ({len(arrays)} seeds, n = {n_in})")
-            offset = (v - (n_vut - 1) / 2) * width / (n_vut + 1)
-            ax_npool.bar(
-                centers + offset, pooled.counts, width=width / (n_vut + 1), color=color, alpha=0.8
+            arrays = [a for _, a in with_data]
+            bands = binned_seed_means(arrays, edges, level=level, min_count=2)
+            kinds.add(bands.band_kind)
+            _band(
+                ax_seeds,
+                centers,
+                bands.means,
+                bands.lo,
+                bands.hi,
+                color,
+                f"{vut} (mean of {len(arrays)} seeds)",
             )
-            for pos, run in enumerate(members):
-                arr = _seed_arrays(run)
-                if arr is None:
-                    in_range.append((vut, f"{run.label}\n(none)", 0))
-                    continue
-                stats = binned_mean_ci(arr[0], arr[1], edges, level=level, min_count=2)
+            for pos, ((run, _), stats) in enumerate(zip(with_data, bands.per_seed, strict=True)):
                 ls, marker = seed_style(pos)
-                ax_seed.plot(
+                ax_seeds.plot(
                     centers,
                     stats.means,
                     color=color,
                     ls=ls,
-                    lw=1.1,
+                    lw=0.9,
                     marker=marker,
                     ms=3,
+                    alpha=0.8,
                     label=run.label,
                 )
                 in_range.append((vut, run.label, int(stats.counts.sum())))
-        ax_pool.set_title(f"All seeds pooled: mean and {pct} CI per {width:g} m bin")
-        ax_seed.set_title("Each SPCP (seed) separately: mean per bin")
-        ax_pool.set_ylabel(f"{axis_label}\n(lower = more aggressive SPCP = safer VUT)")
+            h = np.concatenate([a[0] for a in arrays])
+            y = np.concatenate([a[1] for a in arrays])
+            pooled = binned_mean_ci(h, y, edges, level=level, min_count=2)
+            n_in = int(pooled.counts.sum())
+            _band(
+                ax_pool, centers, pooled.means, pooled.lo, pooled.hi, color, f"{vut} (n = {n_in})"
+            )
+            offset = (v - (n_vut - 1) / 2) * width / (n_vut + 1)
+            ax_npool.bar(
+                centers + offset, pooled.counts, width=width / (n_vut + 1), color=color, alpha=0.8
+            )
+        band = " / ".join(sorted(kinds)) or "band between seeds"
+        ax_seeds.set_title(
+            f"Primary, between seeds (what the verdict uses): mean of the seeds' means\n"
+            f"band: {band}",
+            fontsize=9.5,
+        )
+        ax_pool.set_title(
+            f"Secondary: all samples pooled, {pct} CI per {width:g} m bin\n"
+            "(ignores the seed-to-seed spread: tighter than the evidence)",
+            fontsize=9.5,
+        )
+        ax_seeds.set_ylabel(f"{axis_label}\n(lower = more aggressive SPCP = safer VUT)")
         ax_npool.set_ylabel("samples / bin")
         ax_npool.set_xlabel("distance headway h [m]")
-        ax_seed.set_xlabel("distance headway h [m]")
-        ax_pool.set_xlim(edges[0], edges[-1])
+        ax_pool.set_xlabel("distance headway h [m]")
+        ax_seeds.set_xlim(edges[0], edges[-1])
         if any(n for _, _, n in in_range):
-            ax_pool.legend(loc="best")
-            ax_seed.legend(loc="best", ncol=2)
+            ax_seeds.legend(loc="best", fontsize=7, ncol=2)
+            ax_pool.legend(loc="best", fontsize=7)
             xs = np.arange(len(in_range))
             ax_nseed.bar(xs, [n for _, _, n in in_range], color=[colors[v] for v, _, _ in in_range])
             ax_nseed.set_xticks(xs, [lab.replace(" seed ", "\ns") for _, lab, _ in in_range])
@@ -293,7 +320,7 @@ def indicator_figure(
             )
             ax_nseed.grid(axis="x", visible=False)
         else:
-            no_data(ax_pool, "no AYSS samples (ayss.csv) in these runs yet")
+            no_data(ax_seeds, "no AYSS samples (ayss.csv) in these runs yet")
             ax_nseed.set_axis_off()
         fig.suptitle(title, fontsize=12, fontweight="bold")
         return save(fig, path)
@@ -389,82 +416,4 @@ def safety_index_figure(
             pad = 0.08 * (xmax - xmin) if math.isfinite(xmax - xmin) else 0.0
             ax.set_xlim(xmin - pad, xmax + pad)
         ax.grid(axis="y", visible=False)
-        return save(fig, path)
-
-
-# --------------------------------------------------------------------------- per-seed scores
-
-
-def seed_scores_figure(
-    rows: Sequence[SeedRankRow],
-    scores: Mapping[str, Mapping[int, float]],
-    colors: Mapping[str, str],
-    path: Path,
-    *,
-    ylabel: str,
-    title: str,
-) -> Path:
-    """Per-seed scores of every VUT, seeds joined across VUTs, with the seed mean and CI.
-
-    VUTs are drawn left to right from the safest (rank 1) to the least safe. Each training
-    seed is one grey line through its VUTs' scores: parallel lines show that seeds move all
-    VUTs together (a block effect that the paired comparison removes).
-
-    Args:
-        rows: The seed-level ranking, safest first.
-        scores: ``{vut: {seed: score}}``.
-        colors: ``{vut: colour}``.
-        path: PNG file to write.
-        ylabel: Axis label of the score, with unit.
-        title: Figure title.
-
-    Returns:
-        ``path``.
-    """
-    names = [r.name for r in rows]
-    seeds = sorted({s for v in names for s in scores[v]})
-    with style():
-        many = len(names) > MANY_VUTS  # a leaderboard: bounded width, rotated labels
-        width = min(2.2 + 1.6 * max(1, len(names)), MAX_WIDTH_IN)
-        fig = Figure(figsize=(width, 4.6 + (1.2 if many else 0.0)), layout="constrained")
-        ax = fig.subplots()
-        for seed in seeds:
-            xs = [i for i, v in enumerate(names) if seed in scores[v]]
-            ys = [scores[names[i]][seed] for i in xs]
-            ax.plot(xs, ys, color="0.6", lw=1.0, marker="o", ms=4, zorder=1)
-            if xs:
-                ax.annotate(
-                    f"seed {seed}",
-                    xy=(xs[-1], ys[-1]),
-                    xytext=(6, 0),
-                    textcoords="offset points",
-                    va="center",
-                    fontsize=8,
-                    color="0.45",
-                )
-        for i, r in enumerate(rows):
-            lo = r.mean - r.lo if math.isfinite(r.lo) else 0.0
-            hi = r.hi - r.mean if math.isfinite(r.hi) else 0.0
-            ax.errorbar(
-                i + 0.12,
-                r.mean,
-                yerr=[[lo], [hi]],
-                fmt="D",
-                ms=8,
-                color=colors.get(r.name, "C0"),
-                capsize=5,
-                lw=2.0,
-                zorder=3,
-            )
-        ax.set_xticks(
-            range(len(names)),
-            [f"#{r.rank} {r.name}" for r in rows],
-            rotation=60 if many else 0,
-            ha="right" if many else "center",
-            fontsize=7 if many else None,
-        )
-        ax.set_xlim(-0.4, len(names) - 0.4)
-        ax.set_ylabel(ylabel)
-        ax.set_title(title)
-        ax.grid(axis="y", alpha=0.3)
         return save(fig, path)

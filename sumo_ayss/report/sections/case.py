@@ -138,10 +138,14 @@ def indicator_blocks(
     )
     caption = (
         f"Mean {info.symbol} of the adversarial-yet-safe states (AYSS) per "
-        f"{options.bin_width_m:g} m headway bin, with {100 * options.level:g} % confidence "
-        "bands (Student t per bin, samples pooled over seeds). More negative = a more "
-        "aggressive SPCP = a safer VUT. Right: each seed's SPCP alone. Bottom: samples per bin "
-        "and per SPCP; bins with fewer than two samples are not drawn."
+        f"{options.bin_width_m:g} m headway bin. More negative = a more aggressive SPCP = a "
+        "safer VUT. Left (read this one): per VUT the mean of its seeds' bin means, with "
+        f"the band between seeds that the verdict rests on ({100 * options.level:g} % "
+        "t-interval over three or more seeds; with two seeds the range between them), and "
+        "each seed's SPCP as a thin line. Right: all samples pooled over seeds with a "
+        "Student t interval per bin; it ignores the seed-to-seed spread, so its band is "
+        "narrower than the evidence. Bottom: samples per bin and per SPCP; bins with fewer "
+        "than two samples of a seed are not drawn."
     )
     rows = []
     for vut, members in a.runs.items():

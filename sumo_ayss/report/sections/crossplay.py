@@ -7,7 +7,8 @@ from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.crossplay import crossplay_sentence
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
+from sumo_ayss.analysis.formatting import fmt_num, fmt_p
+from sumo_ayss.analysis.seed_intervals import seed_interval_text
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.report.blocks import (
     Block,
@@ -89,13 +90,13 @@ def crossplay_blocks(
     rows = []
     for r in a.crossplay_rows:
         nxt = r.vs_next
-        ci = fmt_interval(r.lo, r.hi, 3)
+        ci = seed_interval_text(r.lo, r.hi, r.n_seeds, 3)
         o = outcomes.get(r.name)
         rows.append(
             (
                 str(r.rank),
                 r.name,
-                f"{fmt_num(r.mean, 3)} ({ci})" if ci else fmt_num(r.mean, 3),
+                f"{fmt_num(r.mean, 3)} ({ci})",
                 str(r.n_seeds),
                 f"{nxt.test}, p {fmt_p(nxt.p)}" if nxt else "—",
                 ("yes" if nxt.significant else "no") if nxt else "—",

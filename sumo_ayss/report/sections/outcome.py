@@ -6,10 +6,10 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis, exposure_sentence, premise_sentence
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
+from sumo_ayss.analysis.formatting import fmt_num, fmt_p
+from sumo_ayss.analysis.seed_intervals import seed_interval_text
 from sumo_ayss.cases import OUTCOME_COLUMNS
 from sumo_ayss.config.report import MODES, ReportOptions
-from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -27,6 +27,7 @@ from sumo_ayss.report.sections.common import (
     mobility_cell,
     pairs_table,
 )
+from sumo_ayss.report.seed_figure import seed_scores_figure
 
 __all__ = ["exposure_blocks", "outcome_blocks", "premise_blocks"]
 
@@ -117,10 +118,10 @@ def premise_blocks(a: CaseAnalysis, options: ReportOptions) -> list[Block]:
             if vut not in m.per_vut:
                 cells.append("—")
                 continue
-            mean, lo, hi, _n = m.per_vut[vut]
+            mean, lo, hi, n = m.per_vut[vut]
             sc = m.spec.scale
-            ci = fmt_interval(lo * sc, hi * sc)
-            cells.append(f"{fmt_num(mean * sc)} ({ci})" if ci else fmt_num(mean * sc))
+            ci = seed_interval_text(lo * sc, hi * sc, n)
+            cells.append(f"{fmt_num(mean * sc)} ({ci})")
         rows.append(
             (
                 m.spec.name + unit,
@@ -136,9 +137,10 @@ def premise_blocks(a: CaseAnalysis, options: ReportOptions) -> list[Block]:
             ("metric", *vuts, "spread (max − min)", "tolerance", "within tolerance"),
             tuple(rows),
             (False,) + (True,) * (len(vuts) + 2) + (False,),
-            f"Each VUT: mean over its seeds' SPCPs ({pct} t-interval over seeds; one seed "
-            "gives no interval). Metrics over all outcome episodes. Tolerances are report "
-            "options (premise_reward, premise_crash_rate, premise_final_headway_m).",
+            f"Each VUT: mean over its seeds' SPCPs ({pct} t-interval over seeds, clipped to "
+            "what is possible: a crash rate to 0–100 %; fewer than three seeds give no "
+            "interval). Metrics over all outcome episodes. Tolerances are report options "
+            "(premise_reward, premise_crash_rate, premise_final_headway_m).",
         )
     )
     blocks.append(
@@ -161,7 +163,7 @@ def exposure_blocks(
     pct = f"{100 * options.level:g} %"
     scores = a.exposure_scores
     outcomes = a.outcomes.get("exposure", {})
-    path = figures.seed_scores_figure(
+    path = seed_scores_figure(
         a.exposure_rows,
         scores,
         colors,
@@ -174,20 +176,20 @@ def exposure_blocks(
             path,
             f"Harm per episode of every seed's own SPCP (grey: one line per training seed), "
             f"safest VUT on the left; diamonds: seed mean with its {pct} t-interval over "
-            "seeds.",
+            "seeds, clipped to 0–1 (none with fewer than three seeds).",
         )
     )
     rows = []
     for r in a.exposure_rows:
         nxt = r.vs_next
         per_seed = ", ".join(f"s{k}: {fmt_num(v, 3)}" for k, v in scores[r.name].items())
-        ci = fmt_interval(r.lo, r.hi, 3)
+        ci = seed_interval_text(r.lo, r.hi, r.n_seeds, 3)
         o = outcomes.get(r.name)
         rows.append(
             (
                 str(r.rank),
                 r.name,
-                f"{fmt_num(r.mean, 3)} ({ci})" if ci else fmt_num(r.mean, 3),
+                f"{fmt_num(r.mean, 3)} ({ci})",
                 per_seed,
                 str(r.n_seeds),
                 f"{nxt.test}, p {fmt_p(nxt.p)}" if nxt else "—",

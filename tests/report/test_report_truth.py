@@ -1,0 +1,139 @@
+"""The report says what its data say: captions checked against what is plotted, intervals
+inside what is possible, a leaderboard first, one minus sign, modes stated as they ran."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from sumo_ayss.analysis.case import analyse_case, ranking_line
+from sumo_ayss.report import write_report
+from sumo_ayss.report.crossplay_figure import crossplay_lines
+from sumo_ayss.report.episodes import load_crossplay
+from sumo_ayss.report.figstyle import set_wrapped_title, style
+from sumo_ayss.report.leaderboard import leaderboard_rows, leaderboard_text
+from sumo_ayss.report.load import load_run
+from tests.report.test_report import FAST, make_crossplay, make_run
+
+
+def _runs(root: Path, case: str, vuts: tuple[str, ...], seeds: range) -> dict:
+    for vut in vuts:
+        for seed in seeds:
+            make_run(root, case, vut, seed)
+    return {v: [load_run(root / case / v / f"seed_{s}") for s in seeds] for v in vuts}
+
+
+@pytest.fixture(scope="module")
+def crossplay_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    root = tmp_path_factory.mktemp("runs")
+    _runs(root, "car_following", ("pi1", "pi2"), range(3))
+    make_crossplay(root / "car_following", ["pi1", "pi2"], range(3))
+    return write_report([root], options=FAST)
+
+
+def _section(html: str, start: str, end: str) -> str:
+    return html.split(f'id="{start}"')[1].split(f'id="{end}"')[0]
+
+
+def test_crossplay_caption_claim_matches_the_plotted_lines(tmp_path: Path) -> None:
+    runs = _runs(tmp_path, "car_following", ("pi1", "pi2"), range(3))
+    make_crossplay(tmp_path / "car_following", ["pi1", "pi2"], range(3))
+    a = analyse_case("car_following", runs, FAST, crossplay=load_crossplay(runs))
+    assert a.crossplay is not None and a.crossplay_rows[0].vs_next is not None
+    assert a.crossplay_rows[0].vs_next.significant  # the ranking is a finding here
+    order = [r.name for r in a.crossplay_rows]
+    lines = crossplay_lines(order, a.crossplay.harm, a.crossplay.vuts)
+    # What the figure draws, left to right: safest first, so the mean over opponents rises.
+    assert np.all(np.diff(lines.mean(axis=0)) > 0)
+    rising = int(np.sum(np.all(np.diff(lines, axis=1) > 0, axis=1)))
+    falling = int(np.sum(np.all(np.diff(lines, axis=1) < 0, axis=1)))
+    assert rising > falling
+    # ... and the caption says that rising lines agree with the ranking.
+    html = write_report([tmp_path], options=FAST).read_text(encoding="utf-8")
+    caption = html.split("brings about against each VUT, VUTs in cross-play ranking order")[1]
+    caption = caption.split("</figcaption>")[0]
+    assert "lines that rise from left to right agree with the ranking" in caption
+    assert "fall from left to right agree" not in html
+
+
+def test_leaderboard_comes_first_with_rank_score_crashes_and_verdict(
+    crossplay_report: Path,
+) -> None:
+    html = crossplay_report.read_text(encoding="utf-8")
+    assert html.index('id="leaderboard"') < html.index('id="verdicts"')
+    board = _section(html, "leaderboard", "verdicts")
+    for head in ("rank", "VUT", "cross-play harm H per episode", "crash rate", "vs next"):
+        assert head in board
+    assert board.index("pi2") < board.index("pi1")  # pi2 is safer in the synthetic data
+    assert "safer than pi1 (paired t, p" in board
+    assert re.search(r"\d\.\d % \(\d+\.\d–\d+\.\d %\), \d+/\d+", board)  # crash rate cell
+
+
+def test_leaderboard_text_fits_80_columns_and_matches_the_report(tmp_path: Path) -> None:
+    runs = _runs(tmp_path, "car_following", ("pi1", "pi2"), range(3))
+    make_crossplay(tmp_path / "car_following", ["pi1", "pi2"], range(3))
+    a = analyse_case("car_following", runs, FAST, crossplay=load_crossplay(runs))
+    text = leaderboard_text([a])
+    rows = leaderboard_rows(a)
+    assert [r.vut for r in rows] == ["pi2", "pi1"]
+    assert all(len(line) <= 80 for line in text.splitlines()[1:]), text
+    assert rows[0].score in text and rows[0].vs_next in text
+
+
+def test_two_seed_report_prints_no_t_interval_over_two_points(tmp_path: Path) -> None:
+    _runs(tmp_path, "car_following", ("pi1", "pi2"), range(2))
+    html = write_report([tmp_path], options=FAST).read_text(encoding="utf-8")
+    premise = html.split("Outcome of the SPCPs per VUT")[1].split("</table>")[0]
+    assert premise.count("2 seeds: no interval") == 6  # 3 metrics x 2 VUTs
+    assert "2 seeds: no interval" in _section(html, "leaderboard", "verdicts")
+
+
+def test_premise_crash_rate_intervals_lie_in_0_100(tmp_path: Path) -> None:
+    _runs(tmp_path, "car_following", ("pi1", "pi2"), range(4))
+    html = write_report([tmp_path], options=FAST).read_text(encoding="utf-8")
+    premise = html.split("Outcome of the SPCPs per VUT")[1].split("</table>")[0]
+    row = premise.split("crash rate [%]")[1].split("</tr>")[0]
+    cells = re.findall(r"([−\d.]+) \(([−\d.]+)(?:–| to )([−\d.]+)\)", row)
+    assert len(cells) == 2, row
+    for mean, lo, hi in cells:
+        lo_v, mean_v, hi_v = (float(x.replace("−", "-")) for x in (lo, mean, hi))
+        assert 0.0 <= lo_v <= mean_v <= hi_v <= 100.0
+
+
+def test_one_minus_sign_in_the_verdicts(crossplay_report: Path) -> None:
+    html = crossplay_report.read_text(encoding="utf-8")
+    text = re.sub(r"<[^>]+>", " ", html.split('id="inputs"')[0])
+    assert not re.search(r"(?<![\w.])-\d", text), re.findall(r".{30}(?<![\w.])-\d.{10}", text)
+
+
+def test_single_vut_report_claims_no_verdict_mode(tmp_path: Path) -> None:
+    _runs(tmp_path, "car_following", ("pi1",), range(1))
+    html = write_report([tmp_path], options=FAST).read_text(encoding="utf-8")
+    assert "Verdicts above are in" not in html
+    assert "No verdict: every case of this report has fewer than two VUTs" in html
+    assert "from 1 run folder (" in html
+
+
+def test_ties_read_the_same_in_every_mode() -> None:
+    assert ranking_line(["pi2", "pi1"], [False]) == ranking_line(["pi1", "pi2"], [False])
+    assert ranking_line(["c", "b", "a"], [True, False]) == "c > a ≈ b"
+    assert ranking_line(["c", "b", "a"], [False, True]) == "b ≈ c > a"
+
+
+@pytest.mark.parametrize("width_in", [4.0, 5.4, 8.0])
+def test_wrapped_title_fits_its_figure(width_in: float) -> None:
+    title = "One-lane car-following: exposure harm per seed (lower = safer), a long title"
+    with style():
+        fig = Figure(figsize=(width_in, 4.0), layout="constrained")
+        canvas = FigureCanvasAgg(fig)
+        ax = fig.subplots()
+        text = set_wrapped_title(ax, title, width_in)
+        canvas.draw()
+        box = text.get_window_extent(canvas.get_renderer())
+    assert box.width <= fig.bbox.width
+    assert box.x0 >= 0 and box.x1 <= fig.bbox.width
