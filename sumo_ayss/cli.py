@@ -25,7 +25,10 @@ COMMANDS = {
     "evaluate": ("sumo_ayss.evaluate", "outcome table and Monte Carlo AYSS of a run's SPCP"),
     "report": ("sumo_ayss.report.__main__", "HTML + Markdown report from run folders"),
     "pipeline": ("sumo_ayss.pipeline", "the grid cases x VUTs x seeds, resumable"),
-    "rank": ("sumo_ayss.rank", "leaderboard of K VUTs by safety index (a pipeline + ranking)"),
+    "rank": (
+        "sumo_ayss.rank",
+        "leaderboard of K VUTs by safety (a pipeline + ranking; default mode cross-play)",
+    ),
     "discriminability": (
         "sumo_ayss.discriminability",
         "where VUTs' one-step responses differ over the AYSS box (no training)",

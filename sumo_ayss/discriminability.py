@@ -97,6 +97,14 @@ def load_target(path: str | Path, vuts: Sequence[str] | None, case: Case | None)
     is_pipeline = "env" not in data and bool(set(data) & _PIPELINE_KEYS)
     if is_pipeline:
         pipe = load_pipeline(path)
+        if case is None and len(pipe.grid.cases) > 1:
+            logger.warning(
+                "%s has %d cases (%s): measuring only the first, %s; choose one with --case",
+                path,
+                len(pipe.grid.cases),
+                ", ".join(pipe.grid.cases),
+                pipe.grid.cases[0],
+            )
         case = case or pipe.grid.cases[0]
         env = pipeline_env(pipe, case)
         names = tuple(vuts) if vuts else tuple(pipe.grid.vuts)
@@ -299,7 +307,13 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     )
     p.add_argument("config", type=Path, help="experiment YAML or pipeline YAML")
     p.add_argument("--vuts", nargs="+", default=None, help="VUTs to compare (>= 2)")
-    p.add_argument("--case", choices=case_names(), default=None)
+    p.add_argument(
+        "--case",
+        choices=case_names(),
+        default=None,
+        help="case to measure (default: the experiment's, or a pipeline's FIRST grid.cases "
+        "only; a warning says so)",
+    )
     p.add_argument(
         "--out", type=Path, default=None, help="default: runs/discriminability/<stem>_<case>"
     )

@@ -326,6 +326,35 @@ def write_discriminability(cfg: PipelineConfig) -> None:
             logger.warning("discriminability of %s not computed: %s", case, e)
 
 
+def add_budget_flags(parser: argparse.ArgumentParser) -> None:
+    """``--total-timesteps``, ``--eval-every``, ``--n-outcome``, ``--n-ayss``: a small
+    budget without writing a YAML. They replace the config's values and are written into
+    ``pipeline.json`` and every run's ``config.yaml`` like them."""
+    group = parser.add_argument_group(
+        "budget (replace the config's; written into pipeline.json and each run's config.yaml)"
+    )
+    group.add_argument(
+        "--total-timesteps", type=int, default=None, help="training transitions per run"
+    )
+    group.add_argument(
+        "--eval-every", type=int, default=None, help="transitions between SPCP candidates"
+    )
+    group.add_argument(
+        "--n-outcome", type=int, default=None, help="outcome episodes per SPCP (paper: 200)"
+    )
+    group.add_argument("--n-ayss", type=int, default=None, help="AYSS Monte Carlo draws per SPCP")
+
+
+def budget_overrides(args: argparse.Namespace) -> dict[str, int | None]:
+    """The budget flags of :func:`add_budget_flags` as :func:`load_pipeline` overrides."""
+    return {
+        "total_timesteps": args.total_timesteps,
+        "eval_every": args.eval_every,
+        "n_outcome": args.n_outcome,
+        "n_ayss": args.n_ayss,
+    }
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
         prog=prog("python -m sumo_ayss.pipeline"), description=__doc__.splitlines()[0]
@@ -346,10 +375,17 @@ def main(argv: Sequence[str] | None = None) -> None:
         help="no live table: one log line per job event (the default when stdout is not a "
         "terminal)",
     )
+    add_budget_flags(parser)
     args = parser.parse_args(argv)
     console = configure_logging(not args.no_live)
     try:
-        cfg = load_pipeline(args.config, out=args.out, workers=args.workers, seeds=args.seeds)
+        cfg = load_pipeline(
+            args.config,
+            out=args.out,
+            workers=args.workers,
+            seeds=args.seeds,
+            **budget_overrides(args),
+        )
         result = run_pipeline(
             cfg,
             backend=args.backend,
@@ -362,6 +398,10 @@ def main(argv: Sequence[str] | None = None) -> None:
     except KeyboardInterrupt:
         print("interrupted: no job runs any more; rerun the same command to resume", flush=True)
         sys.exit(130)
+    if result.analyses:
+        from sumo_ayss.report.leaderboard import leaderboard_text
+
+        print(leaderboard_text(result.analyses))
     for line in final_messages(result):
         print(line)
     sys.exit(1 if any(s.state == "failed" for s in result.statuses) else 0)

@@ -357,6 +357,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     from sumo_ayss.cli import prog
     from sumo_ayss.config.report import MODES
     from sumo_ayss.pipeline import (
+        add_budget_flags,
+        budget_overrides,
         configure_logging,
         final_messages,
         load_pipeline,
@@ -390,11 +392,18 @@ def main(argv: Sequence[str] | None = None) -> None:
     )
     parser.add_argument("--no-live", action="store_true", help="no live table (log lines)")
     parser.add_argument("--strict", action="store_true", help=STRICT_HELP)
+    add_budget_flags(parser)
     args = parser.parse_args(argv)
     console = configure_logging(not args.no_live)
     result = None
     try:
-        cfg = load_pipeline(args.config, workers=args.workers, out=args.out, seeds=args.seeds)
+        cfg = load_pipeline(
+            args.config,
+            workers=args.workers,
+            out=args.out,
+            seeds=args.seeds,
+            **budget_overrides(args),
+        )
         if args.mode is not None:
             cfg = dataclasses.replace(cfg, report=dataclasses.replace(cfg.report, mode=args.mode))
         if args.no_run:
@@ -417,8 +426,17 @@ def main(argv: Sequence[str] | None = None) -> None:
         print("interrupted: no job runs any more; rerun the same command to resume", flush=True)
         sys.exit(130)
     checks = order_checks(analyses, cfg.expected_order)
-    _, md = write_ranking(ranking_rows(analyses), cfg.out, checks, cfg.expected_order)
-    print(md.read_text())
+    csv_path, md = write_ranking(ranking_rows(analyses), cfg.out, checks, cfg.expected_order)
+    from sumo_ayss.report.leaderboard import leaderboard_text
+
+    print(leaderboard_text(analyses))
+    for c in checks:
+        print(
+            f"{c['case']}, {c['mode']} mode, against the known order: Kendall tau = "
+            f"{c['tau']:.2f}; ends differ significantly: "
+            f"{'yes' if c['ends_significant'] else 'no'}"
+        )
+    print(f"ranking (every mode): {md} and {csv_path.name}")
     if result is None:  # --no-run
         from sumo_ayss.report.checks import trust_warnings
 

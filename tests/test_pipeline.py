@@ -129,6 +129,7 @@ def test_sigkill_then_rerun_finishes_without_redoing_finished_stages(tmp_path: P
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     assert "report:" in done.stdout
+    assert "car_following: leaderboard (" in done.stdout  # the verdicts, printed
     assert "taking over the stale lock" in done.stderr and not lock.exists()
     for p, data in finished.items():  # completed stages were not redone
         assert p.read_bytes() == data, p

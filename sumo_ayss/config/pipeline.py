@@ -99,6 +99,18 @@ class PipelineConfig:
     retries: int = 1
 
     def __post_init__(self) -> None:
+        for name in ("total_timesteps", "eval_every"):
+            value = getattr(self, name)
+            require(
+                value is None or (isinstance(value, int) and value >= 1),
+                f"{name} must be an integer >= 1 (or absent: the experiment's), got {value!r}",
+            )
+        if self.total_timesteps is not None and self.eval_every is not None:
+            require(
+                self.eval_every <= self.total_timesteps,
+                f"eval_every ({self.eval_every}) must be <= total_timesteps "
+                f"({self.total_timesteps}): a run needs at least one SPCP candidate",
+            )
         require(self.workers >= 0, f"workers must be >= 0, got {self.workers}")
         require(self.retries >= 0, f"retries must be >= 0, got {self.retries}")
         if self.expected_order:
@@ -128,7 +140,14 @@ class PipelineConfig:
 
 
 def load_pipeline(path: str | Path | None, **overrides: Any) -> PipelineConfig:
-    """Pipeline YAML over defaults, then ``overrides`` (None values are ignored)."""
+    """Pipeline YAML over defaults, then ``overrides`` (None values are ignored).
+
+    ``overrides`` are fields of :class:`PipelineConfig` and ``seeds`` (``grid.seeds``),
+    ``n_outcome`` (``evaluate.n_outcome``) and ``n_ayss`` (``evaluate.n_ayss``, which then
+    also sets ``evaluate.ayss.n_samples``). They enter the resolved configuration that the
+    pipeline writes (``pipeline.json``, each run's ``config.yaml``), so a run made with
+    command-line overrides is reproduced from its files.
+    """
     if path is None:
         cfg = PipelineConfig()
     else:
@@ -138,4 +157,15 @@ def load_pipeline(path: str | Path | None, **overrides: Any) -> PipelineConfig:
     seeds = clean.pop("seeds", None)
     if seeds is not None:
         clean["grid"] = dataclasses.replace(cfg.grid, seeds=tuple(int(x) for x in seeds))
+    evaluate = cfg.evaluate
+    n_outcome = clean.pop("n_outcome", None)
+    if n_outcome is not None:
+        evaluate = dataclasses.replace(evaluate, n_outcome=n_outcome)
+    n_ayss = clean.pop("n_ayss", None)
+    if n_ayss is not None:
+        require(n_ayss >= 1, f"evaluate.n_ayss must be >= 1, got {n_ayss}")
+        ayss = dataclasses.replace(evaluate.ayss, n_samples=n_ayss)
+        evaluate = dataclasses.replace(evaluate, n_ayss=n_ayss, ayss=ayss)
+    if evaluate is not cfg.evaluate:
+        clean["evaluate"] = evaluate
     return dataclasses.replace(cfg, **clean) if clean else cfg
