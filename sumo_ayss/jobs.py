@@ -110,9 +110,9 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
         cfg = spec.experiment
         set_torch_threads(cfg.train.torch_threads)  # for evaluate too, when training is skipped
         if folder.spcp_json.is_file() and folder.config.is_file():
-            from sumo_ayss.train import _check_same_config
+            from sumo_ayss.training.config_check import check_same_config
 
-            _check_same_config(run_dir, cfg, spec.seed)  # raises if the inputs changed
+            check_same_config(run_dir, cfg, spec.seed)  # raises if the inputs changed
             stages["train"] = "skipped"
         else:
             resume = folder.config.is_file()

@@ -46,6 +46,7 @@ import argparse
 import dataclasses
 import logging
 import math
+import shlex
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -63,9 +64,7 @@ from sumo_ayss.config import (
     ExperimentConfig,
     check_out_dir,
     check_seed,
-    experiment_from_dict,
     load_experiment,
-    to_dict,
 )
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
@@ -77,7 +76,6 @@ from sumo_ayss.run_folder import (
     STATE_JSON,
     RunFolder,
     read_checkpoint_state,
-    read_run_config,
     run_dir_for,
     write_eval_table,
     write_latest,
@@ -95,6 +93,7 @@ from sumo_ayss.training.collectors import (
     evaluate_on_vec,
     make_collector,
 )
+from sumo_ayss.training.config_check import check_same_config
 from sumo_ayss.training.run_metadata import write_metadata
 
 __all__ = [
@@ -385,7 +384,7 @@ def train(
     if resume:
         if not config_file.is_file():
             raise CheckpointError(f"--resume: no run folder at {run_dir}")
-        _check_same_config(run_dir, cfg, seed)
+        check_same_config(run_dir, cfg, seed)
     elif RunFolder(run_dir).checkpoints.exists():
         raise CheckpointError(
             f"{run_dir} already holds a run; pass --resume to continue it or choose another --out"
@@ -416,26 +415,17 @@ def train(
     return run_dir
 
 
-def _check_same_config(run_dir: Path, cfg: ExperimentConfig, seed: int) -> None:
-    path = RunFolder(run_dir).config
-    stored = read_run_config(path)
-    try:
-        stored_cfg = experiment_from_dict(stored.experiment, run_dir)
-    except ConfigError as e:
-        raise CheckpointError(f"{path}: unreadable run configuration ({e})") from e
-    stored_seed = stored.seed
-    if stored_seed != seed or to_dict(stored_cfg) != to_dict(cfg):
-        raise CheckpointError(
-            f"--resume: {run_dir}/config.yaml differs from the requested configuration; "
-            "resume with the same config file, --vut and --seed"
-        )
-
-
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(
         prog=prog("python -m sumo_ayss.train"), description=__doc__.splitlines()[0]
     )
-    parser.add_argument("--config", type=Path, default=None, help="experiment YAML")
+    parser.add_argument(
+        "--config",
+        type=Path,
+        default=None,
+        help="experiment YAML (required): configs/car_following.yaml or configs/cut_in.yaml "
+        "are the paper's experiments",
+    )
     parser.add_argument("--vut", default=None, help="VUT name (overrides env.vut)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=Path, default=Path("runs"), help="runs root folder")
@@ -455,6 +445,15 @@ def main(argv: Sequence[str] | None = None) -> None:
     argv = list(sys.argv[1:] if argv is None else argv)
     args = parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
+    if args.config is None:
+        # The built-in defaults (one env, 200,000 transitions) are not the paper's
+        # configuration: starting a long run on them by omission helps nobody.
+        sys.exit(
+            "error: --config: an experiment YAML is required, e.g. --config "
+            "configs/car_following.yaml (the paper's car-following experiment) or "
+            "configs/cut_in.yaml; the built-in defaults are not the paper's configuration"
+        )
+    run_dir: Path | None = None
     try:
         cfg = load_experiment(args.config).with_vut(args.vut)
         overrides: dict[str, Any] = {}
@@ -467,9 +466,20 @@ def main(argv: Sequence[str] | None = None) -> None:
         if args.device is not None:
             overrides["device"] = args.device
         cfg = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, **overrides))
+        run_dir = run_dir_for(args.out, cfg.env.case, cfg.env.vut, args.seed)
         run_dir = train(cfg, args.seed, args.out, resume=args.resume, argv=argv)
     except AyssError as e:
         sys.exit(f"error: {e}")
+    except KeyboardInterrupt:
+        resume = [a for a in argv if a != "--resume"] + ["--resume"]
+        where = f" ({run_dir})" if run_dir is not None else ""
+        print(
+            f"\ninterrupted: training stopped{where}; continue it from its last checkpoint "
+            f"with:\n  python -m sumo_ayss.train {shlex.join(resume)}",
+            file=sys.stderr,
+            flush=True,
+        )
+        sys.exit(130)
     print(run_dir)
 
 

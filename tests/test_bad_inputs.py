@@ -316,8 +316,9 @@ def test_bad_train_arguments_exit_with_one_line(
 ) -> None:
     from sumo_ayss.train import main
 
+    config = _yaml(tmp_path, "train: {progress_bar: false}\n", "experiment.yaml")
     with pytest.raises(SystemExit) as info:
-        main([*args, "--out", str(tmp_path / "runs"), "--no-progress"])
+        main(["--config", str(config), *args, "--out", str(tmp_path / "runs"), "--no-progress"])
     code = info.value.code
     assert isinstance(code, str) and code.startswith("error: ") and expected in code
     assert "\n" not in code
@@ -328,9 +329,10 @@ def test_train_out_pointing_at_a_file_is_refused(tmp_path: Path) -> None:
     from sumo_ayss.train import main
 
     file = _yaml(tmp_path, "precious\n", "out.txt")
+    config = _yaml(tmp_path, "train: {progress_bar: false}\n", "experiment.yaml")
     for out in (file, file / "below"):
         with pytest.raises(SystemExit) as info:
-            main(["--out", str(out), "--no-progress"])
+            main(["--config", str(config), "--out", str(out), "--no-progress"])
         assert isinstance(info.value.code, str) and "--out: " in info.value.code
         assert "is a file" in info.value.code
     assert file.read_text() == "precious\n"
