@@ -73,7 +73,7 @@ class ControllerSpec:
     Attributes:
         target: ``"package.module:attr"`` (imported with :mod:`importlib`; the module must be
             importable, e.g. from the working directory or an installed package) or
-            ``"path/to/file.py:attr"`` (a file, relative to the working directory).
+            ``"path/to/file.py:attr"`` (a file; relative to the YAML file that names it).
             ``attr`` may be dotted (``module:Outer.Inner``); it must name a class with an
             ``acceleration(state)`` method, checked before the class is instantiated.
         max_accel_mps2: Largest acceleration the vehicle can realise [m/s²], > 0.
@@ -257,7 +257,7 @@ def controller_imports(allowed: bool) -> Iterator[None]:
 
 
 def _import(module_part: str) -> Any:
-    """Import ``pkg.module``, or load ``path/to/file.py`` (relative to the working dir)."""
+    """Import ``pkg.module``, or load ``path/to/file.py`` (made absolute by the config)."""
     if module_part.endswith(".py"):
         path = Path(module_part).expanduser().resolve()
         name = "sumo_ayss_user_" + hashlib.sha1(str(path).encode()).hexdigest()[:16]

@@ -19,7 +19,7 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
 from sumo_ayss.jobs import NOT_RETRIED, JobSpec, run_job
-from sumo_ayss.progress import GridProgress, JobStatus, format_duration
+from sumo_ayss.progress import GridProgress, JobStatus
 from sumo_ayss.run_folder import RunFolder
 
 logger = logging.getLogger("sumo_ayss.pipeline")
@@ -77,7 +77,7 @@ def _raise_terminated(signum: int, frame: Any) -> None:
 
 
 def run_grid_local(
-    jobs: Sequence[JobSpec], workers: int, retries: int, live: Any = None
+    jobs: Sequence[JobSpec], workers: int, retries: int, live: Any = None, after: str = ""
 ) -> list[JobStatus]:
     """Run ``jobs`` on a local process pool with retries; report progress as it goes.
 
@@ -87,12 +87,13 @@ def run_grid_local(
     resumable), queued ones never start (``cancelled``), and the KeyboardInterrupt
     propagates to the caller within seconds. Every job event is logged (one line each, with
     the grid's counts and ETA); ``live`` (a :class:`rich.console.Console`, or None for
-    none) also shows a table of every job that refreshes twice a second.
+    none) also shows a table of every job that refreshes twice a second. ``after`` names
+    what follows the grid outside the ETA (:class:`~sumo_ayss.progress.GridProgress`).
     """
     import signal
 
     statuses = [JobStatus(j) for j in jobs]
-    progress = GridProgress(statuses, workers)
+    progress = GridProgress(statuses, workers, after)
     queue: collections.deque[JobStatus] = collections.deque(statuses)
     ctx = multiprocessing.get_context("spawn")  # fresh interpreters: no inherited libsumo
     logger.info(
@@ -161,13 +162,7 @@ def run_grid_local(
             display.update(progress.table())
             display.stop()
         pool.shutdown(wait=False, cancel_futures=True)
-    c = progress.counts()
-    logger.info(
-        "grid finished: %d done, %d failed, %s wall",
-        c["done"],
-        c["failed"],
-        format_duration(time.time() - progress.t0),
-    )
+    logger.info(progress.summary())
     return statuses
 
 

@@ -180,6 +180,11 @@ def final_messages(result: PipelineResult) -> list[str]:
         for s in result.statuses
         if s.state == "failed"
     ]
+    lines += [
+        f"RETRIED {s.spec.name}: passed on try {s.attempts} after a failure: {s.error}"
+        for s in result.statuses
+        if s.state == "done" and s.attempts > 1
+    ]
     done = [s for s in result.statuses if s.state == "done"]
     if done:
         from sumo_ayss.report.checks import trust_warnings
@@ -229,17 +234,23 @@ def _run_locked(
     from sumo_ayss.atomic import atomic_write_json
 
     atomic_write_json(cfg.out / "pipeline.json", _relative_paths(to_dict(cfg), cfg.out))
+    crossplay = cfg.report.mode == "crossplay" and len(cfg.grid.vuts) >= 2
+    after = "cross-play and the report" if crossplay else "the report"
     if backend == "ray":
         from sumo_ayss.ray_backend import run_grid_ray
 
-        statuses = run_grid_ray(jobs, cfg.retries, address)
+        statuses = run_grid_ray(jobs, cfg.retries, address, after=after)
     else:
         if live and console is None and sys.stdout.isatty():
             from rich.console import Console
 
             console = Console()
         statuses = run_grid_local(
-            jobs, min(cfg.n_workers, len(jobs)), cfg.retries, console if live else None
+            jobs,
+            min(cfg.n_workers, len(jobs)),
+            cfg.retries,
+            console if live else None,
+            after=after,
         )
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
     if not finished:
@@ -250,6 +261,7 @@ def _run_locked(
     from sumo_ayss.report.document import load_runs, write_report_for
     from sumo_ayss.report.load import analyse_runs
 
+    logger.info("report: analysing %d run folders and drawing the figures", len(finished))
     runs = load_runs(finished)
     analyses = analyse_runs(runs, cfg.report)  # once per case: the report's and rank's
     report = write_report_for(runs, cfg.out / "report", analyses=analyses, options=cfg.report)

@@ -10,8 +10,9 @@ finished stages. From these :class:`GridProgress` makes
 - one log line per job event (started, each new SPCP candidate, training finished,
   evaluation finished, failed, retried), each prefixed with the grid's counts and ETA, for
   ``--no-live`` runs and logs;
-- a table for a live terminal display (jobs queued / running / done / failed, stage, steps,
-  rate in steps/s, tries, wall time in s) with the grid's ETA in its title.
+- a table for a live terminal display (jobs queued / train / evaluate / done / failed,
+  training progress, rate in steps/s, tries, wall time in s) with the grid's ETA in its
+  title, readable at 80 columns.
 
 Imports neither SUMO nor torch.
 """
@@ -134,11 +135,15 @@ class GridProgress:
         statuses: The grid's jobs (the pipeline updates ``state``, ``attempts``,
             ``started_at``, ``wall_s`` and the stage times; :meth:`poll` the rest).
         workers: Worker processes, for the ETA.
+        after: What runs after the grid and is not in the ETA (e.g. ``"cross-play and
+            the report"``), named in the ETA text so that no stage is a silent gap; "" for
+            nothing.
     """
 
-    def __init__(self, statuses: Sequence[JobStatus], workers: int) -> None:
+    def __init__(self, statuses: Sequence[JobStatus], workers: int, after: str = "") -> None:
         self.statuses = list(statuses)
         self.workers = max(1, workers)
+        self.after = after
         self.t0 = time.time()
 
     def finished(self, s: JobStatus, result: dict[str, Any]) -> str:
@@ -225,19 +230,37 @@ class GridProgress:
 
     def eta_text(self) -> str:
         eta, with_eval = self.eta_s()
+        then = f" (jobs; then {self.after})" if self.after else ""
         if eta is None:
-            return "ETA: after the first rate is measured"
+            return f"ETA: after the first rate is measured{then}"
         text = f"ETA ≈ {format_duration(eta)}"
-        return text if with_eval else text + " + evaluation"
+        return (text if with_eval else text + " + evaluation") + then
+
+    def retried(self) -> list[JobStatus]:
+        """Jobs that needed more than one try (whatever their state now)."""
+        return [s for s in self.statuses if s.attempts > 1]
 
     def header(self) -> str:
-        """``"2/8 done, 2 running, 4 queued, 0 failed; 3 min elapsed; ETA ≈ 9 min"``."""
+        """``"2/8 done, 2 running, 4 queued, 0 failed, 1 retried; 3 min elapsed; ETA ≈ 9
+        min"`` (the retried count only when a job was retried)."""
         c = self.counts()
         elapsed = format_duration(time.time() - self.t0)
+        retried = len(self.retried())
+        again = f", {retried} retried" if retried else ""
         return (
             f"{c['done']}/{len(self.statuses)} done, {c['running']} running, "
-            f"{c['queued']} queued, {c['failed']} failed; {elapsed} elapsed; {self.eta_text()}"
+            f"{c['queued']} queued, {c['failed']} failed{again}; {elapsed} elapsed; "
+            f"{self.eta_text()}"
         )
+
+    def summary(self) -> str:
+        """The grid's last line: ``"grid finished: 7 done (1 after a retry), 1 failed, 12
+        min wall"``."""
+        c = self.counts()
+        passed = sum(1 for s in self.retried() if s.state == "done")
+        again = f" ({passed} after a retry)" if passed else ""
+        wall = format_duration(time.time() - self.t0)
+        return f"grid finished: {c['done']} done{again}, {c['failed']} failed, {wall} wall"
 
     def line(self, s: JobStatus, event: str) -> str:
         """One log line for an event of job ``s``."""
@@ -250,30 +273,46 @@ class GridProgress:
             return f"{s.step:,}/{s.total:,} ({100 * s.step / s.total:.0f} %)"
         return ""
 
+    def short_progress(self, s: JobStatus) -> str:
+        """``"42 % of 10k"``: the training progress in a narrow table cell."""
+        if not s.total or not (s.step or s.state in ("running", "done")):
+            return ""
+        step = s.total if s.state == "done" else s.step
+        total = f"{s.total / 1000:g}k" if s.total >= 1000 else str(s.total)
+        return f"{100 * step / s.total:.0f} % of {total}"
+
     # -- live table -------------------------------------------------------------------
 
     def table(self) -> Any:
         """A rich table of every job (headers escaped: rich reads ``[s]`` as markup)."""
+        # Fits 80 columns: short headers that are never cut ("runn…", "[ste…" were
+        # unreadable), the running stage as the state, no vertical rules; a long job name
+        # folds onto a second line instead of squeezing the other cells.
+        from rich import box
         from rich.markup import escape
         from rich.table import Table
 
-        table = Table(title=escape(f"sumo_ayss pipeline: {self.header()}"), expand=False)
-        for col, right in (
-            ("job", False),
-            ("state", False),
-            ("stage", False),
-            ("training steps", True),
-            ("rate [steps/s]", True),
-            ("tries", True),
-            ("wall [s]", True),
+        table = Table(
+            title=escape(f"sumo_ayss pipeline: {self.header()}"),
+            expand=False,
+            box=box.SIMPLE_HEAD,
+            pad_edge=False,
+            show_edge=False,
+        )
+        for col, right, width in (
+            ("job", False, 12),
+            ("state", False, len("interrupted")),
+            ("steps", True, len("100 % of 200k")),
+            ("steps/s", True, len("steps/s")),
+            ("try", True, len("try")),
+            ("wall s", True, len("wall s")),
         ):
             table.add_column(
                 escape(col),
                 justify="right" if right else "left",
-                no_wrap=col == "job",
-                min_width=max((len(s.spec.name) for s in self.statuses), default=0)
-                if col == "job"
-                else None,
+                no_wrap=col != "job",
+                overflow="fold",
+                min_width=width,
             )
         colours = {
             "done": "green",
@@ -291,11 +330,11 @@ class GridProgress:
             else:
                 wall = f"{s.wall_s:.0f}" if s.wall_s else ""
             rate = f"{s.rate_steps_per_s:.0f}" if s.rate_steps_per_s else ""
+            state = s.stage if s.state == "running" and s.stage else s.state
             table.add_row(
                 escape(s.spec.name),
-                f"[{colour}]{s.state}[/{colour}]",
-                escape(s.stage if s.state == "running" else ""),
-                self.progress_text(s),
+                f"[{colour}]{escape(state)}[/{colour}]",
+                self.short_progress(s),
                 rate if s.state in ("running", "done") else "",
                 str(s.attempts),
                 wall,

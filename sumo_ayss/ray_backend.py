@@ -21,7 +21,6 @@ import logging
 import shutil
 import tarfile
 import tempfile
-import time
 import traceback
 from collections.abc import Sequence
 from pathlib import Path
@@ -29,7 +28,7 @@ from typing import Any
 
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.jobs import NOT_RETRIED, JobSpec, run_job
-from sumo_ayss.progress import JobStatus
+from sumo_ayss.progress import GridProgress, JobStatus
 from sumo_ayss.run_folder import RunFolder
 
 logger = logging.getLogger(__name__)
@@ -71,8 +70,17 @@ def remote_job(spec: JobSpec, folder: bytes) -> tuple[dict[str, Any], bytes]:
         return result, pack(local.run_dir)
 
 
-def run_grid_ray(jobs: Sequence[JobSpec], retries: int, address: str | None) -> list[JobStatus]:
-    """Run ``jobs`` as Ray tasks (one CPU each), retrying a failed job ``retries`` times."""
+def run_grid_ray(
+    jobs: Sequence[JobSpec], retries: int, address: str | None, after: str = ""
+) -> list[JobStatus]:
+    """Run ``jobs`` as Ray tasks (one CPU each), retrying a failed job ``retries`` times.
+
+    Every job event is logged like the local backend's (started, done with its stages and
+    times, failed, retried, each line with the grid's counts and ETA,
+    :class:`~sumo_ayss.progress.GridProgress`); a task's run folder is remote until it
+    ends, so there are no events in between. ``after``: what follows the grid, outside
+    the ETA.
+    """
     try:
         import ray
     except ImportError as e:  # pragma: no cover - depends on the install
@@ -92,15 +100,16 @@ def run_grid_ray(jobs: Sequence[JobSpec], retries: int, address: str | None) -> 
             ) from e
     task = ray.remote(num_cpus=1, max_retries=0)(remote_job)
     statuses = [JobStatus(j) for j in jobs]
+    resources = ray.cluster_resources() if hasattr(ray, "cluster_resources") else {}
+    progress = GridProgress(statuses, int(resources.get("CPU", 1)), after)
     pending: dict[Any, JobStatus] = {}
-    started: dict[Any, float] = {}
+    logger.info("%d jobs as Ray tasks (one CPU each)", len(jobs))
 
     def submit(s: JobStatus) -> None:
-        s.attempts += 1
-        s.state = "running" if s.attempts == 1 else "retrying"
+        s.start()
         ref = task.remote(s.spec, pack(s.spec.run_dir))
         pending[ref] = s
-        started[ref] = time.perf_counter()
+        logger.info(progress.line(s, f"started on Ray (try {s.attempts})"))
 
     try:
         for s in statuses:
@@ -112,19 +121,22 @@ def run_grid_ray(jobs: Sequence[JobSpec], retries: int, address: str | None) -> 
             try:
                 result, folder = ray.get(ref)
                 unpack(folder, s.spec.run_dir)
-                s.state, s.wall_s = "done", result["wall_s"]
-                logger.info("ray job %s done", s.spec.name)
+                logger.info(progress.finished(s, result))
             except Exception as e:  # a job's failure is data here
                 s.error = "".join(traceback.format_exception_only(e)).strip()[-2000:]
                 cause = getattr(e, "cause", e)  # a RayTaskError wraps the job's exception
                 if s.attempts <= retries and not isinstance(cause, NOT_RETRIED):
-                    logger.warning("ray job %s failed (%s); retrying", s.spec.name, s.error)
+                    s.state = "queued"
+                    logger.warning(progress.line(s, f"failed ({s.error}); will retry"))
                     submit(s)
                 else:
                     s.state = "failed"
                     s.spec.run_dir.mkdir(parents=True, exist_ok=True)
-                    RunFolder(s.spec.run_dir).job_log.write_text(s.error + "\n")
+                    log = RunFolder(s.spec.run_dir).job_log
+                    log.write_text(s.error + "\n")
+                    logger.error(progress.line(s, f"FAILED: {s.error} (log: {log})"))
     finally:
         if started_here:
             ray.shutdown()
+    logger.info(progress.summary())
     return statuses

@@ -392,3 +392,28 @@ def test_controller_vut_in_env(case: str) -> None:
         assert all(-6.0 - 1e-9 <= a <= 3.0 + 1e-9 for a in accels)
     finally:
         env.close()
+
+
+def test_file_target_resolves_relative_to_the_yaml_not_the_working_dir(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from sumo_ayss.config import load_experiment
+
+    project = tmp_path / "project"
+    (project / "ctl").mkdir(parents=True)
+    (project / "ctl" / "hold.py").write_text(
+        "class Hold:\n    def acceleration(self, state):\n        return 0.0\n"
+    )
+    exp = project / "exp.yaml"
+    exp.write_text(
+        "env:\n  vut: hold\n  vuts:\n    hold:\n      controller:\n"
+        "        target: ctl/hold.py:Hold\n        max_accel_mps2: 3.0\n"
+        "        max_decel_mps2: 6.0\n"
+    )
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)  # "ctl/hold.py" does not exist here
+    spec = load_experiment(exp).env.vut_type.controller
+    assert spec is not None
+    assert spec.target == f"{(project / 'ctl' / 'hold.py').resolve()}:Hold"
+    assert type(spec.build("hold")).__name__ == "Hold"

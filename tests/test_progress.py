@@ -122,8 +122,8 @@ def test_only_started_jobs_are_running_and_table_keeps_units(tmp_path: Path) -> 
     console = Console(width=200, record=True)
     console.print(progress.table())
     text = console.export_text()
-    assert "wall [s]" in text and "rate [steps/s]" in text
-    assert text.count("running") == 2  # the title's count and one row
+    assert "wall s" in text and "steps/s" in text
+    assert text.count("running") == 2  # the title's count and the row (no stage yet)
     assert text.count("queued") == 3
 
 
@@ -143,3 +143,52 @@ def test_eta_without_training_left_needs_no_rate(tmp_path: Path) -> None:
     job.start()
     assert job.step == job.total
     assert GridProgress([job], 1).eta_s() == (0.0, False)
+
+
+def test_table_reads_whole_at_80_columns(tmp_path: Path) -> None:
+    from rich.console import Console
+
+    statuses = _grid(tmp_path, 3)
+    statuses[0].start()
+    statuses[0].stage, statuses[0].step, statuses[0].rate_steps_per_s = "train", 4200, 95.0
+    statuses[1].start()
+    statuses[1].stage = "evaluate"
+    console = Console(width=80, record=True)
+    console.print(GridProgress(statuses, workers=2, after="cross-play and the report").table())
+    text = console.export_text()
+    assert "…" not in text, text
+    assert all(len(line) <= 80 for line in text.splitlines())
+    for cell in ("car_following/pi1/seed_0", "train", "evaluate", "queued", "42 % of 10k"):
+        assert cell in text, (cell, text)
+    for head in ("job", "state", "steps", "steps/s", "try", "wall s"):
+        assert head in text
+    assert "then cross-play and the report" in " ".join(text.split())
+
+
+def test_a_retry_is_counted_and_said_at_the_end(tmp_path: Path) -> None:
+    statuses = _grid(tmp_path, 2)
+    progress = GridProgress(statuses, workers=1)
+    for s in statuses:
+        s.start()
+    statuses[0].start()  # a second try: the first failed
+    statuses[0].error = "SimulationError: boom"
+    for s in statuses:
+        progress.finished(s, {"wall_s": 1.0, "stages": {"train": "done"}})
+    assert "0 failed, 1 retried" in progress.header()
+    assert progress.summary().startswith("grid finished: 2 done (1 after a retry), 0 failed")
+
+
+def test_pipeline_final_messages_name_a_job_that_passed_on_retry(tmp_path: Path) -> None:
+    from sumo_ayss.pipeline import PipelineResult, final_messages
+    from sumo_ayss.report.load import load_run
+    from tests.report.test_report import make_run
+
+    run = load_run(make_run(tmp_path, "car_following", "pi1", 0))
+    status = JobStatus(Spec("car_following/pi1/seed_0", run.path))
+    status.attempts, status.state = 2, "done"
+    status.error = "SimulationError: boom"
+    lines = final_messages(PipelineResult([status], None, [run], []))
+    expected = (
+        "RETRIED car_following/pi1/seed_0: passed on try 2 after a failure: SimulationError: boom"
+    )
+    assert expected in lines

@@ -31,14 +31,21 @@ def test_pack_unpack_round_trip(tmp_path: Path) -> None:
 
 @pytest.mark.sumo
 @pytest.mark.timeout(900)  # starting Ray plus two tiny jobs: ~1-3 min on 2 busy cores
-def test_grid_on_a_local_ray_instance(tmp_path: Path) -> None:
+def test_grid_on_a_local_ray_instance(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
     ray = pytest.importorskip("ray", reason="ray is not installed (pip install 'sumo_ayss[ray]')")
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     try:
         cfg = load_pipeline(write_configs(tmp_path, [0]))
-        statuses, report, *_ = run_pipeline(cfg, backend="ray", live=False)
+        with caplog.at_level("INFO", logger="sumo_ayss.ray_backend"):
+            statuses, report, *_ = run_pipeline(cfg, backend="ray", live=False)
     finally:
         ray.shutdown()
+    # Every job event, as on the local backend: started and done, with the grid's counts.
+    for s in statuses:
+        assert f"{s.spec.name}: started on Ray (try 1)" in caplog.text
+        assert f"{s.spec.name}: done in " in caplog.text
+    assert "2/2 done, 0 running, 0 queued, 0 failed" in caplog.text
+    assert "grid finished: 2 done, 0 failed" in caplog.text
     assert [s.state for s in statuses] == ["done", "done"]
     for s in statuses:  # results are back in the run folders on the driver
         for name in ("spcp.json", "eval.csv", "outcome.csv", "ayss.csv", "job.log"):

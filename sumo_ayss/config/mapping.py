@@ -23,19 +23,34 @@ from sumo_ayss.errors import ConfigError
 from sumo_ayss.validation import check_choice, unknown_key
 
 
+def _anchor_controller(spec: ControllerSpec, base_dir: Path) -> ControllerSpec:
+    """A ``path/to/file.py:attr`` target made absolute against ``base_dir`` (the YAML
+    file's folder), like every other path of a configuration; module targets unchanged."""
+    module_part, _, attr = spec.target.rpartition(":")
+    if not module_part.endswith(".py"):
+        return spec
+    path = Path(module_part).expanduser()
+    if path.is_absolute():
+        return spec
+    return dataclasses.replace(spec, target=f"{(base_dir / path).resolve()}:{attr}")
+
+
 def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> Any:
     origin = typing.get_origin(tp)
     args = typing.get_args(tp)
     if tp is ControllerSpec:  # free-form params: parsed and validated by the catalog
         if isinstance(value, ControllerSpec):
             return value
-        return ControllerSpec.from_mapping(value, where)
+        return _anchor_controller(ControllerSpec.from_mapping(value, where), base_dir)
     if dataclasses.is_dataclass(tp) and isinstance(tp, type):
         if isinstance(value, tp):
             return value
         return build(tp, value, where, base_dir, default)
     if tp is VehicleType:
-        return VehicleType.from_mapping(value, where)
+        vt = VehicleType.from_mapping(value, where)
+        if vt.controller is None:
+            return vt
+        return dataclasses.replace(vt, controller=_anchor_controller(vt.controller, base_dir))
     if origin in (types.UnionType, typing.Union):
         if value is None and type(None) in args:
             return None
