@@ -94,9 +94,9 @@ def run_grid_ray(
         except ConnectionError as e:
             raise ConfigError(
                 f"--address {address}: no Ray cluster reachable ({e}). Start one first: "
-                "`ray start --head` on this machine (then `ray start --address <head-ip>:6379` "
-                "on each worker machine), or leave out --address to run on a Ray instance "
-                "started just for this pipeline on this machine"
+                "`.venv/bin/ray start --head` on this machine (then `.venv/bin/ray start "
+                "--address <head-ip>:6379` on each worker machine), or leave out --address to "
+                "run on a Ray instance started just for this pipeline on this machine"
             ) from e
     task = ray.remote(num_cpus=1, max_retries=0)(remote_job)
     statuses = [JobStatus(j) for j in jobs]

@@ -8,6 +8,7 @@ shrunk by appended options; ``make demo``'s pipeline runs on a tiny copy of
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import shlex
 import subprocess
@@ -118,3 +119,39 @@ def test_named_modules_commands_and_files_exist(doc: str) -> None:
         assert command in COMMANDS, f"{doc}: sumo-ayss {command}"
     for path in set(re.findall(r"\b((?:configs|examples|docker)/[\w./-]+\.(?:yaml|py|sh))", text)):
         assert (PROJECT_ROOT / path).is_file(), f"{doc}: {path}"
+
+
+def test_controller_pipeline_block_adds_to_the_shipped_experiment(tmp_path: Path) -> None:
+    """The README's controller YAML trains like ``configs/car_following.yaml`` (its learner,
+    its pairs per simulation), with the controller VUT added: not the code's defaults."""
+    from sumo_ayss.config import load_experiment
+    from sumo_ayss.config.pipeline import load_pipeline
+    from sumo_ayss.pipeline import plan_jobs
+
+    block = re.search(r"<!-- controller-pipeline.*?-->\s*```yaml\n(.*?)```", README, re.S)
+    assert block, "README.md has no controller-pipeline block"
+    path = tmp_path / "my_acc.yaml"
+    path.write_text(block.group(1))
+    jobs = plan_jobs(load_pipeline(path))
+    shipped = load_experiment(PROJECT_ROOT / "configs" / "car_following.yaml")
+    acc = [j for j in jobs if j.vut == "acc_tg2"]
+    assert len(acc) == 3
+    for job in acc:
+        assert job.experiment.env.vut_type.controller is not None
+        assert job.experiment.train == dataclasses.replace(shipped.train, progress_bar=False)
+        assert job.experiment.agent == shipped.agent
+    assert shipped.train.n_envs > 1  # the snippet alone would have given 1
+
+
+def test_readme_commands_exist_on_a_fresh_clone_and_write_only_ignored_folders() -> None:
+    """Console scripts live in .venv/bin (not on PATH after `make`); outputs go to runs/,
+    which git ignores."""
+    for tool in ("ray", "tensorboard", "sumo-ayss"):
+        for m in re.finditer(rf"(\S*){tool} (start|--logdir|\w+)", README):
+            if tool == "sumo-ayss" and m.group(1) == "":
+                continue  # "sumo-ayss <command>" named in prose, with .venv/bin/ given once
+            assert m.group(1).endswith(".venv/bin/") or m.group(1).startswith("'"), m.group(0)
+    ignored = (PROJECT_ROOT / ".gitignore").read_text().splitlines()
+    assert "runs/" in ignored
+    for out in re.findall(r"--out (\S+)", README):
+        assert out.startswith(("runs/", "DIR", "<")), f"--out {out}: not under runs/"
