@@ -22,7 +22,7 @@ pip="$work/venv/bin/pip"
 mkdir -p "$work/src"
 cp "$root/pyproject.toml" "$root/README.md" "$work/src/"
 (cd "$work/src" && mkdir sumo_ayss && touch sumo_ayss/__init__.py \
-  && "$pip" install --quiet . && "$pip" uninstall --quiet -y sumo_ayss \
+  && "$pip" install --quiet "./[ray]" && "$pip" uninstall --quiet -y sumo_ayss \
   && rm -rf sumo_ayss build ./*.egg-info)
 cp -r "$root/sumo_ayss" "$root/configs" "$root/networks" "$root/routes" "$root/examples" \
   "$work/src/"
@@ -35,6 +35,7 @@ cd "$work/src"
   --vut pi2 --seed 0 --total-timesteps 1200 --eval-every 600 --no-progress
 test -f "$work/out/car_following/pi2/seed_0/spcp.json"
 test -f "$work/src/examples/acc_controller.py"
+"$work/venv/bin/python" -c "import ray"  # the image has the ray extra
 
 hadolint=${HADOLINT:-$(command -v hadolint || true)}
 if [[ -z "$hadolint" && -x "$root/.venv/bin/hadolint" ]]; then
