@@ -369,7 +369,10 @@ def main(argv: Sequence[str] | None = None) -> None:
     from sumo_ayss.report.checks import input_problems
 
     parser = argparse.ArgumentParser(
-        prog=prog("python -m sumo_ayss.rank"), description=__doc__.splitlines()[0]
+        prog=prog("python -m sumo_ayss.rank"),
+        description=__doc__.splitlines()[0]
+        + " Default mode: cross-play (every SPCP of a case against every VUT, ranked by the "
+        "harm the pooled SPCPs bring about; lower = safer).",
     )
     parser.add_argument("config", type=Path, help="pipeline YAML listing the VUTs to rank")
     parser.add_argument("--workers", type=int, default=None)

@@ -104,3 +104,7 @@ def test_cli_help_names_cross_play_as_rank_default(capsys) -> None:
     text = capsys.readouterr().out
     line = next(x for x in text.splitlines() if x.strip().startswith("rank"))
     assert "safety index" not in line and "cross-play" in line
+    with pytest.raises(SystemExit):
+        cli_main(["rank", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "safety index" not in help_text and "Default mode: cross-play" in help_text

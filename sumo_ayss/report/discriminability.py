@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
+from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.cases import case_info
 from sumo_ayss.report import figstyle
 from sumo_ayss.report.blocks import Block, FigureBlock, Heading, Paragraph, Table
@@ -110,7 +111,7 @@ def discriminability_figure(
                 lw=1.2 + 2.8 * (len(names) - 1 - i) / max(1, len(names) - 1),
                 alpha=0.85,
                 color=colors.get(vut),
-                label=f"{vut} ({record['mean_response_mps2'][vut]:+.2f})",
+                label=f"{vut} ({fmt_num(record['mean_response_mps2'][vut])})",
             )
         ax_m.set_xlabel("headway h [m] (bin centre)")
         ax_m.set_ylabel("mean VUT acceleration [m/s²]")
@@ -241,7 +242,7 @@ def discriminability_blocks(
             "Mean one-step response per VUT",
             ("VUT", "mean acceleration [m/s²]", "collisions in the measured step(s)"),
             tuple(
-                (v, f"{a:+.3f}", str(collisions.get(v, "—")))
+                (v, fmt_num(a, 3), str(collisions.get(v, "—")))
                 for v, a in record["mean_response_mps2"].items()
             ),
             (False, True, True),

@@ -41,6 +41,8 @@ def test_blocks_from_a_record(tmp_path: Path) -> None:
     assert len(figs) == 1 and figs[0].path.is_file()
     table = next(b for b in blocks if isinstance(b, Table))
     assert table.rows[0][0] == "pi1 vs pi2" and table.rows[0][2] == "3.50"
+    responses = [b for b in blocks if isinstance(b, Table)][-1]
+    assert all(row[1].startswith("−") for row in responses.rows)  # the report's minus sign
     # One VUT: no section; no record: a paragraph saying how to make one.
     assert discriminability_blocks("car_following", ["pi1"], [case_dir], tmp_path) == []
     empty = discriminability_blocks("car_following", ["pi1", "pi2"], [tmp_path], tmp_path)
