@@ -1,7 +1,12 @@
 #!/usr/bin/env bash
-# Render a report HTML file to a PNG with headless Chromium (Debian package `chromium`).
+# Render a report HTML file (or one of its figures, as the browser shows it) to a PNG with
+# headless Chromium (Debian package `chromium`).
 #
 #   scripts/screenshot_report.sh REPORT.html OUT.png [WIDTHxHEIGHT]
+#   scripts/screenshot_report.sh REPORT_DIR/car_following_indicator_vs_headway.png OUT.png 1200x680
+#
+# docs/report_first_screen.png and docs/report_aggressiveness.png were made this way (see
+# docs/report_screenshots.md).
 #
 # Installs Chromium with apt-get when it is missing (needs root and Debian package access).
 # The page is rendered offline: the report is self-contained, and networking features of
