@@ -12,6 +12,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from sumo_ayss.analysis.case import analyse_case, ranking_line
+from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.report import write_report
 from sumo_ayss.report.crossplay_figure import crossplay_lines
 from sumo_ayss.report.episodes import load_crossplay
@@ -138,3 +139,16 @@ def test_wrapped_title_fits_its_figure(width_in: float) -> None:
         box = text.get_window_extent(canvas.get_renderer())
     assert box.width <= fig.bbox.width
     assert box.x0 >= 0 and box.x1 <= fig.bbox.width
+
+
+def test_paper_mode_leaderboard_reads_the_safety_index(tmp_path: Path) -> None:
+    from sumo_ayss.config.report import ReportOptions
+
+    runs = _runs(tmp_path, "car_following", ("pi1", "pi2"), range(3))
+    a = analyse_case("car_following", runs, ReportOptions(mode="paper", n_boot=300))
+    rows = leaderboard_rows(a)
+    assert a.ranking_mode == "paper"
+    assert [r.vut for r in rows] == [r.name for r in a.ranking]
+    assert rows[0].score.startswith(fmt_num(a.ranking[0].point)) and "m/s²" in rows[0].score
+    assert "Welch t, p" in rows[0].vs_next and rows[-1].vs_next == "—"
+    assert "safety index (higher = safer)" in leaderboard_text([a])
