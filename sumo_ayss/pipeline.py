@@ -234,8 +234,7 @@ def _run_locked(
     from sumo_ayss.atomic import atomic_write_json
 
     atomic_write_json(cfg.out / "pipeline.json", _relative_paths(to_dict(cfg), cfg.out))
-    crossplay = cfg.report.mode == "crossplay" and len(cfg.grid.vuts) >= 2
-    after = "cross-play and the report" if crossplay else "the report"
+    after = ", ".join(stages_after_grid(cfg))
     if backend == "ray":
         from sumo_ayss.ray_backend import run_grid_ray
 
@@ -266,6 +265,15 @@ def _run_locked(
     analyses = analyse_runs(runs, cfg.report)  # once per case: the report's and rank's
     report = write_report_for(runs, cfg.out / "report", analyses=analyses, options=cfg.report)
     return PipelineResult(statuses, report, runs, analyses)
+
+
+def stages_after_grid(cfg: PipelineConfig) -> list[str]:
+    """What runs after the grid's jobs, outside their ETA (named in it: no silent gap)."""
+    several = len(cfg.grid.vuts) >= 2
+    stages = ["discriminability"] if several else []
+    if several and cfg.report.mode == "crossplay":
+        stages.append("cross-play")
+    return [*stages, "the report"]
 
 
 def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> list[Path]:
@@ -331,6 +339,12 @@ def write_discriminability(cfg: PipelineConfig) -> None:
     from sumo_ayss.errors import AyssError
 
     for case in cfg.grid.cases:
+        logger.info(
+            "discriminability of %s: one-step responses of %d VUTs over the AYSS box "
+            "(seconds per VUT; skipped when up to date)",
+            case,
+            len(cfg.grid.vuts),
+        )
         try:
             env = discriminability.pipeline_env(cfg, case)
             discriminability.ensure(env, cfg.grid.vuts, cfg.out / case)

@@ -108,3 +108,30 @@ def test_cli_help_names_cross_play_as_rank_default(capsys) -> None:
         cli_main(["rank", "--help"])
     help_text = " ".join(capsys.readouterr().out.split())
     assert "safety index" not in help_text and "Default mode: cross-play" in help_text
+
+
+def test_eta_names_every_stage_after_the_grid() -> None:
+    import dataclasses
+
+    from sumo_ayss.pipeline import stages_after_grid
+
+    cfg = load_pipeline(DEMO)
+    assert stages_after_grid(cfg) == ["discriminability", "cross-play", "the report"]
+    exposure = dataclasses.replace(cfg, report=dataclasses.replace(cfg.report, mode="exposure"))
+    assert stages_after_grid(exposure) == ["discriminability", "the report"]
+    one = dataclasses.replace(cfg, grid=dataclasses.replace(cfg.grid, vuts=("pi1",)))
+    assert stages_after_grid(one) == ["the report"]
+
+
+def test_leaderboard_with_one_seed_says_there_is_no_test(tmp_path, monkeypatch) -> None:
+    from sumo_ayss.analysis.case import analyse_case
+    from sumo_ayss.config.report import ReportOptions
+    from sumo_ayss.report.leaderboard import leaderboard_rows
+    from sumo_ayss.report.load import load_run
+    from tests.report.test_report import make_run
+
+    runs = {v: [load_run(make_run(tmp_path, "car_following", v, 0))] for v in ("pi1", "pi2")}
+    a = analyse_case("car_following", runs, ReportOptions(mode="exposure", n_boot=100))
+    rows = leaderboard_rows(a)
+    assert rows[0].vs_next == f"no test against {rows[1].vut}: 1 vs 1 seed(s), a test needs 2"
+    assert rows[0].score.endswith("(1 seed: no interval)")

@@ -66,15 +66,10 @@ def leaderboard_rows(a: CaseAnalysis) -> list[LeaderRow]:
             c = r.vs_next
             p = f"{c.test}, p {fmt_p(c.p)}" if c is not None else ""
             score = f"{fmt_num(r.mean, 3)} ({seed_interval_text(r.lo, r.hi, r.n_seeds, 3)})"
-            rows.append(
-                LeaderRow(
-                    r.rank,
-                    r.name,
-                    score,
-                    crash_cell(outcomes.get(r.name)),
-                    _vs_next(c.significant if c else None, nxt, p),
-                )
-            )
+            verdict = _vs_next(c.significant if c else None, nxt, p)
+            if c is not None and c.test == "none":
+                verdict = f"no test against {nxt}: {c.n_a} vs {c.n_b} seed(s), a test needs 2"
+            rows.append(LeaderRow(r.rank, r.name, score, crash_cell(outcomes.get(r.name)), verdict))
         return rows
     pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
     for i, ranked in enumerate(a.ranking):
