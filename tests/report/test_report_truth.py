@@ -152,3 +152,49 @@ def test_paper_mode_leaderboard_reads_the_safety_index(tmp_path: Path) -> None:
     assert rows[0].score.startswith(fmt_num(a.ranking[0].point)) and "m/s²" in rows[0].score
     assert "Welch t, p" in rows[0].vs_next and rows[-1].vs_next == "—"
     assert "safety index (higher = safer)" in leaderboard_text([a])
+
+
+def test_the_first_aggressiveness_panel_carries_the_between_seed_spread(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Left panel (read first): every seed's bin mean lies inside its VUT's band; right
+    panel: the pooled view, named as such."""
+    from matplotlib.collections import PolyCollection
+    from matplotlib.colors import to_rgb
+
+    from sumo_ayss.report import figures
+
+    runs = _runs(tmp_path, "car_following", ("pi1", "pi2"), range(2))
+    drawn: list[Figure] = []
+    monkeypatch.setattr(figures, "save", lambda fig, path: drawn.append(fig) or path)
+    figures.indicator_figure(
+        runs,
+        {"pi1": "C0", "pi2": "C1"},
+        tmp_path / "fig.png",
+        edges=np.linspace(0.0, 5.0, 11),
+        axis_label="a [m/s²]",
+        title="t",
+    )
+    left, _, right, _ = drawn[0].axes
+    assert left.get_title().startswith("Primary, between seeds (what the verdict uses)")
+    assert "range of the 2 seeds" in left.get_title()
+    assert right.get_title().startswith("Secondary: all samples pooled")
+    assert "ignores the seed-to-seed spread" in right.get_title()
+    bands = {}
+    for poly in (c for c in left.collections if isinstance(c, PolyCollection)):
+        verts = np.concatenate([p.vertices for p in poly.get_paths()])
+        bands[tuple(poly.get_facecolor()[0][:3])] = verts
+    assert len(bands) == 2
+    checked = 0
+    for line in left.get_lines():
+        if " seed " not in str(line.get_label()):
+            continue
+        color = to_rgb(line.get_color())
+        verts = next(v for c, v in bands.items() if np.allclose(c, color))
+        for x, y in zip(*line.get_data(), strict=True):
+            if not np.isfinite(y):
+                continue
+            at = verts[np.isclose(verts[:, 0], x)][:, 1]
+            assert at.min() - 1e-9 <= y <= at.max() + 1e-9, (line.get_label(), x, y)
+            checked += 1
+    assert checked >= 20  # 2 VUTs x 2 seeds x 10 bins, all inside their band
