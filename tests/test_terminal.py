@@ -32,7 +32,8 @@ def test_rank_prints_the_leaderboard_of_each_case(tmp_path, monkeypatch, capsys)
     assert "crashes " in board and "/600" in board  # 3 seeds x 200 episodes pooled
     assert "against the known order: Kendall tau = 1.00" in out
     rows = [line for line in board.splitlines() if line.startswith("  ")]
-    assert len(rows) == 5 and all(len(line) <= 80 for line in rows), board
+    assert len(rows) == 6 and all(len(line) <= 80 for line in rows), board
+    assert "car_following: leaderboard (exposure mode), safest first\n" in out
 
 
 def test_budget_flags_enter_the_resolved_config_and_every_job(tmp_path: Path) -> None:

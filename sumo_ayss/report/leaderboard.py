@@ -112,16 +112,14 @@ def leaderboard_table(a: CaseAnalysis, level: float) -> Table | None:
 def leaderboard_text(analyses: Sequence[CaseAnalysis]) -> str:
     """Every case's leaderboard as plain text that fits 80 columns (VUT names permitting).
 
-    Each VUT takes two lines: rank, name, score and crash rate; then its verdict against
-    the next VUT, indented.
+    A case takes a title line and a line naming its score; each VUT two lines: rank, name,
+    score and crash rate; then its verdict against the next VUT, indented.
     """
     lines: list[str] = []
     for a in analyses:
         rows = leaderboard_rows(a)
-        lines.append(
-            f"{a.case}: leaderboard ({a.ranking_mode} mode), safest first; "
-            f"score = {SCORE_NAMES[a.ranking_mode]}"
-        )
+        lines.append(f"{a.case}: leaderboard ({a.ranking_mode} mode), safest first")
+        lines.append(f"  score: {SCORE_NAMES[a.ranking_mode]}")
         if not rows:
             lines.append(f"  no ranking: {a.headline}")
         width = max((len(r.vut) for r in rows), default=0)
