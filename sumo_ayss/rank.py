@@ -349,6 +349,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     import dataclasses
 
     from sumo_ayss.cli import prog
+    from sumo_ayss.config.budget import BUDGET_CHOICES, BUDGET_HELP
     from sumo_ayss.config.report import MODES
     from sumo_ayss.pipeline import (
         configure_logging,
@@ -369,6 +370,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument(
         "--seeds", type=int, nargs="+", default=None, help="replace grid.seeds (e.g. 100 101 102)"
     )
+    parser.add_argument("--budget", choices=BUDGET_CHOICES, default=None, help=BUDGET_HELP)
     parser.add_argument(
         "--mode",
         choices=list(MODES),
@@ -388,7 +390,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     console = configure_logging(not args.no_live)
     result = None
     try:
-        cfg = load_pipeline(args.config, workers=args.workers, out=args.out, seeds=args.seeds)
+        cfg = load_pipeline(
+            args.config, workers=args.workers, out=args.out, seeds=args.seeds, budget=args.budget
+        )
         if args.mode is not None:
             cfg = dataclasses.replace(cfg, report=dataclasses.replace(cfg.report, mode=args.mode))
         if args.no_run:
