@@ -45,9 +45,11 @@ def _children_cpu_s() -> float:
 
 
 def write_config(ladder: Path, budget: str, case: str, out: Path) -> Path:
-    """The ladder YAML with one case and the budget named explicitly."""
+    """The ladder YAML with one case and the budget named explicitly (its training budget,
+    candidate cadence and seeds are the budget's)."""
     cfg = yaml.safe_load(ladder.read_text())
     cfg["grid"]["cases"] = [case]
+    cfg["grid"].pop("seeds", None)  # the budget's seeds
     cfg["budget"] = budget
     for key in ("total_timesteps", "eval_every"):
         cfg.pop(key, None)
