@@ -207,7 +207,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     try:
         out = Path(args.out) if args.out is not None else None
         cfg = load_pipeline(args.config, out=out, seeds=args.seeds)
-        seeds = cfg.grid.seeds
+        seeds = cfg.seeds
         for case in cfg.grid.cases:
             dirs = case_runs(Path(cfg.out), case, cfg.grid.vuts, seeds)
             run_case(

@@ -26,11 +26,12 @@ This module plans the grid (each case's experiment parsed once), runs it and the
 
 Pipeline YAML (every key optional)::
 
-    grid: {cases: [car_following, cut_in], vuts: [pi1, pi2], seeds: [0, 1, 2]}
+    grid: {cases: [car_following, cut_in], vuts: [pi1, pi2], seeds: [0, 1, 2, 3]}  # budget
     experiments: {car_following: car_following.yaml, cut_in: cut_in.yaml}  # per case
     out: ../runs/paper          # relative to the YAML file
-    total_timesteps: null       # override every experiment's train.total_timesteps
-    eval_every: null            # override every experiment's train.eval_every
+    budget: verdict             # a named budget: verdict (default) | paper | null (config.budget)
+    total_timesteps: null       # override the budget's / every experiment's train.total_timesteps
+    eval_every: null            # override the budget's / every experiment's train.eval_every
     evaluate: {n_outcome: 200, n_ayss: 100000}  # n_ayss: shorthand for ayss.n_samples
     #   ayss: {h_m: [0, 5], seed: 4242, ...}   # Monte Carlo (sumo_ayss.config.AyssConfig)
     vuts: {}                    # extra VUTs (name: vehicle type) added to every experiment
@@ -54,6 +55,7 @@ from typing import TYPE_CHECKING, Any, Literal, NamedTuple
 
 from sumo_ayss.cli import prog
 from sumo_ayss.config import PipelineConfig, check_out_dir, load_experiment, load_pipeline, to_dict
+from sumo_ayss.config.budget import BUDGET_CHOICES, BUDGET_HELP
 from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.folder_lock import output_lock
 from sumo_ayss.grid_local import run_grid_local
@@ -128,7 +130,7 @@ def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
                     f"grid.vuts: {vut!r} is not a VUT of the {case} experiment"
                     f"{suggest(vut, exp.env.vuts)}; allowed: {sorted(exp.env.vuts)}"
                 )
-            for seed in cfg.grid.seeds:
+            for seed in cfg.seeds:
                 jobs.append(
                     JobSpec(
                         case=case,
@@ -357,7 +359,8 @@ def add_budget_flags(parser: argparse.ArgumentParser) -> None:
     budget without writing a YAML. They replace the config's values and are written into
     ``pipeline.json`` and every run's ``config.yaml`` like them."""
     group = parser.add_argument_group(
-        "budget (replace the config's; written into pipeline.json and each run's config.yaml)"
+        "budget overrides (replace the config's or the named --budget's values; written into "
+        "pipeline.json and each run's config.yaml)"
     )
     group.add_argument(
         "--total-timesteps", type=int, default=None, help="training transitions per run"
@@ -393,6 +396,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument(
         "--seeds", type=int, nargs="+", default=None, help="replace grid.seeds (e.g. 100 101 102)"
     )
+    parser.add_argument("--budget", choices=BUDGET_CHOICES, default=None, help=BUDGET_HELP)
     parser.add_argument("--backend", choices=["local", "ray"], default="local")
     parser.add_argument("--address", default=None, help="Ray cluster address (ray backend)")
     parser.add_argument(
@@ -410,6 +414,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             out=args.out,
             workers=args.workers,
             seeds=args.seeds,
+            budget=args.budget,
             **budget_overrides(args),
         )
         result = run_pipeline(

@@ -355,6 +355,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     import dataclasses
 
     from sumo_ayss.cli import prog
+    from sumo_ayss.config.budget import BUDGET_CHOICES, BUDGET_HELP
     from sumo_ayss.config.report import MODES
     from sumo_ayss.pipeline import (
         add_budget_flags,
@@ -380,6 +381,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument(
         "--seeds", type=int, nargs="+", default=None, help="replace grid.seeds (e.g. 100 101 102)"
     )
+    parser.add_argument("--budget", choices=BUDGET_CHOICES, default=None, help=BUDGET_HELP)
     parser.add_argument(
         "--mode",
         choices=list(MODES),
@@ -405,6 +407,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             workers=args.workers,
             out=args.out,
             seeds=args.seeds,
+            budget=args.budget,
             **budget_overrides(args),
         )
         if args.mode is not None:

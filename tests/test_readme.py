@@ -132,13 +132,21 @@ def test_controller_pipeline_block_adds_to_the_shipped_experiment(tmp_path: Path
     assert block, "README.md has no controller-pipeline block"
     path = tmp_path / "my_acc.yaml"
     path.write_text(block.group(1))
-    jobs = plan_jobs(load_pipeline(path))
+    cfg = load_pipeline(path)
+    jobs = plan_jobs(cfg)
     shipped = load_experiment(PROJECT_ROOT / "configs" / "car_following.yaml")
     acc = [j for j in jobs if j.vut == "acc_tg2"]
     assert len(acc) == 3
+    # The experiment's training settings, the pipeline's budget (transitions, cadence) aside.
+    expected = dataclasses.replace(
+        shipped.train,
+        progress_bar=False,
+        total_timesteps=cfg.total_timesteps or shipped.train.total_timesteps,
+        eval_every=cfg.eval_every or shipped.train.eval_every,
+    )
     for job in acc:
         assert job.experiment.env.vut_type.controller is not None
-        assert job.experiment.train == dataclasses.replace(shipped.train, progress_bar=False)
+        assert job.experiment.train == expected
         assert job.experiment.agent == shipped.agent
     assert shipped.train.n_envs > 1  # the snippet alone would have given 1
 

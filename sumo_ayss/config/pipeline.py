@@ -13,6 +13,7 @@ from typing import Any, ClassVar
 from sumo_ayss.cases import case_names
 from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config.ayss import AyssConfig
+from sumo_ayss.config.budget import BUDGETS, DEFAULT_BUDGET
 from sumo_ayss.config.env import PROJECT_ROOT, Case
 from sumo_ayss.config.mapping import build
 from sumo_ayss.config.report import ReportOptions
@@ -30,16 +31,21 @@ class GridConfig:
     cases: tuple[Case, ...] = field(default_factory=case_names)
     """Registered cases (:mod:`sumo_ayss.cases`); default: all of them."""
     vuts: tuple[str, ...] = ("pi1", "pi2")
-    seeds: tuple[int, ...] = (0, 1, 2)
+    seeds: tuple[int, ...] | None = None
+    """Training seeds, each run by every VUT; None (the default): the pipeline's budget
+    decides (seeds 0 .. n-1, :mod:`sumo_ayss.config.budget`; read them as
+    :attr:`PipelineConfig.seeds`)."""
 
     def __post_init__(self) -> None:
         for name in ("cases", "vuts", "seeds"):
             values = getattr(self, name)
+            if values is None:
+                continue  # seeds: the pipeline's budget decides
             require(len(values) > 0, f"grid.{name} must not be empty")
             require(len(set(values)) == len(values), f"grid.{name} has duplicates: {list(values)}")
         for i, case in enumerate(self.cases):
             check_choice(f"grid.cases[{i}]", case, case_names())
-        for seed in self.seeds:
+        for seed in self.seeds or ():
             check_seed(seed, "grid.seeds[]")
 
 
@@ -83,8 +89,14 @@ class PipelineConfig:
     experiments: Mapping[str, Path] = field(default_factory=_default_experiments)
     """Experiment YAML per case; default: ``configs/<case>.yaml`` of every registered case."""
     out: Path = Path("runs") / "paper"
+    budget: str | None = DEFAULT_BUDGET
+    """A named budget (:data:`~sumo_ayss.config.budget.BUDGETS`: ``verdict``, the default, or
+    ``paper``) that sets ``total_timesteps``, ``eval_every`` and ``grid.seeds`` where they are
+    not given; None: every experiment's ``train`` section as its file says."""
     total_timesteps: int | None = None
+    """Transitions per run for every experiment; None: the budget's (or the experiment's)."""
     eval_every: int | None = None
+    """Transitions between SPCP candidates; None: the budget's (or the experiment's)."""
     evaluate: EvaluateConfig = field(default_factory=EvaluateConfig)
     vuts: Mapping[str, VehicleType] = field(default_factory=dict)
     """Extra VUTs (catalog syntax, as in ``env.vuts``) added to every case's experiment, so
@@ -99,17 +111,29 @@ class PipelineConfig:
     retries: int = 1
 
     def __post_init__(self) -> None:
+        if self.budget is not None:
+            check_choice("budget", self.budget, BUDGETS)
+            b = BUDGETS[self.budget]
+            if self.total_timesteps is None:
+                object.__setattr__(self, "total_timesteps", b.total_timesteps)
+            if self.eval_every is None:
+                object.__setattr__(self, "eval_every", b.eval_every)
+        if self.grid.seeds is None:
+            n = BUDGETS[self.budget].seeds if self.budget is not None else 3
+            object.__setattr__(self, "grid", dataclasses.replace(self.grid, seeds=tuple(range(n))))
         for name in ("total_timesteps", "eval_every"):
             value = getattr(self, name)
             require(
                 value is None or (isinstance(value, int) and value >= 1),
-                f"{name} must be an integer >= 1 (or absent: the experiment's), got {value!r}",
+                f"{name} must be an integer >= 1 (or absent: the budget's or the experiment's), "
+                f"got {value!r}",
             )
         if self.total_timesteps is not None and self.eval_every is not None:
             require(
                 self.eval_every <= self.total_timesteps,
                 f"eval_every ({self.eval_every}) must be <= total_timesteps "
-                f"({self.total_timesteps}): a run needs at least one SPCP candidate",
+                f"({self.total_timesteps}): a run needs at least one SPCP candidate (a "
+                "smaller total_timesteps than the budget's needs a smaller eval_every too)",
             )
         require(self.workers >= 0, f"workers must be >= 0, got {self.workers}")
         require(self.retries >= 0, f"retries must be >= 0, got {self.retries}")
@@ -135,6 +159,12 @@ class PipelineConfig:
             )
 
     @property
+    def seeds(self) -> tuple[int, ...]:
+        """The grid's training seeds (given, or the budget's)."""
+        assert self.grid.seeds is not None  # resolved in __post_init__
+        return self.grid.seeds
+
+    @property
     def n_workers(self) -> int:
         return self.workers or os.cpu_count() or 1
 
@@ -142,18 +172,21 @@ class PipelineConfig:
 def load_pipeline(path: str | Path | None, **overrides: Any) -> PipelineConfig:
     """Pipeline YAML over defaults, then ``overrides`` (None values are ignored).
 
-    ``overrides`` are fields of :class:`PipelineConfig` and ``seeds`` (``grid.seeds``),
-    ``n_outcome`` (``evaluate.n_outcome``) and ``n_ayss`` (``evaluate.n_ayss``, which then
-    also sets ``evaluate.ayss.n_samples``). They enter the resolved configuration that the
-    pipeline writes (``pipeline.json``, each run's ``config.yaml``), so a run made with
-    command-line overrides is reproduced from its files.
+    ``budget`` replaces the YAML's budget before the budget fills the settings the YAML
+    leaves open; the other overrides replace resolved fields: fields of
+    :class:`PipelineConfig` and ``seeds`` (``grid.seeds``), ``n_outcome``
+    (``evaluate.n_outcome``) and ``n_ayss`` (``evaluate.n_ayss``, which then also sets
+    ``evaluate.ayss.n_samples``). They enter the resolved configuration that the pipeline
+    writes (``pipeline.json``, each run's ``config.yaml``), so a run made with command-line
+    overrides is reproduced from its files.
     """
-    if path is None:
-        cfg = PipelineConfig()
-    else:
-        path = Path(path)
-        cfg = build(PipelineConfig, read_yaml(path), "", path.resolve().parent)
     clean = {k: v for k, v in overrides.items() if v is not None}
+    data: dict[str, Any] = {} if path is None else dict(read_yaml(Path(path)) or {})
+    if "budget" in clean:
+        budget = clean.pop("budget")
+        data["budget"] = None if budget == "none" else budget
+    base = PROJECT_ROOT if path is None else Path(path).resolve().parent
+    cfg = build(PipelineConfig, data, "", base) if data else PipelineConfig()
     seeds = clean.pop("seeds", None)
     if seeds is not None:
         clean["grid"] = dataclasses.replace(cfg.grid, seeds=tuple(int(x) for x in seeds))

@@ -1,0 +1,469 @@
+"""The verdict's learning curve: how the cross-play ranking of a ladder depends on the budget.
+
+    python scripts/verdict_curve.py cells OUT STUDY [STUDY ...]     # roll out (resumable)
+    python scripts/verdict_curve.py curve OUT                      # rank per budget
+
+``cells``: for every run of the studies (one ladder; several studies of it are pooled, e.g.
+run A and run B with other seeds) and every budget B = 10k, 20k, ... up to the run's last
+candidate, the SPCP the run would have selected with a training budget of B transitions is
+the best of its candidates up to B (the run's selection criterion on its ``eval.csv``).
+Every distinct such candidate is driven against every VUT of the case exactly as the
+cross-play stage drives an opponent (:func:`sumo_ayss.scenarios.crossplay.run_crossplay`: a
+fresh single env, SUMO seed = the opponent's seed, the outcome stage's ``n`` scenarios of
+its seed). One row per episode goes to ``OUT/<case>/cells.csv`` (appended cell by cell, so a
+killed run continues where it stopped), with the CPU-seconds of each cell. At each run's
+final SPCP the episodes of its own VUT are checked against the run's ``outcome.csv``
+(the cross-play diagonal check): this script drives the vehicle the product drives.
+
+``curve``: for each budget B, each number of training seeds per VUT S (every subset of S of
+the pooled seeds) and each number of scenarios n (the first n), the cross-play ranking
+(:func:`sumo_ayss.analysis.crossplay.rank_crossplay`, the product's default: harm, paired
+t-test over seed blocks) against the known order: Kendall's τ, whether the ends differ
+significantly in the right direction, significant adjacent pairs. Writes
+``OUT/<case>/curve.csv`` (one row per (B, S, n, seed subset)) and ``OUT/summary.csv`` (per
+(case, B, S, n): share of subsets with τ = 1, with significant ends, with both; mean τ; the
+CPU-seconds of that protocol for the ladder).
+
+CPU-seconds of a protocol (V VUTs, S seeds, budget B, n scenarios): V·S jobs trained to B
+(seconds per 10k transitions with candidate evaluation: the median gap between consecutive
+candidates in the runs' ``job.log``, where each job had one core), their outcome stages
+(V·S·n episodes) and cross-play (V·V·S·n episodes), episodes at the CPU-seconds per episode
+measured here. The AYSS stage (not needed by the cross-play verdict) is left out.
+
+Pass ``--expected`` to override the study's known order (``order_check.json``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import itertools
+import json
+import math
+import re
+import statistics
+import sys
+import time
+from collections import defaultdict
+from collections.abc import Sequence
+from datetime import datetime
+from pathlib import Path
+
+import numpy as np
+
+from sumo_ayss.analysis.crossplay import crossplay_matrix, rank_crossplay
+from sumo_ayss.analysis.harm import episode_harm
+from sumo_ayss.analysis.seeds import kendall_tau
+from sumo_ayss.atomic import atomic_write_text
+from sumo_ayss.report.episodes import harm_scale_of
+
+CELL_COLUMNS = (
+    "vut",
+    "opponent_vut",
+    "opponent_seed",
+    "opponent_step",
+    "scenario",
+    "collided",
+    "near_miss_pay",
+    "episode_return",
+    "n_steps",
+    "final_headway_m",
+    "vut_mean_speed_mps",
+    "cell_cpu_s",
+)
+BUDGET_STEP = 10_000
+
+
+# ----------------------------------------------------------------------------- cells
+
+
+def _eval_rows(run_dir: Path) -> list[dict[str, float]]:
+    with (run_dir / "eval.csv").open() as f:
+        return [{k: float(v) for k, v in r.items() if k != "checkpoint"} for r in csv.DictReader(f)]
+
+
+def spcp_steps(run_dir: Path, criterion: str) -> dict[int, int]:
+    """Budget B -> step of the candidate the run selects among those at steps <= B."""
+    from sumo_ayss.selection import select_spcp
+
+    rows = _eval_rows(run_dir)
+    last = int(max(r["step"] for r in rows))
+    out = {}
+    for budget in range(BUDGET_STEP, last + 1, BUDGET_STEP):
+        prefix = [r for r in rows if r["step"] <= budget]
+        out[budget] = select_spcp(prefix, criterion).step
+    return out
+
+
+def _run_dirs(studies: Sequence[Path], case: str) -> list[Path]:
+    return sorted(d for s in studies for d in (s / case).glob("*/seed_*") if d.is_dir())
+
+
+def _done_cells(path: Path) -> set[tuple[str, str, int, int]]:
+    if not path.is_file():
+        return set()
+    with path.open() as f:
+        return {
+            (r["vut"], r["opponent_vut"], int(r["opponent_seed"]), int(r["opponent_step"]))
+            for r in csv.DictReader(f)
+        }
+
+
+def cells(out: Path, studies: Sequence[Path]) -> None:
+    """Roll out every (VUT, candidate SPCP) cell not yet in ``OUT/<case>/cells.csv``."""
+    from sumo_ayss.agents.weights import load_greedy_policy
+    from sumo_ayss.envs import make_env
+    from sumo_ayss.envs.odd import sample_initial_conditions
+    from sumo_ayss.evaluate import load_run
+    from sumo_ayss.run_folder import read_outcome_json
+    from sumo_ayss.scenarios.rollout import run_episodes
+
+    cases = sorted({p.name for s in studies for p in s.iterdir() if list(p.glob("*/seed_*"))})
+    for case in cases:
+        runs = [load_run(d) for d in _run_dirs(studies, case)]
+        settings = read_outcome_json(runs[0].run_dir / "outcome.json").settings
+        n, seed = int(settings["n"]), int(settings["seed"])
+        envs = {}
+        for r in runs:
+            envs.setdefault(r.config.env.vut, r.config.env)
+        folder = out / case
+        folder.mkdir(parents=True, exist_ok=True)
+        path = folder / "cells.csv"
+        done = _done_cells(path)
+        meta = {
+            "studies": [str(s) for s in studies],
+            "n": n,
+            "seed": seed,
+            "runs": {},
+        }
+        todo = []
+        for r in runs:
+            steps = spcp_steps(r.run_dir, r.config.train.selection)
+            meta["runs"][f"{r.config.env.vut}/{r.seed}"] = {
+                "run_dir": str(r.run_dir),
+                "spcp_by_budget": {str(b): s for b, s in steps.items()},
+                "sec_per_10k": _sec_per_10k(r.run_dir),
+            }
+            for step in sorted(set(steps.values())):
+                todo += [
+                    (v, r, step) for v in envs if (v, r.config.env.vut, r.seed, step) not in done
+                ]
+        atomic_write_text(folder / "cells.json", json.dumps(meta, indent=2) + "\n")
+        print(f"{case}: {len(done)} cells done, {len(todo)} to run", flush=True)
+        new = not path.is_file()
+        policies: dict[tuple[str, int, int], object] = {}
+        with path.open("a", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=CELL_COLUMNS, lineterminator="\n")
+            if new:
+                writer.writeheader()
+            for k, (vut, run, step) in enumerate(todo):
+                c0, t0 = time.process_time(), time.perf_counter()
+                env = make_env(envs[vut], sumo_seed=run.seed)
+                try:
+                    key = (run.config.env.vut, run.seed, step)
+                    if key not in policies:
+                        ckpt = run.run_dir / "checkpoints" / f"step_{step:09d}" / "model.zip"
+                        policies = {
+                            key: load_greedy_policy(
+                                ckpt,
+                                run.config.agent,
+                                env.observation_space,  # type: ignore[arg-type]
+                                env.action_space,  # type: ignore[arg-type]
+                            )
+                        }
+                    scenarios = sample_initial_conditions(envs[vut].odd, n, seed)
+                    episodes = run_episodes(env, policies[key], scenarios)  # type: ignore[arg-type]
+                finally:
+                    env.close()
+                cpu = time.process_time() - c0
+                for j, e in enumerate(episodes):
+                    writer.writerow(
+                        {
+                            "vut": vut,
+                            "opponent_vut": run.config.env.vut,
+                            "opponent_seed": run.seed,
+                            "opponent_step": step,
+                            "scenario": j,
+                            "collided": int(e.collided),
+                            "near_miss_pay": repr(e.near_miss_pay),
+                            "episode_return": repr(e.episode_return),
+                            "n_steps": e.n_steps,
+                            "final_headway_m": repr(e.final_headway_m),
+                            "vut_mean_speed_mps": repr(e.vut_mean_speed_mps),
+                            "cell_cpu_s": f"{cpu:.4f}",
+                        }
+                    )
+                f.flush()
+                if vut == run.config.env.vut and step == run.spcp_step:
+                    _check_diagonal(run.run_dir, episodes)
+                    print(f"{run.run_dir}: own SPCP reproduces outcome.csv", flush=True)
+                print(
+                    f"{case} [{k + 1}/{len(todo)}] {vut} vs {run.config.env.vut}/{run.seed}"
+                    f"@{step}: {sum(e.collided for e in episodes)}/{n} crashes "
+                    f"({time.perf_counter() - t0:.2f} s)",
+                    flush=True,
+                )
+
+
+def _check_diagonal(run_dir: Path, episodes: Sequence[object]) -> None:
+    """The run's own SPCP against its own VUT must reproduce ``outcome.csv`` exactly."""
+    with (run_dir / "outcome.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    for row, e in zip(rows, episodes, strict=True):
+        same = float(row["episode_return"]) == e.episode_return and int(  # type: ignore[attr-defined]
+            row["collided"] in ("1", "True", "true")
+        ) == int(e.collided)  # type: ignore[attr-defined]
+        if not same:
+            sys.exit(f"{run_dir}: a rollout differs from outcome.csv: not the product's vehicle")
+
+
+_STAMP = re.compile(r"^(\S+ \S+) \S+ INFO: candidate (\d+):")
+
+
+def _sec_per_10k(run_dir: Path) -> float:
+    """Median seconds between consecutive candidates in ``job.log`` (per 10k transitions)."""
+    stamps = []
+    for line in (run_dir / "job.log").read_text().splitlines():
+        m = _STAMP.match(line)
+        if m:
+            t = datetime.strptime(m.group(1), "%Y-%m-%d %H:%M:%S,%f").timestamp()
+            stamps.append((int(m.group(2)), t))
+    gaps = [
+        (t1 - t0) * BUDGET_STEP / (s1 - s0)
+        for (s0, t0), (s1, t1) in itertools.pairwise(stamps)
+        if s1 > s0 and t1 > t0
+    ]
+    return statistics.median(gaps) if gaps else math.nan
+
+
+# ----------------------------------------------------------------------------- curve
+
+
+def _load_cells(folder: Path) -> tuple[dict, dict, float]:
+    """(vut, opp_vut, opp_seed, step) -> (harm, collided) arrays; meta; CPU-s per episode."""
+    from sumo_ayss.evaluate import load_run
+
+    meta = json.loads((folder / "cells.json").read_text())
+    first = next(iter(meta["runs"].values()))["run_dir"]
+    cfg = load_run(first).config
+    scale = harm_scale_of(
+        cfg.env.reward,
+        {"episode_s": cfg.env.episode_s, "decision_period_s": cfg.env.decision_period_s},
+    )
+    data: dict = defaultdict(list)
+    cpu: dict = {}
+    with (folder / "cells.csv").open() as f:
+        for r in csv.DictReader(f):
+            key = (r["vut"], r["opponent_vut"], int(r["opponent_seed"]), int(r["opponent_step"]))
+            data[key].append((int(r["scenario"]), float(r["near_miss_pay"]), int(r["collided"])))
+            cpu[key] = float(r["cell_cpu_s"])
+    cells_out = {}
+    for key, rows in data.items():
+        rows.sort()
+        pay = np.array([p for _, p, _ in rows])
+        crash = np.array([c for _, _, c in rows], dtype=bool)
+        cells_out[key] = (episode_harm(pay, crash, scale.max_episode_pay), crash)
+    n = meta["n"]
+    per_episode = float(np.median([c / n for c in cpu.values()]))
+    return cells_out, meta, per_episode
+
+
+def curve(out: Path, expected: Sequence[str] | None, max_subsets: int) -> None:
+    summary = []
+    for folder in sorted(p for p in out.iterdir() if (p / "cells.csv").is_file()):
+        case = folder.name
+        data, meta, cpu_episode = _load_cells(folder)
+        runs = meta["runs"]
+        vuts = sorted({k.split("/")[0] for k in runs})
+        order = list(expected) if expected else _expected(meta)
+        seeds_of = {
+            v: sorted(int(k.split("/")[1]) for k in runs if k.split("/")[0] == v) for v in vuts
+        }
+        seeds = seeds_of[vuts[0]]
+        budgets = sorted({int(b) for r in runs.values() for b in r["spcp_by_budget"]})
+        sec10k = float(np.nanmedian([r["sec_per_10k"] for r in runs.values()]))
+        n_max = meta["n"]
+        ns = [x for x in (50, 100, 200) if x <= n_max] or [n_max]
+        rows = []
+        for budget in budgets:
+            for s_count in range(2, len(seeds) + 1):
+                subsets = list(itertools.combinations(seeds, s_count))[:max_subsets]
+                for n in ns:
+                    cpu = _protocol_cpu(len(vuts), s_count, budget, n, sec10k, cpu_episode)
+                    results = []
+                    for subset in subsets:
+                        res = _rank(data, runs, vuts, subset, budget, n, order)
+                        results.append(res)
+                        rows.append(
+                            {
+                                "budget": budget,
+                                "seeds_per_vut": s_count,
+                                "n": n,
+                                "subset": " ".join(map(str, subset)),
+                                **res,
+                                "cpu_s": round(cpu),
+                            }
+                        )
+                    ok = [r["tau"] == 1.0 for r in results]
+                    ends = [r["ends_significant"] for r in results]
+                    summary.append(
+                        {
+                            "case": case,
+                            "budget": budget,
+                            "seeds_per_vut": s_count,
+                            "n": n,
+                            "subsets": len(results),
+                            "share_tau1": round(float(np.mean(ok)), 3),
+                            "share_ends": round(float(np.mean(ends)), 3),
+                            "share_both": round(
+                                float(np.mean([a and b for a, b in zip(ok, ends, strict=True)])), 3
+                            ),
+                            "mean_tau": round(float(np.mean([r["tau"] for r in results])), 3),
+                            "median_ends_p": float(np.median([r["ends_p"] for r in results])),
+                            "mean_sig_adjacent": round(
+                                float(np.mean([r["significant_adjacent"] for r in results])), 2
+                            ),
+                            "cpu_s": round(cpu),
+                        }
+                    )
+        _write_csv(folder / "curve.csv", rows)
+        print(
+            f"{case}: {len(rows)} rankings; {cpu_episode * 1000:.2f} ms CPU per episode, "
+            f"{sec10k:.1f} s per 10k transitions"
+        )
+    _write_csv(out / "summary.csv", summary)
+    print(f"wrote {out / 'summary.csv'}")
+
+
+def _expected(meta: dict) -> list[str]:
+    study = Path(meta["studies"][0])
+    return list(json.loads((study / "order_check.json").read_text())["expected"])
+
+
+def _protocol_cpu(v: int, s: int, budget: int, n: int, sec10k: float, cpu_episode: float) -> float:
+    train = v * s * sec10k * budget / BUDGET_STEP
+    episodes = v * s * n + v * v * s * n
+    return train + episodes * cpu_episode
+
+
+def _rank(data, runs, vuts, subset, budget, n, order) -> dict:
+    cols: dict[str, list] = {k: [] for k in ("vut", "ov", "os", "harm", "crash")}
+    for opp in vuts:
+        for s in subset:
+            step = runs[f"{opp}/{s}"]["spcp_by_budget"].get(str(budget))
+            if step is None:
+                step = max(runs[f"{opp}/{s}"]["spcp_by_budget"].values())
+            for v in vuts:
+                harm, crash = data[(v, opp, s, step)]
+                cols["vut"] += [v] * n
+                cols["ov"] += [opp] * n
+                cols["os"] += [s] * n
+                cols["harm"] += harm[:n].tolist()
+                cols["crash"] += crash[:n].tolist()
+    m = crossplay_matrix(cols["vut"], cols["ov"], cols["os"], cols["harm"], cols["crash"])
+    ranked, pairs = rank_crossplay(m)
+    got = [r.name for r in ranked]
+    ends = next(c for c in pairs if {c.name_a, c.name_b} == {order[0], order[-1]})
+    return {
+        "order": " > ".join(got),
+        "tau": kendall_tau(got, order),
+        "ends_significant": bool(ends.significant and ends.name_a == order[0]),
+        "ends_p": ends.p,
+        "significant_adjacent": sum(bool(r.significant_vs_next) for r in ranked[:-1]),
+    }
+
+
+def _write_csv(path: Path, rows: list[dict]) -> None:
+    import io
+
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
+    w.writeheader()
+    w.writerows(rows)
+    atomic_write_text(path, buf.getvalue())
+
+
+def figure(outs: Sequence[Path], dest: Path, seeds: int, n: int) -> None:
+    """One figure per case: share of correct rankings and median ends p against the budget
+    (top axis: CPU-seconds of the protocol), one line per ladder, S seeds and n scenarios."""
+    import matplotlib as mpl
+
+    mpl.use("Agg")
+    from matplotlib.figure import Figure
+
+    by_case: dict[str, dict[str, list[dict]]] = defaultdict(dict)
+    for out in outs:
+        with (out / "summary.csv").open() as f:
+            for r in csv.DictReader(f):
+                if int(r["seeds_per_vut"]) == seeds and int(r["n"]) == n:
+                    by_case[r["case"]].setdefault(out.name, []).append(r)
+    for case, ladders in sorted(by_case.items()):
+        fig = Figure(figsize=(7.5, 6.2), layout="constrained")
+        top, bottom = fig.subplots(2, 1, sharex=True)
+        for k, (ladder, rows) in enumerate(sorted(ladders.items())):
+            b = [int(r["budget"]) / 1000 for r in rows]
+            top.plot(
+                b,
+                [float(r["share_tau1"]) for r in rows],
+                "o-",
+                color=f"C{k}",
+                label=f"{ladder}: τ = 1",
+            )
+            top.plot(
+                b,
+                [float(r["share_both"]) for r in rows],
+                "s--",
+                color=f"C{k}",
+                alpha=0.7,
+                label=f"{ladder}: τ = 1 and ends significant",
+            )
+            bottom.plot(
+                b, [float(r["median_ends_p"]) for r in rows], "o-", color=f"C{k}", label=ladder
+            )
+        top.set_ylabel(f"share of the {seeds}-seed subsets")
+        top.set_ylim(-0.05, 1.05)
+        top.grid(alpha=0.3)
+        top.legend(fontsize=7, loc="lower right")
+        top.set_title(
+            f"{case}: cross-play verdict against the training budget "
+            f"({seeds} seeds per VUT, {n} scenarios)"
+        )
+        bottom.set_yscale("log")
+        bottom.axhline(0.05, color="k", lw=0.8, ls=":")
+        bottom.set_ylabel("ends p (median over subsets)")
+        bottom.set_xlabel(
+            "training budget per run [thousand transitions] (SPCP = best candidate up to it)"
+        )
+        bottom.grid(alpha=0.3)
+        bottom.legend(fontsize=7)
+        path = dest / f"verdict_curve_{case}.png"
+        fig.savefig(path, dpi=100)
+        print(f"wrote {path}")
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="cmd", required=True)
+    c = sub.add_parser("cells")
+    c.add_argument("out", type=Path)
+    c.add_argument("studies", type=Path, nargs="+")
+    k = sub.add_parser("curve")
+    k.add_argument("out", type=Path)
+    k.add_argument("--expected", nargs="+", default=None)
+    k.add_argument("--max-subsets", type=int, default=20)
+    g = sub.add_parser("figure")
+    g.add_argument("dest", type=Path)
+    g.add_argument("outs", type=Path, nargs="+")
+    g.add_argument("--seeds", type=int, default=3)
+    g.add_argument("--n", type=int, default=200)
+    a = p.parse_args(argv)
+    if a.cmd == "figure":
+        figure(a.outs, a.dest, a.seeds, a.n)
+    elif a.cmd == "cells":
+        cells(a.out, a.studies)
+    else:
+        curve(a.out, a.expected, a.max_subsets)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,100 @@
+"""Named budgets (config.budget): what a pipeline trains when its YAML names one, or none."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+from sumo_ayss.config import load_pipeline
+from sumo_ayss.config.budget import BUDGETS, DEFAULT_BUDGET
+from sumo_ayss.errors import ConfigError
+from sumo_ayss.paths import PROJECT_ROOT
+from sumo_ayss.pipeline import plan_jobs
+
+
+def _yaml(tmp_path: Path, **data: object) -> Path:
+    path = tmp_path / "p.yaml"
+    base = {"grid": {"cases": ["cut_in"], "vuts": ["pi1"]}, "out": "out"}
+    path.write_text(yaml.safe_dump(base | data))
+    return path
+
+
+def _trained(path: Path, **overrides: object) -> tuple[set[int], set[int], tuple[int, ...]]:
+    cfg = load_pipeline(path, **overrides)
+    jobs = plan_jobs(cfg)
+    return (
+        {j.experiment.train.total_timesteps for j in jobs},
+        {j.experiment.train.eval_every for j in jobs},
+        tuple(sorted({j.seed for j in jobs})),
+    )
+
+
+def test_a_pipeline_that_names_no_budget_trains_the_default_one(tmp_path: Path) -> None:
+    b = BUDGETS[DEFAULT_BUDGET]
+    total, every, seeds = _trained(_yaml(tmp_path))
+    assert (total, every, seeds) == ({b.total_timesteps}, {b.eval_every}, tuple(range(b.seeds)))
+    assert DEFAULT_BUDGET == "verdict" and b.total_timesteps < BUDGETS["paper"].total_timesteps
+
+
+def test_the_paper_budget_is_the_papers_protocol(tmp_path: Path) -> None:
+    assert _trained(_yaml(tmp_path, budget="paper")) == ({100_000}, {10_000}, (0, 1, 2))
+
+
+def test_given_settings_win_over_the_budget(tmp_path: Path) -> None:
+    path = _yaml(tmp_path, budget="paper", total_timesteps=3000, eval_every=1500)
+    data = yaml.safe_load(path.read_text())
+    data["grid"]["seeds"] = [7]
+    path.write_text(yaml.safe_dump(data))
+    assert _trained(path) == ({3000}, {1500}, (7,))
+
+
+def test_no_budget_keeps_each_experiments_train_section(tmp_path: Path) -> None:
+    exp = yaml.safe_load((PROJECT_ROOT / "configs/cut_in.yaml").read_text())["train"]
+    total, every, seeds = _trained(_yaml(tmp_path, budget=None))
+    assert (total, every, seeds) == ({exp["total_timesteps"]}, {exp["eval_every"]}, (0, 1, 2))
+
+
+def test_the_command_line_budget_replaces_the_yamls(tmp_path: Path) -> None:
+    path = _yaml(tmp_path, budget="paper")
+    b = BUDGETS["verdict"]
+    assert _trained(path, budget="verdict")[0] == {b.total_timesteps}
+    assert _trained(path, budget="none")[0] == {100_000}  # configs/cut_in.yaml's own
+
+
+def test_an_unknown_budget_is_refused_with_the_allowed_names(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match=r"budget.*paper.*verdict|budget.*verdict.*paper"):
+        load_pipeline(_yaml(tmp_path, budget="fast"))
+
+
+def test_an_empty_seed_list_is_still_refused(tmp_path: Path) -> None:
+    path = _yaml(tmp_path)
+    data = yaml.safe_load(path.read_text())
+    data["grid"]["seeds"] = []
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(ConfigError, match=r"grid\.seeds must not be empty"):
+        load_pipeline(path)
+
+
+@pytest.mark.parametrize(
+    "config",
+    [
+        "paper.yaml",
+        "paper_fidelity.yaml",
+        "ladders/braking.yaml",
+        "ladders/time_headway.yaml",
+        "ladders/min_gap.yaml",
+        "ladders/acc_time_gap.yaml",
+        "ladders/reaction.yaml",
+        "fidelity_ablation/sumo_vut.yaml",
+        "fidelity_ablation/clipped_pov.yaml",
+    ],
+)
+def test_committed_studies_still_train_what_they_ran(config: str) -> None:
+    """Their results were made at 100,000 transitions with a candidate every 10,000 and
+    three seeds; the default budget must not change what rerunning them does."""
+    path = PROJECT_ROOT / "configs" / config
+    total, every, seeds = _trained(path)
+    assert (total, every, len(seeds)) == ({100_000}, {10_000}, 3)
+    assert seeds == tuple(sorted(yaml.safe_load(path.read_text())["grid"]["seeds"]))
