@@ -113,3 +113,11 @@ def test_the_schema_check_can_fail(ci_run: Path, tmp_path: Path) -> None:
     doc = etree.parse(str(result.xosc))
     doc.getroot().remove(doc.getroot().find("FileHeader"))
     assert not schema().validate(doc)
+
+
+def test_an_ayss_sample_is_one_decision(ci_run: Path, tmp_path: Path) -> None:
+    result = export_xosc(ci_run, tmp_path / "a", ayss_row=0, policy=cut_in_policy)
+    assert schema().validate(etree.parse(str(result.xosc)))
+    assert result.info["decisions"] == 1 and result.info["reproduces_row"] == {"action": True}
+    t, _, _ = _trajectory(ET.parse(result.xosc).getroot(), "pov")
+    assert t == [0.0, 0.2]

@@ -16,8 +16,10 @@ regulation that cite it: esmini's R157 controller
 (``esmini/esmini``, ``EnvironmentSimulator/Modules/Controllers/ControllerALKS_R157SM.cpp``,
 written with IDIADA: "TTCLaneIntrusion > vrel / (2 x 6 ms^2) + 0.35s" and "front wheel has
 moved 0.3 meter inside own vehicle's lane") and the European Commission JRC's
-``ec-jrc/JRC-FSM`` (``utility/models.py``, model "Reg157", "Reg 157 5.2.5.2":
-``ttc > dv / (2 · 6) + 0.25 + 0.1``). What is applied:
+``ec-jrc/JRC-FSM`` (``utility/models.py``, model "Reg157", citing "Reg 157 5.2.5.2": TTC >
+dv / (2 · Reg157_max_deceleration) + Reg157_rt, with ``Reg157_max_deceleration = 6`` and
+``Reg157_rt = 0.35`` in ``utility/vehicle.py``; one version of its check adds a further
+0.1 s margin, which is not applied here). What is applied:
 
 * the intrusion point is the POV's body side 0.3 m inside the VUT's lane (the body side
   stands in for the outside of the front tyre, which our rectangles do not model);

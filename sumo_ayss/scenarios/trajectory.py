@@ -11,8 +11,13 @@ lateral positions and speeds and the boundary of the VUT's lane
 lane's centre line (lateral position 0, no lateral speed).
 
 Sample ``k`` is the state after ``k`` decisions, at ``k · decision_period_s`` (0 = the
-reset). Body widths come from the vehicle types, SUMO's default 1.8 m where a type gives
-none (SUMO's vType ``width`` default for passenger cars; a test checks it against SUMO).
+reset). With several SUMO steps per decision (``sim.step_length_s`` below the decision
+period) a collision ends its decision early, at a SUMO step the infos do not name: the last
+sample's time is then the decision's end, up to one decision late (the default, one SUMO
+step per decision, is exact).
+
+Body widths come from the vehicle types, SUMO's default 1.8 m where a type gives none
+(SUMO's vType ``width`` default for passenger cars; a test checks it against SUMO).
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.rank import analyse
 from sumo_ayss.report import write_report
 from sumo_ayss.report.measures import MEASURES_CSV, write_measures
-from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, Table, read_table, write_table
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA, Table, read_table, write_table
 from tests.report.test_report import FAST, make_crossplay, make_run
 
 
@@ -69,3 +69,19 @@ def test_measures_csv(tmp_path: Path) -> None:
     # nothing recorded: no file
     bare = _study(tmp_path / "bare", measures=False)
     assert write_measures(tmp_path / "bare", analyse(sorted(bare.glob("*/*/seed_*")), FAST)) is None
+
+
+def test_without_cross_play_the_pool_is_each_vuts_own_spcps(tmp_path: Path) -> None:
+    root = tmp_path / "runs"
+    for vut in ("pi1", "pi2"):
+        for seed in range(3):
+            run = make_run(root, "car_following", vut, seed)
+            path = run / "outcome.csv"
+            t = read_table(path, OUTCOME_SCHEMA)
+            cols = {c: t[c] for c in OUTCOME_SCHEMA.names}
+            cols["min_thw_s"] = np.full(len(t), 1.5 if vut == "pi2" else 0.5)
+            write_table(path, Table(OUTCOME_SCHEMA, cols))
+    md = (write_report([root], options=FAST).parent / "summary.md").read_text(encoding="utf-8")
+    section = md.split("### (j) Surrogate safety measures")[1]
+    assert "Every episode of the own SPCPs pool" in section and "training seed resampled" in section
+    assert "| min time headway | higher = safer | pi2 > pi1 |" in section
