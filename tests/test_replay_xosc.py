@@ -4,6 +4,8 @@ recorded episode (real SUMO; the run folders are evaluated with scripted policie
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 import xml.etree.ElementTree as ET
 from importlib.resources import files
 from pathlib import Path
@@ -121,3 +123,28 @@ def test_an_ayss_sample_is_one_decision(ci_run: Path, tmp_path: Path) -> None:
     assert result.info["decisions"] == 1 and result.info["reproduces_row"] == {"action": True}
     t, _, _ = _trajectory(ET.parse(result.xosc).getroot(), "pov")
     assert t == [0.0, 0.2]
+
+
+def test_asams_checker_finds_no_issue(ci_run: Path, tmp_path: Path) -> None:
+    """ASAM's OpenSCENARIO XML checker (schema, references, data types...): every check
+    completes without an issue."""
+    result = export_xosc(ci_run, tmp_path / "x", outcome_row=0, policy=cut_in_policy)
+    report = tmp_path / "report.xqar"
+    config = tmp_path / "qc.xml"
+    config.write_text(
+        '<?xml version="1.0" encoding="UTF-8"?>\n<Config>\n'
+        f'  <Param name="InputFile" value="{result.xosc}"/>\n'
+        '  <CheckerBundle application="xoscBundle">\n'
+        f'    <Param name="resultFile" value="{report}"/>\n'
+        "  </CheckerBundle>\n</Config>\n"
+    )
+    subprocess.run(
+        [sys.executable, "-m", "qc_openscenario", "-c", str(config)],
+        check=True,
+        capture_output=True,
+        timeout=120,
+    )
+    checkers = list(ET.parse(report).getroot().iter("Checker"))
+    assert len(checkers) > 10  # the schema check and the reference and data-type checks
+    assert {c.get("status") for c in checkers} == {"completed"}
+    assert [i.get("description") for c in checkers for i in c.iter("Issue")] == []
