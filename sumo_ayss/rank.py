@@ -416,6 +416,9 @@ def main(argv: Sequence[str] | None = None) -> None:
         sys.exit(130)
     checks = order_checks(analyses, cfg.expected_order)
     _, md = write_ranking(ranking_rows(analyses), cfg.out, checks, cfg.expected_order)
+    from sumo_ayss.report.measures import write_measures
+
+    write_measures(cfg.out, analyses)  # measures.csv: the safety measures (issue 27)
     print(md.read_text())
     if result is None:  # --no-run
         from sumo_ayss.report.checks import trust_warnings
