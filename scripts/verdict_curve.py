@@ -55,6 +55,7 @@ from sumo_ayss.analysis.crossplay import crossplay_matrix, rank_crossplay
 from sumo_ayss.analysis.harm import episode_harm
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.atomic import atomic_write_text
+from sumo_ayss.paths import PROJECT_ROOT, portable_path
 from sumo_ayss.report.episodes import harm_scale_of
 
 CELL_COLUMNS = (
@@ -131,7 +132,7 @@ def cells(out: Path, studies: Sequence[Path]) -> None:
         path = folder / "cells.csv"
         done = _done_cells(path)
         meta = {
-            "studies": [str(s) for s in studies],
+            "studies": [portable_path(s) for s in studies],
             "n": n,
             "seed": seed,
             "runs": {},
@@ -140,7 +141,7 @@ def cells(out: Path, studies: Sequence[Path]) -> None:
         for r in runs:
             steps = spcp_steps(r.run_dir, r.config.train.selection)
             meta["runs"][f"{r.config.env.vut}/{r.seed}"] = {
-                "run_dir": str(r.run_dir),
+                "run_dir": portable_path(r.run_dir),
                 "spcp_by_budget": {str(b): s for b, s in steps.items()},
                 "sec_per_10k": _sec_per_10k(r.run_dir),
             }
@@ -244,7 +245,7 @@ def _load_cells(folder: Path) -> tuple[dict, dict, float]:
     from sumo_ayss.evaluate import load_run
 
     meta = json.loads((folder / "cells.json").read_text())
-    first = next(iter(meta["runs"].values()))["run_dir"]
+    first = PROJECT_ROOT / next(iter(meta["runs"].values()))["run_dir"]
     cfg = load_run(first).config
     scale = harm_scale_of(
         cfg.env.reward,
@@ -336,7 +337,7 @@ def curve(out: Path, expected: Sequence[str] | None, max_subsets: int) -> None:
 
 
 def _expected(meta: dict) -> list[str]:
-    study = Path(meta["studies"][0])
+    study = PROJECT_ROOT / meta["studies"][0]
     return list(json.loads((study / "order_check.json").read_text())["expected"])
 
 
@@ -383,59 +384,58 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-def figure(outs: Sequence[Path], dest: Path, seeds: int, n: int) -> None:
-    """One figure per case: share of correct rankings and median ends p against the budget
-    (top axis: CPU-seconds of the protocol), one line per ladder, S seeds and n scenarios."""
+def figure(outs: Sequence[Path], dest: Path, seeds: Sequence[int], n: int) -> None:
+    """One figure per case, against the budget (top axis: the CPU-seconds of a 3-VUT
+    ladder's protocol at the first seed count): the share of seed subsets whose ranking has
+    τ = 1 and significant ends, and the median ends p; one colour per ladder, one line style
+    per number of seeds per VUT, ``n`` scenarios."""
     import matplotlib as mpl
 
     mpl.use("Agg")
     from matplotlib.figure import Figure
 
-    by_case: dict[str, dict[str, list[dict]]] = defaultdict(dict)
+    by_case: dict[str, dict[tuple[str, int], list[dict]]] = defaultdict(dict)
     for out in outs:
         with (out / "summary.csv").open() as f:
             for r in csv.DictReader(f):
-                if int(r["seeds_per_vut"]) == seeds and int(r["n"]) == n:
-                    by_case[r["case"]].setdefault(out.name, []).append(r)
-    for case, ladders in sorted(by_case.items()):
-        fig = Figure(figsize=(7.5, 6.2), layout="constrained")
+                s = int(r["seeds_per_vut"])
+                if s in seeds and int(r["n"]) == n:
+                    by_case[r["case"]].setdefault((out.name, s), []).append(r)
+    styles = ["o-", "s--", "^:"]
+    for case, lines in sorted(by_case.items()):
+        fig = Figure(figsize=(8.0, 6.6), layout="constrained")
         top, bottom = fig.subplots(2, 1, sharex=True)
-        for k, (ladder, rows) in enumerate(sorted(ladders.items())):
+        ladders = sorted({ladder for ladder, _ in lines})
+        for (ladder, s), rows in sorted(lines.items()):
+            colour = f"C{ladders.index(ladder)}"
+            style = styles[list(seeds).index(s) % len(styles)]
             b = [int(r["budget"]) / 1000 for r in rows]
-            top.plot(
-                b,
-                [float(r["share_tau1"]) for r in rows],
-                "o-",
-                color=f"C{k}",
-                label=f"{ladder}: τ = 1",
-            )
-            top.plot(
-                b,
-                [float(r["share_both"]) for r in rows],
-                "s--",
-                color=f"C{k}",
-                alpha=0.7,
-                label=f"{ladder}: τ = 1 and ends significant",
-            )
-            bottom.plot(
-                b, [float(r["median_ends_p"]) for r in rows], "o-", color=f"C{k}", label=ladder
-            )
-        top.set_ylabel(f"share of the {seeds}-seed subsets")
+            label = f"{ladder}, {s} seeds"
+            top.plot(b, [float(r["share_both"]) for r in rows], style, color=colour, label=label)
+            p = [max(float(r["median_ends_p"]), 1e-5) for r in rows]
+            bottom.plot(b, p, style, color=colour, label=label)
+        ref = next(rows for (_, s), rows in sorted(lines.items()) if s == seeds[0])
+        xs = np.array([int(r["budget"]) / 1000 for r in ref])
+        ys = np.array([float(r["cpu_s"]) for r in ref])
+        slope, icpt = np.polyfit(xs, ys, 1)
+        axis = top.secondary_xaxis(
+            "top",
+            functions=(
+                lambda x, a=icpt, b=slope: a + b * x,
+                lambda y, a=icpt, b=slope: (y - a) / b,
+            ),
+        )
+        axis.set_xlabel(f"CPU-seconds of the whole protocol ({ref[0]['seeds_per_vut']} seeds)")
+        top.set_ylabel("share of seed subsets with\nτ = 1 and significant ends")
         top.set_ylim(-0.05, 1.05)
         top.grid(alpha=0.3)
-        top.legend(fontsize=7, loc="lower right")
-        top.set_title(
-            f"{case}: cross-play verdict against the training budget "
-            f"({seeds} seeds per VUT, {n} scenarios)"
-        )
+        top.legend(fontsize=7, loc="lower right", ncol=2)
+        top.set_title(f"{case}: the cross-play verdict against the training budget ({n} scenarios)")
         bottom.set_yscale("log")
         bottom.axhline(0.05, color="k", lw=0.8, ls=":")
-        bottom.set_ylabel("ends p (median over subsets)")
-        bottom.set_xlabel(
-            "training budget per run [thousand transitions] (SPCP = best candidate up to it)"
-        )
+        bottom.set_ylabel("ends p, median over subsets")
+        bottom.set_xlabel("training budget per run [thousand transitions]")
         bottom.grid(alpha=0.3)
-        bottom.legend(fontsize=7)
         path = dest / f"verdict_curve_{case}.png"
         fig.savefig(path, dpi=100)
         print(f"wrote {path}")
@@ -454,7 +454,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     g = sub.add_parser("figure")
     g.add_argument("dest", type=Path)
     g.add_argument("outs", type=Path, nargs="+")
-    g.add_argument("--seeds", type=int, default=3)
+    g.add_argument("--seeds", type=int, nargs="+", default=[3, 4])
     g.add_argument("--n", type=int, default=200)
     a = p.parse_args(argv)
     if a.cmd == "figure":

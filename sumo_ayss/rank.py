@@ -433,6 +433,9 @@ def main(argv: Sequence[str] | None = None) -> None:
         sys.exit(130)
     checks = order_checks(analyses, cfg.expected_order)
     csv_path, md = write_ranking(ranking_rows(analyses), cfg.out, checks, cfg.expected_order)
+    from sumo_ayss.report.measures import write_measures
+
+    write_measures(cfg.out, analyses)  # measures.csv: the safety measures (issue 27)
     from sumo_ayss.report.leaderboard import leaderboard_text
 
     print(leaderboard_text(analyses))

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
+from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.catalog import BUILTIN_VUTS
 from sumo_ayss.config import RewardConfig, to_dict
 from sumo_ayss.errors import CheckpointError, TableError
@@ -168,6 +169,7 @@ def _outcome_table() -> Table:
             "n_steps": [25, 7],
             "near_miss_pay": [12.5, 9.0],
             "vut_mean_speed_mps": [21.5, 0.5],
+            **{name: [1.25, 0.5] for name in MEASURE_NAMES},
         },
     )
 
@@ -288,6 +290,7 @@ def test_crossplay_files_of_a_case_folder_round_trip(tmp_path: Path) -> None:
             "n_steps": np.array([7, 4], dtype=np.int64),
             "near_miss_pay": [1.5, 12.5],
             "vut_mean_speed_mps": [20.0, 19.25],
+            **{name: [0.5, np.nan] for name in MEASURE_NAMES},
         },
     )
     write_table(folder.crossplay_csv, table)

@@ -207,6 +207,11 @@ class CutInEnv(PairEnv):
         self._target_mps = ic.pov_speed_mps
         self._lc_started = self._lc_ignored = False
         info.update(self._lane_info(self._k))
+        # The boundary of the VUT's lane that the POV crosses to cut in (safety measures).
+        side = 1.0 if POV_LANE > VUT_LANE else -1.0
+        info["vut_lane_edge_y_m"] = self._pair.lane_centre_y_m(
+            VUT_LANE
+        ) + side * 0.5 * self._pair.lane_width_m(VUT_LANE)
         return values, info
 
     # ------------------------------------------------------------------ case hooks

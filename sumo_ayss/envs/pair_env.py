@@ -328,6 +328,7 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
             "ttc_s": time_to_collision_s(k.headway_m, k.vut_speed_mps, k.pov_speed_mps),
             "sumo_seed": self.sumo_seed,
             "initial_condition": ic,
+            **self._positions_info(k),
         }
         return self._observation_values(k), info
 
@@ -393,9 +394,21 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
             "reward_adversarial": r_a,
             "reward_collision": -1.0 if collided else 0.0,
             "sumo_seed": self.sumo_seed,
+            **self._positions_info(k),
             **extra,
         }
         return self._observation_values(k), reward, terminated, truncated, info
+
+    @staticmethod
+    def _positions_info(k: PairKinematics) -> dict[str, float]:
+        """Front-bumper lane positions [m] and speeds [m/s] of both vehicles, for the
+        episode's trajectory (:mod:`sumo_ayss.scenarios.trajectory`)."""
+        return {
+            "pov_pos_m": k.pov_pos_m,
+            "vut_pos_m": k.vut_pos_m,
+            "pov_speed_mps": k.pov_speed_mps,
+            "vut_speed_mps": k.vut_speed_mps,
+        }
 
     def join_shared(self, pair: VehiclePair, sumo_seed: int) -> None:
         """Become a member of a vec env: drive ``pair`` in a simulation the env does not own.

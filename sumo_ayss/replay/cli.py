@@ -26,7 +26,8 @@ __all__ = ["main"]
 def _export_main(argv: Sequence[str]) -> int:
     parser = argparse.ArgumentParser(
         prog=prog("python -m sumo_ayss.replay") + " export",
-        description="Write an AYSS sample or an outcome episode of a run as SUMO files.",
+        description="Write an AYSS sample or an outcome episode of a run as SUMO files "
+        "(or, with --format xosc, as OpenSCENARIO + OpenDRIVE).",
     )
     parser.add_argument("run_dir", type=Path, help="run folder (config.yaml, spcp.zip, tables)")
     which = parser.add_mutually_exclusive_group(required=True)
@@ -44,7 +45,30 @@ def _export_main(argv: Sequence[str]) -> int:
         default=None,
         help="SPCP decisions to record (default: 1 for AYSS, the whole episode for outcome)",
     )
+    parser.add_argument(
+        "--format",
+        choices=("sumo", "xosc"),
+        default="sumo",
+        help="sumo: SUMO files that replay in sumo-gui (default); xosc: ASAM OpenSCENARIO 1.2 "
+        "with its OpenDRIVE road",
+    )
     args = parser.parse_args(argv)
+    if args.format == "xosc":
+        from sumo_ayss.replay.xosc import export_xosc
+
+        x = export_xosc(
+            args.run_dir,
+            args.out,
+            ayss_row=args.ayss_row,
+            outcome_row=args.outcome_row,
+            decisions=args.decisions,
+            trust_controller=args.trust_controller,
+        )
+        print(
+            f"wrote {x.xosc} and {x.xodr}: {x.info['decisions']} decision(s), collision "
+            f"{x.info['collided']}, reproduces the row: {x.info['reproduces_row']}"
+        )
+        return 0
     result = export_scenario(
         args.run_dir,
         args.out,

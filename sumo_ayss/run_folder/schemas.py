@@ -17,6 +17,7 @@ Written and read with :func:`~sumo_ayss.run_folder.table.write_table` /
 from __future__ import annotations
 
 from sumo_ayss.cases import CAR_FOLLOWING, CUT_IN, indicator_columns
+from sumo_ayss.run_folder.measure_columns import EPISODE_MEASURE_COLUMNS
 from sumo_ayss.run_folder.table import Column, TableSchema
 
 __all__ = [
@@ -79,6 +80,7 @@ OUTCOME_SCHEMA = TableSchema(
         ),
         Column("n_steps", "int", "-", "decisions taken (25 for a full 5 s episode)"),
         *EPISODE_HARM_COLUMNS,
+        *EPISODE_MEASURE_COLUMNS,
     ),
 )
 
@@ -171,5 +173,6 @@ CROSSPLAY_SCHEMA = TableSchema(
         ),
         Column("n_steps", "int", "-", "decisions in the episode"),
         *EPISODE_HARM_COLUMNS,
+        *EPISODE_MEASURE_COLUMNS,
     ),
 )

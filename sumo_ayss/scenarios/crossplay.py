@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
@@ -133,6 +134,7 @@ def run_crossplay(
                         "n_steps": e.n_steps,
                         "near_miss_pay": e.near_miss_pay,
                         "vut_mean_speed_mps": e.vut_mean_speed_mps,
+                        **e.measure_row(),
                     }
                 )
             if progress is not None:
@@ -153,6 +155,7 @@ DIAGONAL_COLUMNS = (
     "n_steps",
     "near_miss_pay",
     "vut_mean_speed_mps",
+    *MEASURE_NAMES,
 )
 
 

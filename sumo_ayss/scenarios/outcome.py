@@ -37,7 +37,7 @@ from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.run_folder import OUTCOME_SCHEMA, Table
-from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, run_episode
+from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, measure_columns, run_episode
 
 __all__ = [
     "DEFAULT_OUTCOME_N",
@@ -187,6 +187,7 @@ def outcome_table(
             "n_steps": np.array([e.n_steps for e in episodes], dtype=np.int64),
             "near_miss_pay": [e.near_miss_pay for e in episodes],
             "vut_mean_speed_mps": [e.vut_mean_speed_mps for e in episodes],
+            **measure_columns(episodes),
         },
     )
 

@@ -7,16 +7,19 @@ any callable from a batch of observations ``(N, obs_dim)`` to actions ``(N,)``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
+from sumo_ayss.analysis.safety_measures import MEASURE_NAMES, EpisodeMeasures
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
+from sumo_ayss.scenarios.trajectory import measures_of
 
 Policy = Callable[[npt.NDArray[np.float32]], npt.NDArray[np.integer]]
 
@@ -34,6 +37,9 @@ class EpisodeResult:
         near_miss_pay: Sum of ``alpha_A·R_A`` over the episode: the return without the
             collision term (a collision step pays no R_A).
         vut_mean_speed_mps: Mean of the VUT's speed at the end of each decision [m/s].
+        measures: The episode's surrogate safety measures (:func:`run_episode` records
+            them; ``None`` where the episode was not recorded, e.g. training's vec-env
+            evaluation).
     """
 
     episode_return: float
@@ -43,6 +49,14 @@ class EpisodeResult:
     lane_changed: bool
     near_miss_pay: float = math.nan
     vut_mean_speed_mps: float = math.nan
+    # Not part of equality: the same episode tabulated from a vec env has no trajectory.
+    measures: EpisodeMeasures | None = field(default=None, compare=False)
+
+    def measure_row(self) -> dict[str, float]:
+        """The measures as table columns (NaN throughout when not recorded)."""
+        if self.measures is None:
+            return dict.fromkeys(MEASURE_NAMES, math.nan)
+        return self.measures.as_row()
 
 
 @dataclass(frozen=True)
@@ -65,10 +79,12 @@ def run_episode(env: PairEnv, policy: Policy, ic: InitialCondition) -> EpisodeRe
 
     Uses ``env.unwrapped`` and ``reset(options={"initial_condition": ic})``, so the env's RNG
     is not consumed. ``policy`` is called on a batch of one observation, shape ``(1, d)``.
+    The episode's trajectory is recorded and reduced to its safety measures
+    (:mod:`sumo_ayss.scenarios.trajectory`).
     """
     base = env.unwrapped
     assert isinstance(base, PairEnv)
-    obs, _ = base.reset(options={"initial_condition": ic})
+    obs, reset_info = base.reset(options={"initial_condition": ic})
     rewards: list[float] = []
     infos: list[dict[str, Any]] = []
     while True:
@@ -78,7 +94,8 @@ def run_episode(env: PairEnv, policy: Policy, ic: InitialCondition) -> EpisodeRe
         infos.append(info)
         if terminated or truncated:
             break
-    return episode_result(rewards, infos)
+    result = episode_result(rewards, infos)
+    return dataclasses.replace(result, measures=measures_of(base.config, reset_info, infos))
 
 
 def episode_result(rewards: Sequence[float], infos: Sequence[Mapping[str, Any]]) -> EpisodeResult:
@@ -105,6 +122,12 @@ def episode_result(rewards: Sequence[float], infos: Sequence[Mapping[str, Any]])
         near_miss_pay=pay,
         vut_mean_speed_mps=speed_sum / len(rewards),
     )
+
+
+def measure_columns(episodes: Sequence[EpisodeResult]) -> dict[str, list[float]]:
+    """The measure columns of a table of ``episodes``: column name -> one value each."""
+    rows = [e.measure_row() for e in episodes]
+    return {name: [r[name] for r in rows] for name in MEASURE_NAMES}
 
 
 def run_episodes(

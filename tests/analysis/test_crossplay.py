@@ -26,6 +26,7 @@ def _table(returns: np.ndarray, seeds=(0, 1, 2), n_scen: int = 2):
     """
     vut, ov, os_, ret, col = [], [], [], [], []
     opps = [(v, s) for v in VUTS[: returns.shape[0]] for s in seeds]
+    assert returns.shape[1] == len(opps), "one column per (VUT, seed) opponent"
     for i in range(returns.shape[0]):
         for j, (o, s) in enumerate(opps):
             for k in range(n_scen):  # +-0.5 around the cell mean
@@ -108,14 +109,16 @@ def test_known_ladder_is_recovered():
     assert ends / n_rep > 0.95
 
 
+@pytest.mark.parametrize("seeds", [3, 4])  # the paper budget's and the verdict budget's
 @pytest.mark.parametrize("blocks", ["seed", "opponent"])
-def test_false_positive_rate_is_at_most_nominal(blocks):
+def test_false_positive_rate_is_at_most_nominal(blocks, seeds):
     """No true difference, independent opponents: both block units call a difference in at
     most 5 % of replicates (plus Monte Carlo error); the tests are exact here."""
     rng = np.random.default_rng(5)
     n_rep, hits = 2000, 0
     for _ in range(n_rep):
-        m = crossplay_matrix(*_table(_null_or_ladder(rng, [0.0, 0.0], seed_sd=1.0)))
+        null = _null_or_ladder(rng, [0.0, 0.0], seeds=seeds, seed_sd=1.0)
+        m = crossplay_matrix(*_table(null, range(seeds)))
         a, b = m.scores(blocks)
         hits += compare_seeds(a, b).significant
     rate, se = hits / n_rep, math.sqrt(0.05 * 0.95 / n_rep)
@@ -123,7 +126,8 @@ def test_false_positive_rate_is_at_most_nominal(blocks):
     assert rate >= 0.05 - 3 * se, rate
 
 
-def test_seed_blocks_hold_when_a_seeds_opponents_are_correlated():
+@pytest.mark.parametrize("seeds", [3, 4])
+def test_seed_blocks_hold_when_a_seeds_opponents_are_correlated(seeds):
     """When a seed moves the VUT difference for all its opponents alike, opponents are not
     independent: per-opponent blocks then call far more than 5 % of nulls, seed blocks do
     not. This is why seeds are the default block."""
@@ -132,7 +136,10 @@ def test_seed_blocks_hold_when_a_seeds_opponents_are_correlated():
     hits = {"seed": 0, "opponent": 0}
     for _ in range(n_rep):
         m = crossplay_matrix(
-            *_table(_null_or_ladder(rng, [0.0, 0.0], seeds=3, seed_diff_sd=0.5, noise=0.1))
+            *_table(
+                _null_or_ladder(rng, [0.0, 0.0], seeds=seeds, seed_diff_sd=0.5, noise=0.1),
+                range(seeds),
+            )
         )
         for blocks in hits:
             a, b = m.scores(blocks)

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from sumo_ayss.analysis.ranking import POV_ACCELERATION, SafetyIndex
+from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.catalog import BUILTIN_VUTS
 from sumo_ayss.config import RewardConfig, to_dict
 from sumo_ayss.report import (
@@ -153,6 +154,7 @@ def _outcome_table(summary: OutcomeSummary, rng: np.random.Generator) -> Table:
             "n_steps": np.full(n, 25),
             "near_miss_pay": pay,
             "vut_mean_speed_mps": np.full(n, 20.0),
+            **{name: np.full(n, np.nan) for name in MEASURE_NAMES},
         },
     )
 

@@ -20,6 +20,7 @@ from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragr
 from sumo_ayss.report.discriminability import discriminability_blocks
 from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.crossplay import crossplay_blocks
+from sumo_ayss.report.sections.measures import measures_blocks
 from sumo_ayss.report.sections.outcome import exposure_blocks, outcome_blocks, premise_blocks
 from sumo_ayss.report.sections.paper import paper_blocks
 
@@ -47,6 +48,7 @@ def case_blocks(
     case_dirs = list(dict.fromkeys(r.path.parent.parent for rs in a.runs.values() for r in rs))
     blocks += discriminability_blocks(case, list(a.runs), case_dirs, out_dir, colors)
     blocks += crossplay_blocks(a, colors, out_dir, options)
+    blocks += measures_blocks(a, colors, out_dir, options)
     return blocks
 
 

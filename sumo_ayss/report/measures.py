@@ -1,0 +1,234 @@
+"""Safety measures of a case's opponent pool: loading, and ``measures.csv`` (issue 27).
+
+The pool is the case's cross-play table where there is one (every opponent SPCP against
+every VUT: the bootstrap's unit is the opponent), else each VUT's own SPCPs' outcome
+tables (the unit is the training seed). Files written before the measure columns hold NaN
+there: the pool is then reported as "not recorded" (rerun the outcome stage, or
+``scripts/add_measures.py``, and cross-play).
+
+``<out>/measures.csv`` (written by ``rank`` beside ``ranking.csv``): one row per (case,
+measure, VUT) — the median with its interval, the 10th and 90th percentiles, the share of
+infinite values, the VUT's rank by that measure alone, its rank in the primary ranking and
+Kendall's τ between the two orders — and per VUT the R157 cut-in share
+(:mod:`sumo_ayss.analysis.r157`) as measure ``r157_handled_share``.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from sumo_ayss.analysis.case import CaseAnalysis
+from sumo_ayss.analysis.measure_ranking import (
+    MEASURES,
+    MeasureRanking,
+    R157Row,
+    measure_rankings,
+    r157_rows,
+)
+from sumo_ayss.errors import AyssError
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA, RunFolder, read_table
+
+__all__ = ["MEASURES_CSV", "CaseMeasures", "case_measures", "write_measures"]
+
+MEASURES_CSV = "measures.csv"
+
+COLUMNS = [
+    "case",
+    "pool",
+    "measure",
+    "unit",
+    "higher_is_safer",
+    "vut",
+    "rank",
+    "median",
+    "lo",
+    "hi",
+    "p10",
+    "p90",
+    "share_inf",
+    "n",
+    "n_total",
+    "primary_mode",
+    "primary_rank",
+    "tau_vs_primary",
+]
+
+
+@dataclass(frozen=True)
+class CaseMeasures:
+    """A case's measures under its pool.
+
+    Attributes:
+        case: The case.
+        pool: ``"cross-play"`` or ``"own SPCPs"``.
+        vuts: The VUTs, in the primary order where there is one.
+        primary_mode: The mode of the primary ranking (``crossplay``/``exposure``).
+        primary_order: The primary ranking, safest first.
+        rankings: One per measure (:func:`~sumo_ayss.analysis.measure_ranking.
+            measure_rankings`).
+        r157: The R157 cut-in share per VUT (cut-in only, else empty).
+        values: ``{measure column: {vut: finite values}}`` for the figure.
+    """
+
+    case: str
+    pool: str
+    vuts: tuple[str, ...]
+    primary_mode: str
+    primary_order: tuple[str, ...]
+    rankings: tuple[MeasureRanking, ...]
+    r157: tuple[R157Row, ...]
+    values: dict[str, dict[str, np.ndarray]]
+
+
+def _primary(a: CaseAnalysis) -> tuple[str, tuple[str, ...]]:
+    if a.crossplay_rows:
+        return "crossplay", tuple(r.name for r in a.crossplay_rows)
+    return "exposure", tuple(r.name for r in a.exposure_rows)
+
+
+def _pool_columns(a: CaseAnalysis) -> tuple[str, dict[str, np.ndarray]] | None:
+    """The pool's episodes: vut, group (the bootstrap unit), collided and the measures."""
+    if a.crossplay_path is not None and a.crossplay_path.is_file():
+        t = read_table(a.crossplay_path, CROSSPLAY_SCHEMA)
+        group = np.char.add(
+            np.char.add(t["opponent_vut"].astype(str), "/"), t["opponent_seed"].astype(str)
+        )
+        cols = {"vut": t["vut"].astype(str), "group": group, "collided": t["collided"]}
+        return "cross-play", {**cols, **{n: t[n] for n in _measure_columns()}}
+    parts: list[dict[str, np.ndarray]] = []
+    for vut, runs in a.runs.items():
+        for run in runs:
+            path = RunFolder(run.path).outcome_csv
+            if not path.is_file():
+                continue
+            t = read_table(path, OUTCOME_SCHEMA)
+            n = len(t)
+            part = {"vut": np.full(n, vut), "group": np.full(n, str(run.seed))}
+            part["collided"] = t["collided"]
+            parts.append({**part, **{c: t[c] for c in _measure_columns()}})
+    if not parts:
+        return None
+    return "own SPCPs", {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
+def _measure_columns() -> list[str]:
+    return [m.column for m in MEASURES] + ["r157_must_avoid"]
+
+
+def case_measures(a: CaseAnalysis, *, level: float = 0.95) -> CaseMeasures | str:
+    """The measures of case ``a``, or one sentence saying why there are none."""
+    try:
+        found = _pool_columns(a)
+    except AyssError as e:
+        return f"the episode tables could not be read ({e})"
+    if found is None:
+        return "no outcome or cross-play table was found"
+    pool, cols = found
+    if all(np.isnan(cols[m.column]).all() for m in MEASURES):
+        return (
+            f"the {pool} tables were written before the measures were recorded (rerun the "
+            "outcome stage and cross-play, or scripts/add_measures.py)"
+        )
+    mode, order = _primary(a)
+    vuts = tuple(dict.fromkeys([*order, *a.runs]))
+    rankings = measure_rankings(
+        cols["vut"],
+        cols["group"],
+        {m.column: cols[m.column] for m in MEASURES},
+        vuts=vuts,
+        primary_order=order,
+        level=level,
+    )
+    r157: tuple[R157Row, ...] = ()
+    if not np.isnan(cols["r157_must_avoid"]).all():
+        r157 = tuple(
+            r157_rows(
+                cols["vut"], cols["r157_must_avoid"], cols["collided"], vuts=vuts, level=level
+            )
+        )
+    values = {
+        m.column: {
+            v: cols[m.column][(cols["vut"] == v) & np.isfinite(cols[m.column])] for v in vuts
+        }
+        for m in MEASURES
+    }
+    return CaseMeasures(a.case, pool, vuts, mode, order, tuple(rankings), r157, values)
+
+
+def _rows(m: CaseMeasures) -> list[dict[str, object]]:
+    rows: list[dict[str, object]] = []
+    primary = {v: i + 1 for i, v in enumerate(m.primary_order)}
+    for r in m.rankings:
+        for s in r.rows:
+            rows.append(
+                {
+                    "case": m.case,
+                    "pool": m.pool,
+                    "measure": r.spec.column,
+                    "unit": r.spec.unit,
+                    "higher_is_safer": r.spec.higher_is_safer,
+                    "vut": s.vut,
+                    "rank": s.rank or "",
+                    "median": s.median,
+                    "lo": s.lo,
+                    "hi": s.hi,
+                    "p10": s.p10,
+                    "p90": s.p90,
+                    "share_inf": s.share_inf,
+                    "n": s.n,
+                    "n_total": s.n_total,
+                    "primary_mode": m.primary_mode,
+                    "primary_rank": primary.get(s.vut, ""),
+                    "tau_vs_primary": r.tau,
+                }
+            )
+    for q in m.r157:
+        rows.append(
+            {
+                "case": m.case,
+                "pool": m.pool,
+                "measure": "r157_handled_share",
+                "unit": "-",
+                "higher_is_safer": True,
+                "vut": q.vut,
+                "rank": "",
+                "median": q.share,
+                "lo": q.lo,
+                "hi": q.hi,
+                "p10": math.nan,
+                "p90": math.nan,
+                "share_inf": math.nan,
+                "n": q.n_required,
+                "n_total": q.n_intrusions,
+                "primary_mode": m.primary_mode,
+                "primary_rank": primary.get(q.vut, ""),
+                "tau_vs_primary": math.nan,
+            }
+        )
+    return rows
+
+
+def write_measures(out: Path, analyses: Sequence[CaseAnalysis]) -> Path | None:
+    """``<out>/measures.csv`` of every case with recorded measures (atomic); None if none."""
+    from sumo_ayss.atomic import atomic_write_text
+
+    rows: list[dict[str, object]] = []
+    for a in analyses:
+        m = case_measures(a)
+        if isinstance(m, CaseMeasures):
+            rows += _rows(m)
+    if not rows:
+        return None
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    atomic_write_text(out / MEASURES_CSV, buf.getvalue())
+    return out / MEASURES_CSV

@@ -1,0 +1,88 @@
+"""Record an episode's trajectory from the env's step infos, for its safety measures.
+
+:func:`~sumo_ayss.scenarios.rollout.run_episode` hands the reset's info and every step's
+info to :func:`trajectory_from_infos`, which builds the
+:class:`~sumo_ayss.analysis.safety_measures.PairTrajectory` that
+:func:`~sumo_ayss.analysis.safety_measures.episode_measures` reduces to one row of
+measures. Nothing extra is read from SUMO: the env's infos already carry the front-bumper
+positions and speeds (:class:`~sumo_ayss.envs.pair_env.PairEnv`), and in cut-in the
+lateral positions and speeds and the boundary of the VUT's lane
+(:class:`~sumo_ayss.envs.cut_in.CutInEnv`). In car-following both vehicles stay on the one
+lane's centre line (lateral position 0, no lateral speed).
+
+Sample ``k`` is the state after ``k`` decisions, at ``k · decision_period_s`` (0 = the
+reset). With several SUMO steps per decision (``sim.step_length_s`` below the decision
+period) a collision ends its decision early, at a SUMO step the infos do not name: the last
+sample's time is then the decision's end, up to one decision late (the default, one SUMO
+step per decision, is exact).
+
+Body widths come from the vehicle types, SUMO's default 1.8 m where a type gives none
+(SUMO's vType ``width`` default for passenger cars; a test checks it against SUMO).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from sumo_ayss.analysis.safety_measures import EpisodeMeasures, PairTrajectory, episode_measures
+from sumo_ayss.catalog import VehicleType
+from sumo_ayss.config import EnvConfig
+
+__all__ = ["SUMO_DEFAULT_WIDTH_M", "body_width_m", "measures_of", "trajectory_from_infos"]
+
+#: SUMO's default vType width [m] (passenger class), used when a type gives none.
+SUMO_DEFAULT_WIDTH_M = 1.8
+
+
+def body_width_m(vtype: VehicleType) -> float:
+    """The body width [m] SUMO gives a vehicle of ``vtype``."""
+    return float(vtype.params.get("width", SUMO_DEFAULT_WIDTH_M))
+
+
+def trajectory_from_infos(
+    config: EnvConfig, reset_info: Mapping[str, Any], infos: Sequence[Mapping[str, Any]]
+) -> PairTrajectory:
+    """The trajectory of one episode of an env of ``config``.
+
+    Args:
+        config: The env's configuration (decision period, vehicle types).
+        reset_info: The info returned by ``reset``.
+        infos: The info of each step, in order.
+    """
+    samples = [reset_info, *infos]
+    n = len(samples)
+
+    def col(key: str, default: float | None = None) -> np.ndarray:
+        if default is not None and key not in reset_info:
+            return np.full(n, default)
+        return np.array([float(s[key]) for s in samples])
+
+    edge = reset_info.get("vut_lane_edge_y_m")
+    return PairTrajectory(
+        time_s=np.arange(n, dtype=np.float64) * config.decision_period_s,
+        vut_x_m=col("vut_pos_m"),
+        pov_x_m=col("pov_pos_m"),
+        vut_y_m=col("vut_y_m", 0.0),
+        pov_y_m=col("pov_y_m", 0.0),
+        vut_speed_mps=col("vut_speed_mps"),
+        pov_speed_mps=col("pov_speed_mps"),
+        vut_lat_speed_mps=col("vut_lateral_speed_mps", 0.0),
+        pov_lat_speed_mps=col("pov_lateral_speed_mps", 0.0),
+        collided=bool(infos[-1]["collision"]) if infos else False,
+        vut_length_m=config.vut_type.length_m,
+        pov_length_m=config.pov.length_m,
+        vut_width_m=body_width_m(config.vut_type),
+        pov_width_m=body_width_m(config.pov),
+        vut_lane_edge_y_m=None if edge is None else float(edge),
+    )
+
+
+def measures_of(
+    config: EnvConfig, reset_info: Mapping[str, Any], infos: Sequence[Mapping[str, Any]]
+) -> EpisodeMeasures:
+    """The safety measures of one episode (:func:`trajectory_from_infos`, then
+    :func:`~sumo_ayss.analysis.safety_measures.episode_measures`)."""
+    return episode_measures(trajectory_from_infos(config, reset_info, infos))
