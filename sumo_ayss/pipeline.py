@@ -189,11 +189,12 @@ def final_messages(result: PipelineResult) -> list[str]:
     ]
     done = [s for s in result.statuses if s.state == "done"]
     if done:
-        from sumo_ayss.report.checks import trust_warnings
+        from sumo_ayss.report.checks import fewest_seeds, trust_warnings
 
         training = {r.path: r.training for r in result.runs}
         runs = [(s.spec.name, training[Path(s.spec.run_dir).resolve()]) for s in done]
-        lines += [f"WARNING: {w}" for w in trust_warnings(runs)]
+        seeds = fewest_seeds((s.spec.case, s.spec.vut) for s in done)
+        lines += [f"WARNING: {w}" for w in trust_warnings(runs, seeds)]
     if result.report is not None:
         lines.append(f"report: {result.report}")
     return lines

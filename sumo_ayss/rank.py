@@ -447,10 +447,11 @@ def main(argv: Sequence[str] | None = None) -> None:
         )
     print(f"ranking (every mode): {md} and {csv_path.name}")
     if result is None:  # --no-run
-        from sumo_ayss.report.checks import trust_warnings
+        from sumo_ayss.report.checks import fewest_seeds, trust_warnings
 
         for warning in trust_warnings(
-            [(str(d), r.training) for d, r in zip(done, runs, strict=True)]
+            [(str(d), r.training) for d, r in zip(done, runs, strict=True)],
+            fewest_seeds((r.case, r.vut) for r in runs),
         ):
             print(f"WARNING: {warning}")
     else:

@@ -8,8 +8,8 @@ import pytest
 import yaml
 
 from sumo_ayss.config import PROJECT_ROOT, load_experiment
+from sumo_ayss.config.budget import BUDGETS
 from sumo_ayss.pipeline import load_pipeline, plan_jobs
-from sumo_ayss.report.checks import TRUSTED_TIMESTEPS
 
 CONFIGS = sorted((PROJECT_ROOT / "configs").rglob("*.yaml"))
 
@@ -34,7 +34,7 @@ def test_config_loads(path: Path) -> None:
         assert exp.env.vut in exp.env.vuts
 
 
-def test_trusted_budget_is_the_shipped_experiments_budget() -> None:
+def test_the_shipped_experiments_train_the_paper_budget() -> None:
     for name in ("car_following.yaml", "cut_in.yaml"):
         exp = load_experiment(PROJECT_ROOT / "configs" / name)
-        assert exp.train.total_timesteps == TRUSTED_TIMESTEPS
+        assert exp.train.total_timesteps == BUDGETS["paper"].total_timesteps

@@ -11,7 +11,8 @@ the AYSS tables.
   SPCP's (a plateau: the SPCP is one of several candidates equal within noise), or it is
   clearly below (the curve peaked earlier).
 - :func:`trust_warnings` — sentences for the top of a report (and the terminal) when the
-  budget is below :data:`TRUSTED_TIMESTEPS` or SPCPs may still be improving.
+  budget is below :data:`TRUSTED_TIMESTEPS`, the seeds too few for it (no named budget of
+  :mod:`sumo_ayss.config.budget` covers the protocol), or SPCPs may still be improving.
 - :func:`mixing_problems` — runs that must not be pooled: the same (case, VUT, seed) twice,
   or runs of one case whose configurations differ other than by VUT and seed.
 - :func:`input_problems` — the missing, unreadable or empty input files of analysed cases,
@@ -28,22 +29,23 @@ import hashlib
 import json
 import math
 import os
-from collections import defaultdict
-from collections.abc import Mapping, Sequence
+from collections import Counter, defaultdict
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from sumo_ayss.config.budget import BUDGETS
 from sumo_ayss.errors import AyssError
 from sumo_ayss.run_folder import RunFolder, read_eval_rows, read_run_config, read_spcp
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
 
-TRUSTED_TIMESTEPS = 100_000
+TRUSTED_TIMESTEPS = min(b.total_timesteps for b in BUDGETS.values())
 """Training transitions per run below which verdicts are flagged as not to be trusted: the
-budget of the shipped experiments (``configs/car_following.yaml``, ``configs/cut_in.yaml``),
-by which car-following SPCPs mostly plateau (README, learning curves)."""
+smallest named budget's (``verdict``, 20,000), the least that ranked every validation ladder
+right with its seeds (docs/performance.md)."""
 
 NOISE_SE = 2.0
 """The last candidate counts as "within noise" of the SPCP when its mean evaluation reward
@@ -144,11 +146,22 @@ def read_training(run_dir: Path) -> Training:
     return Training(total, every, key, len(rows), spcp_step, int(last["step"]), gap, improving)
 
 
-def trust_warnings(runs: Sequence[tuple[str, Training]]) -> list[str]:
+def fewest_seeds(keys: Iterable[tuple[str, str]]) -> int | None:
+    """The fewest runs (training seeds) of any (case, VUT) among ``keys``, one key per run;
+    None without runs."""
+    counts = Counter(keys)
+    return min(counts.values()) if counts else None
+
+
+def trust_warnings(
+    runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None = None
+) -> list[str]:
     """Sentences that say why verdicts built on ``runs`` (``(label, training)``) are weak.
 
-    Empty when every run trained at least :data:`TRUSTED_TIMESTEPS` transitions and every
-    SPCP has peaked.
+    Empty when every run trained at least :data:`TRUSTED_TIMESTEPS` transitions, the
+    protocol (the smallest budget, ``seeds_per_vut`` when given: the fewest seeds of any VUT)
+    meets one of the named budgets validated on ladders (:data:`~sumo_ayss.config.budget.
+    BUDGETS`: at least its transitions and its seeds), and every SPCP has peaked.
     """
     out = []
     budgets_known = {t.total_timesteps for _, t in runs if t.total_timesteps is not None}
@@ -157,10 +170,24 @@ def trust_warnings(runs: Sequence[tuple[str, Training]]) -> list[str]:
         budgets = ", ".join(f"{b:,}" for b in small)
         out.append(
             f"Small training budget: {budgets} transitions per run, below the "
-            f"{TRUSTED_TIMESTEPS:,} of the shipped experiments. The SPCPs are undertrained; "
-            "the verdicts and rankings below are NOT to be trusted (a demonstration of the "
-            "machinery, not a result)."
+            f"{TRUSTED_TIMESTEPS:,} of the smallest budget that ranked every validation "
+            "ladder right. The SPCPs are undertrained; the verdicts and rankings below are "
+            "NOT to be trusted (a demonstration of the machinery, not a result)."
         )
+    elif budgets_known and seeds_per_vut is not None:
+        total = min(budgets_known)
+        if not any(
+            total >= b.total_timesteps and seeds_per_vut >= b.seeds for b in BUDGETS.values()
+        ):
+            validated = "; ".join(
+                f"{b.seeds} at {b.total_timesteps:,} ({name})" for name, b in BUDGETS.items()
+            )
+            out.append(
+                f"Few training seeds: {seeds_per_vut} per VUT at {total:,} transitions per "
+                f"run, fewer than a protocol validated on ladders uses (seeds at transitions: "
+                f"{validated}). With fewer seeds the tests miss real differences more often: "
+                "a 'no significant difference' here is weak evidence."
+            )
     unknown = [label for label, t in runs if t.total_timesteps is None]
     if unknown:
         out.append(

@@ -37,7 +37,7 @@ from sumo_ayss.report.blocks import (
     Report,
     Table,
 )
-from sumo_ayss.report.checks import mixing_problems, trust_warnings
+from sumo_ayss.report.checks import fewest_seeds, mixing_problems, trust_warnings
 from sumo_ayss.report.figstyle import vut_colors
 from sumo_ayss.report.leaderboard import leaderboard_table
 from sumo_ayss.report.load import (
@@ -126,7 +126,10 @@ def build_report(
         f"{budget or 'none'} transitions per run."
     )
     blocks: list[Block] = []
-    warnings = trust_warnings([(f"{r.case} {r.label}", r.training) for r in runs])
+    warnings = trust_warnings(
+        [(f"{r.case} {r.label}", r.training) for r in runs],
+        fewest_seeds((r.case, r.vut) for r in runs),
+    )
     if warnings:
         blocks.append(Callout("Read the verdicts with care", tuple(warnings), "warning"))
     tables = [t for t in (leaderboard_table(a, options.level) for a in analyses) if t]
@@ -257,7 +260,10 @@ def write_report_for(
     Returns:
         The path of ``report.html``.
     """
-    for warning in trust_warnings([(f"{r.case} {r.label}", r.training) for r in runs]):
+    for warning in trust_warnings(
+        [(f"{r.case} {r.label}", r.training) for r in runs],
+        fewest_seeds((r.case, r.vut) for r in runs),
+    ):
         logger.warning("%s", warning)
     report = build_report(runs, out_dir, title=title, options=options, analyses=analyses)
     html_path = out_dir / HTML_NAME

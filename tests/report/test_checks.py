@@ -8,7 +8,7 @@ import pytest
 
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.report import write_report
-from sumo_ayss.report.checks import read_training, trust_warnings
+from sumo_ayss.report.checks import Training, fewest_seeds, read_training, trust_warnings
 from sumo_ayss.run_folder import (
     RunConfig,
     RunFolder,
@@ -67,13 +67,13 @@ def test_spcp_state_from_the_learning_curve(tmp_path: Path) -> None:
 def test_small_budget_report_says_so_first(tmp_path: Path) -> None:
     for vut in ("pi1", "pi2"):
         for seed in (0, 1):
-            _set_budget(make_run(tmp_path / "runs", "car_following", vut, seed), 20_000, 5_000)
+            _set_budget(make_run(tmp_path / "runs", "car_following", vut, seed), 10_000, 5_000)
     html = write_report([tmp_path / "runs"], tmp_path / "out", options=FAST)
     md = (tmp_path / "out" / "summary.md").read_text()
     first = md.split("## Verdicts")[0]
-    assert "Small training budget: 20,000 transitions per run" in first
+    assert "Small training budget: 10,000 transitions per run" in first
     assert "NOT to be trusted" in first
-    assert "| total_timesteps | eval_every |" in md and "| 20,000 | 5,000 |" in md
+    assert "| total_timesteps | eval_every |" in md and "| 10,000 | 5,000 |" in md
     assert "NOT to be trusted" in html.read_text()
     assert str(tmp_path) not in md  # run folders relative to the report
     assert "../runs/car_following/pi1/seed_0" in md
@@ -108,3 +108,18 @@ def test_different_cases_may_have_different_configs(tmp_path: Path) -> None:
     _set_budget(make_run(tmp_path / "runs", "car_following", "pi1", 0), 100_000)
     _set_budget(make_run(tmp_path / "runs", "cut_in", "pi1", 0), 150_000)
     assert write_report([tmp_path / "runs"], tmp_path / "out", options=FAST).is_file()
+
+
+def test_too_few_seeds_for_the_budget_are_named() -> None:
+    """A named budget is validated with its seeds: 20,000 transitions needs 4 per VUT,
+    100,000 needs 3; fewer seeds at that budget warn (low power), enough do not."""
+    t20 = Training(20_000, 5_000, "k", 4, 20_000, 20_000, 0.0, False)
+    t100 = Training(100_000, 10_000, "k", 10, 60_000, 100_000, 5.0, False)
+    few = trust_warnings([("a", t20)], seeds_per_vut=2)
+    assert len(few) == 1 and few[0].startswith("Few training seeds: 2 per VUT at 20,000")
+    assert "4 at 20,000 (verdict)" in few[0] and "3 at 100,000 (paper)" in few[0]
+    assert trust_warnings([("a", t20)], seeds_per_vut=4) == []
+    assert trust_warnings([("a", t100)], seeds_per_vut=3) == []
+    assert trust_warnings([("a", t100)], seeds_per_vut=2)[0].startswith("Few training seeds")
+    assert fewest_seeds([("cut_in", "a"), ("cut_in", "a"), ("cut_in", "b")]) == 1
+    assert fewest_seeds([]) is None
