@@ -1,4 +1,4 @@
-"""Seed-level comparison and ranking of VUTs (numpy and the stdlib only).
+"""Seed-level comparison and ranking of VUTs (numpy, scipy and the stdlib).
 
 One training seed of one VUT gives one SPCP; its score (a scalar, e.g. the mean harm per
 episode it brings about over the common outcome scenarios) is **one observation**. Samples inside
