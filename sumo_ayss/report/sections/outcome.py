@@ -5,11 +5,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
-from sumo_ayss.analysis.case import CaseAnalysis, exposure_sentence, premise_sentence
+from sumo_ayss.analysis.case import CaseAnalysis, premise_sentence
 from sumo_ayss.analysis.formatting import fmt_num, fmt_p
 from sumo_ayss.analysis.seed_intervals import seed_interval_text
 from sumo_ayss.cases import OUTCOME_COLUMNS
-from sumo_ayss.config.report import MODES, ReportOptions
+from sumo_ayss.config.report import ReportOptions
+from sumo_ayss.modes import EXPOSURE
+from sumo_ayss.modes.exposure import exposure_sentence
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -157,12 +159,12 @@ def exposure_blocks(
     a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
     blocks: list[Block] = [Heading("(f) Exposure ranking", 3)]
-    blocks.append(Paragraph(MODES["exposure"]))
+    blocks.append(Paragraph(EXPOSURE.description))
     if not a.exposure_rows:
         return [*blocks, Paragraph("No exposure: no outcome summaries in this case yet.")]
     pct = f"{100 * options.level:g} %"
     scores = a.exposure_scores
-    outcomes = a.outcomes.get("exposure", {})
+    outcomes = a.outcomes.get(EXPOSURE.name, {})
     path = seed_scores_figure(
         a.exposure_rows,
         scores,
