@@ -18,9 +18,9 @@ from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import get_mode
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragraph, Table
-from sumo_ayss.report.discriminability import discriminability_blocks
 from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.crossplay import crossplay_blocks
+from sumo_ayss.report.sections.discriminability import discriminability_blocks
 from sumo_ayss.report.sections.measures import measures_blocks
 from sumo_ayss.report.sections.outcome import exposure_blocks, outcome_blocks, premise_blocks
 from sumo_ayss.report.sections.paper import paper_blocks
