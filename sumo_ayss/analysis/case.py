@@ -30,7 +30,6 @@ from sumo_ayss.analysis.crossplay import (
     CrossplayMatrix,
     rank_crossplay,
 )
-from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.analysis.harm import HARM_RANGE, VutOutcome, vut_outcomes
 from sumo_ayss.analysis.premise import Premise, premise_check
 from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex, rank, safety_index
@@ -51,7 +50,6 @@ __all__ = [
     "CaseAnalysis",
     "CaseOptions",
     "analyse_case",
-    "premise_sentence",
     "ranking_line",
     "run_label",
     "seed_ranking_line",
@@ -282,31 +280,6 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -
     )
     out.crossplay_rows, out.crossplay_pairs = rank_crossplay(
         m, blocks=options.crossplay_blocks, level=options.level, alpha=options.welch_alpha
-    )
-
-
-def premise_sentence(premise: Premise | None, options: CaseOptions) -> str:
-    """One sentence: did the SPCPs reach the same overall outcome?"""
-    if premise is None or not premise.metrics:
-        return "Premise check: needs outcome summaries of at least two VUTs."
-    parts = []
-    for m in premise.metrics:
-        unit = f" {m.spec.unit}" if m.spec.unit else ""
-        parts.append(
-            f"{m.spec.name} spread {fmt_num(m.spread * m.spec.scale)}{unit} "
-            f"(tolerance {fmt_num(m.tolerance * m.spec.scale)}{unit}"
-            f"{'' if m.met else ', exceeded'})"
-        )
-    if premise.met:
-        return (
-            "Premise met: the SPCPs of all VUTs reached the same overall outcome within the "
-            "stated tolerances (" + "; ".join(parts) + ")."
-        )
-    return (
-        "Premise NOT met: the SPCPs of different VUTs did not reach the same overall outcome ("
-        + "; ".join(parts)
-        + "), so a comparison of their aggressiveness (paper mode) is confounded by the "
-        "difference in outcome."
     )
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sumo_ayss.analysis.case import CaseAnalysis, premise_sentence
+from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import get_mode
@@ -22,7 +22,12 @@ from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.crossplay import crossplay_blocks
 from sumo_ayss.report.sections.discriminability import discriminability_blocks
 from sumo_ayss.report.sections.measures import measures_blocks
-from sumo_ayss.report.sections.outcome import exposure_blocks, outcome_blocks, premise_blocks
+from sumo_ayss.report.sections.outcome import (
+    exposure_blocks,
+    outcome_blocks,
+    premise_blocks,
+    premise_sentence,
+)
 from sumo_ayss.report.sections.paper import paper_blocks
 
 __all__ = ["case_blocks", "verdict_lines"]

@@ -5,8 +5,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
-from sumo_ayss.analysis.case import CaseAnalysis, premise_sentence
+from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.formatting import fmt_num, fmt_p
+from sumo_ayss.analysis.premise import Premise
 from sumo_ayss.analysis.seed_intervals import seed_interval_text
 from sumo_ayss.cases import OUTCOME_COLUMNS
 from sumo_ayss.config.report import ReportOptions
@@ -103,6 +104,31 @@ def outcome_blocks(a: CaseAnalysis) -> list[Block]:
             )
         )
     return blocks
+
+
+def premise_sentence(premise: Premise | None, options: ReportOptions) -> str:
+    """One sentence: did the SPCPs reach the same overall outcome?"""
+    if premise is None or not premise.metrics:
+        return "Premise check: needs outcome summaries of at least two VUTs."
+    parts = []
+    for m in premise.metrics:
+        unit = f" {m.spec.unit}" if m.spec.unit else ""
+        parts.append(
+            f"{m.spec.name} spread {fmt_num(m.spread * m.spec.scale)}{unit} "
+            f"(tolerance {fmt_num(m.tolerance * m.spec.scale)}{unit}"
+            f"{'' if m.met else ', exceeded'})"
+        )
+    if premise.met:
+        return (
+            "Premise met: the SPCPs of all VUTs reached the same overall outcome within the "
+            "stated tolerances (" + "; ".join(parts) + ")."
+        )
+    return (
+        "Premise NOT met: the SPCPs of different VUTs did not reach the same overall outcome ("
+        + "; ".join(parts)
+        + "), so a comparison of their aggressiveness (paper mode) is confounded by the "
+        "difference in outcome."
+    )
 
 
 def premise_blocks(a: CaseAnalysis, options: ReportOptions) -> list[Block]:
