@@ -7,6 +7,7 @@ without it the headline falls back to the exposure mode's and says so.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 from sumo_ayss.modes.registry import Mode, Standing, register_mode
@@ -21,14 +22,46 @@ from sumo_ayss.modes.seed_level import (
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
+    from sumo_ayss.analysis.seeds import SeedComparison
 
-__all__ = ["CROSSPLAY", "crossplay_headline"]
+__all__ = ["CROSSPLAY", "crossplay_headline", "crossplay_sentence"]
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.3f}".replace("-", "−")
+
+
+def crossplay_sentence(c: SeedComparison, blocks: str = "seed") -> str:
+    """One quotable sentence for a cross-play comparison (A ranked above B)."""
+    unit = "training seeds (blocks of opponents)" if blocks == "seed" else "opponent SPCPs"
+    pct = f"{100 * c.level:g} %"
+    b_higher = c.difference < 0
+    lo, hi = (-c.hi, -c.lo) if b_higher else (c.lo, c.hi)
+    if math.isfinite(lo) and math.isfinite(hi):
+        ci = f"{_fmt(lo)}–{_fmt(hi)}" if lo >= 0 else f"{_fmt(lo)} to {_fmt(hi)}"
+    else:
+        ci = "interval undefined"
+    if not math.isfinite(c.p):
+        p = "p undefined"
+    else:
+        p = "p < 0.001" if c.p < 0.001 else f"p = {c.p:.3f}"
+    stats = f"{pct} CI {ci}; paired t-test over {c.n_a} {unit}, {p}"
+    more = "more" if b_higher else "less"
+    what = (
+        f"the pooled SPCPs bring about {abs(c.difference):.3f} {more} harm per episode "
+        f"against {c.name_b} than against {c.name_a}"
+    )
+    if c.significant and c.difference < 0:
+        return f"[crossplay mode] {c.name_a} is safer than {c.name_b}: {what} ({stats})."
+    return (
+        f"[crossplay mode] No significant difference in safety between {c.name_a} and "
+        f"{c.name_b}: {what} ({stats})."
+    )
 
 
 def crossplay_headline(out: CaseAnalysis) -> None:
     """Headline and ranking line of the cross-play mode; without a table, the exposure
     mode's, after a sentence that says so."""
-    from sumo_ayss.analysis.crossplay import crossplay_sentence
     from sumo_ayss.analysis.seeds import seed_ranking_line
     from sumo_ayss.modes.exposure import EXPOSURE, exposure_headline
 
@@ -47,8 +80,6 @@ def crossplay_headline(out: CaseAnalysis) -> None:
 
 
 def _standings(a: CaseAnalysis) -> list[Standing]:
-    from sumo_ayss.analysis.crossplay import crossplay_sentence
-
     return seed_standings(a.crossplay_rows, lambda c: crossplay_sentence(c, a.crossplay_blocks))
 
 

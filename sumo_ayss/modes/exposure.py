@@ -16,6 +16,7 @@ from sumo_ayss.modes.seed_level import (
     seed_interval,
     seed_score_text,
     seed_standings,
+    verdict_sentence,
 )
 
 if TYPE_CHECKING:
@@ -32,8 +33,6 @@ EXPOSURE_SCORE = "bring about {amount} {more_less} harm per episode"
 
 def exposure_sentence(c: SeedComparison) -> str:
     """The exposure-mode verdict sentence of one comparison."""
-    from sumo_ayss.analysis.seeds import verdict_sentence
-
     return verdict_sentence(
         c, higher_is_safer=False, score=EXPOSURE_SCORE, unit="", mode=NAME, digits=3
     )
