@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sumo_ayss.analysis.student_t import student_t_sf
+from sumo_ayss.analysis.stats import student_t_sf
 from sumo_ayss.report.episodes import load_crossplay
 from sumo_ayss.report.load import group_runs, load_run
 

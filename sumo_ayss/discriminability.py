@@ -244,7 +244,7 @@ def write_outputs(meta: dict[str, Any], out_dir: str | Path, *, figure: bool = T
     atomic_write_text(out / CSV_NAME, buf.getvalue())
     paths = [out / JSON_NAME, out / CSV_NAME]
     if figure:
-        from sumo_ayss.report.discriminability import discriminability_figure
+        from sumo_ayss.report.sections.discriminability import discriminability_figure
 
         png = discriminability_figure(meta, out / PNG_NAME)
         if png is not None:

@@ -44,7 +44,7 @@ drive backwards, so :func:`bicycle_step` floors the speed at ``min_speed_mps`` (
 default, set it to −40 for highway-env's bound where no SUMO vehicle is involved).
 
 The state, the bicycle and the collision test live in :mod:`sumo_ayss.hwenv_kinematics`
-and are re-exported here, so every law is imported from this module.
+(imported from there).
 """
 
 from __future__ import annotations
@@ -53,22 +53,14 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from sumo_ayss.hwenv_kinematics import (
-    KinematicState,
-    bicycle_step,
-    collision_check,
-    not_zero,
-)
+from sumo_ayss.hwenv_kinematics import KinematicState, bicycle_step, not_zero
 
 __all__ = [
     "HIGHWAY_ENV_VERSION",
     "HighwayEnvIDM",
-    "KinematicState",
+    "HighwayEnvPov",
     "LateralParams",
-    "bicycle_step",
-    "collision_check",
     "idm_acceleration",
-    "not_zero",
     "speed_control",
     "steering_control",
 ]

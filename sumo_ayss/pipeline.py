@@ -60,6 +60,7 @@ from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.folder_lock import output_lock
 from sumo_ayss.grid_local import run_grid_local
 from sumo_ayss.jobs import JobSpec
+from sumo_ayss.modes import get_mode
 from sumo_ayss.progress import JobStatus
 from sumo_ayss.run_folder import RunFolder
 from sumo_ayss.validation import suggest
@@ -257,7 +258,7 @@ def _run_locked(
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
     if not finished:
         return PipelineResult(statuses, None, [], [])
-    if cfg.report.mode == "crossplay":
+    if get_mode(cfg.report.mode).runs_crossplay:
         run_crossplay_stage(cfg, statuses)
     write_discriminability(cfg)
     from sumo_ayss.report.document import load_runs, write_report_for
@@ -274,7 +275,7 @@ def stages_after_grid(cfg: PipelineConfig) -> list[str]:
     """What runs after the grid's jobs, outside their ETA (named in it: no silent gap)."""
     several = len(cfg.grid.vuts) >= 2
     stages = ["discriminability"] if several else []
-    if several and cfg.report.mode == "crossplay":
+    if several and get_mode(cfg.report.mode).runs_crossplay:
         stages.append("cross-play")
     return [*stages, "the report"]
 

@@ -11,7 +11,7 @@ and prints the table. With ``expected_order`` (a known safety order, e.g. a ladd
 writes ``<out>/order_check.json``: per case and mode, Kendall's τ of the ranking against it,
 whether the two ends differ significantly, and how many adjacent pairs do.
 
-The mode (``report.mode`` or ``--mode``, :data:`sumo_ayss.config.report.MODES`) decides which
+The mode (``report.mode`` or ``--mode``, one of :mod:`sumo_ayss.modes`) decides which
 rows come first and which ranking the report's verdicts use; the rows of every other mode
 available for a case follow, each tagged with its mode:
 
@@ -35,18 +35,16 @@ from __future__ import annotations
 import argparse
 import csv
 import io
-import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from sumo_ayss.analysis.case import CaseAnalysis, exposure_sentence
-from sumo_ayss.analysis.crossplay import crossplay_sentence
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_num
-from sumo_ayss.analysis.seed_intervals import seed_interval_text
+from sumo_ayss.analysis.case import CaseAnalysis
+from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.errors import AyssError, ConfigError
+from sumo_ayss.modes import Mode, get_mode, mode_names, registered_modes
 from sumo_ayss.run_folder import OUTCOME_JSON, RunFolder
 
 if TYPE_CHECKING:
@@ -99,64 +97,40 @@ def analyse_loaded(runs: Sequence[Run], options: ReportOptions | None = None) ->
     from sumo_ayss.report.load import analyse_runs
 
     options = options or ReportOptions()
-    # The AYSS bootstrap is only needed in paper mode.
-    return analyse_runs(runs, options, paper=options.mode == "paper")
-
-
-#: The modes in the order their rows follow the chosen mode's.
-MODE_ORDER = ("crossplay", "exposure", "paper")
+    # The AYSS bootstrap only where the mode ranks by the safety index.
+    return analyse_runs(runs, options, paper=get_mode(options.mode).needs_safety_index)
 
 
 def available_modes(a: CaseAnalysis) -> list[str]:
-    """The modes with a ranking for this case, the analysis's own mode first.
-
-    Cross-play needs the case's ``crossplay.csv``; exposure needs outcome summaries; paper
-    needs the safety indices and is ranked in paper mode only (the pipeline's analyses
-    have them in every mode, for its report).
+    """The modes with a ranking for this case (:attr:`~sumo_ayss.modes.Mode.available`),
+    the analysis's own mode first, then the others in registry order.
     """
-    have = {
-        "crossplay": bool(a.crossplay_rows),
-        "exposure": bool(a.exposure_rows),
-        "paper": bool(a.ranking) and a.mode == "paper",
-    }
-    return sorted((m for m in MODE_ORDER if have[m]), key=lambda m: m != a.mode)
+    have = [m.name for m in registered_modes() if m.available(a)]
+    return sorted(have, key=lambda m: m != a.mode)
 
 
-#: Unit text of the harm score per mode, in ``ranking.csv`` and ``ranking.md``.
-HARM_UNITS = {
-    "crossplay": "harm/episode, pooled SPCPs (lower = safer)",
-    "exposure": "harm/episode, own SPCPs (lower = safer)",
-}
-
-
-def _seed_rows(a: CaseAnalysis, mode: str) -> list[dict[str, Any]]:
-    """Rows of a seed-level ranking (exposure or cross-play), with crashes and mobility."""
-    ranked = a.crossplay_rows if mode == "crossplay" else a.exposure_rows
-    outcomes = a.outcomes.get(mode, {})
+def _rows(a: CaseAnalysis, mode: Mode) -> list[dict[str, Any]]:
+    """The ``ranking.csv`` rows of one case in one mode, with crashes and mobility where
+    the mode reads outcomes (``CaseAnalysis.outcomes``)."""
+    outcomes = a.outcomes.get(mode.name, {})
+    unit = mode.unit(a)
     rows = []
-    for r in ranked:
-        nxt = r.vs_next
-        if nxt is None:
-            sentence = ""
-        elif mode == "crossplay":
-            sentence = crossplay_sentence(nxt, a.crossplay_blocks)
-        else:
-            sentence = exposure_sentence(nxt)
-        o = outcomes.get(r.name)
+    for s in mode.standings(a):
+        o = outcomes.get(s.vut)
         rows.append(
             {
                 "case": a.case,
-                "mode": mode,
-                "rank": r.rank,
-                "vut": r.name,
-                "score": r.mean,
-                "lo": r.lo,
-                "hi": r.hi,
-                "n_seeds": r.n_seeds,
-                "unit": HARM_UNITS[mode],
-                "p_vs_next": nxt.p if nxt else "",
-                "significant_vs_next": nxt.significant if nxt else "",
-                "vs_next": sentence,
+                "mode": mode.name,
+                "rank": s.rank,
+                "vut": s.vut,
+                "score": s.score,
+                "lo": s.lo,
+                "hi": s.hi,
+                "n_seeds": s.n_seeds,
+                "unit": unit,
+                "p_vs_next": s.p if s.p is not None else "",
+                "significant_vs_next": s.significant if s.significant is not None else "",
+                "vs_next": s.vs_next,
                 "crash_rate": o.crash_rate if o else "",
                 "crash_lo": o.crash_lo if o else "",
                 "crash_hi": o.crash_hi if o else "",
@@ -164,34 +138,6 @@ def _seed_rows(a: CaseAnalysis, mode: str) -> list[dict[str, Any]]:
                 "episodes": o.episodes if o else "",
                 "mobility_mps": o.mobility if o else "",
                 "timid": o.timid if o else "",
-            }
-        )
-    return rows
-
-
-def _paper_rows(a: CaseAnalysis) -> list[dict[str, Any]]:
-    pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
-    order = [r.name for r in a.ranking]
-    rows = []
-    for i, ranked in enumerate(a.ranking):
-        nxt_name = order[i + 1] if i + 1 < len(order) else None
-        pair = pairs.get((ranked.name, nxt_name)) if nxt_name else None
-        rows.append(
-            {
-                "case": a.case,
-                "mode": "paper",
-                "rank": ranked.rank,
-                "vut": ranked.name,
-                "score": ranked.point,
-                "lo": ranked.lo,
-                "hi": ranked.hi,
-                "n_seeds": ranked.n_seeds,
-                "unit": f"{a.info.indicator.unit} (higher = safer)",
-                "p_vs_next": pair.verdict.p_seed_welch if pair else "",
-                "significant_vs_next": pair.significant if pair else "",
-                # Tagged like the seed-level modes' sentences ("[exposure mode] ...").
-                "vs_next": f"[paper mode] {pair.sentence}" if pair else "",
-                **dict.fromkeys(RANKING_COLUMNS[RANKING_COLUMNS.index("crash_rate") :], ""),
             }
         )
     return rows
@@ -208,7 +154,7 @@ def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
     rows: list[dict[str, Any]] = []
     for a in analyses:
         for mode in available_modes(a):
-            rows += _paper_rows(a) if mode == "paper" else _seed_rows(a, mode)
+            rows += _rows(a, get_mode(mode))
     return rows
 
 
@@ -232,37 +178,12 @@ def order_check(
     mode = mode or a.mode
     if mode not in available_modes(a):
         return None
-    if mode in ("exposure", "crossplay"):
-        ranked, compared = (
-            (a.exposure_rows, a.exposure_pairs)
-            if mode == "exposure"
-            else (a.crossplay_rows, a.crossplay_pairs)
-        )
-        order = [r.name for r in ranked]
-        sig = [bool(r.significant_vs_next) for r in ranked[:-1]]
-        ends = {frozenset((c.name_a, c.name_b)): c for c in compared}
-    else:
-        order = [r.name for r in a.ranking]
-        sig = [bool(r.significant_vs_next) for r in a.ranking[:-1]]
-        ends = {}
+    standings = get_mode(mode).standings(a)
+    order = [s.vut for s in standings]
+    sig = [s.ranked_apart for s in standings[:-1]]
     if sorted(order) != sorted(expected) or len(order) < 2:
         return None
-    end_cmp = ends.get(frozenset((expected[0], expected[-1])))
-    ends_ok = (
-        end_cmp is not None
-        and end_cmp.significant
-        and end_cmp.name_a == expected[0]  # ranked above, i.e. found safer
-    )
-    if mode == "paper":
-        pair = next(
-            (
-                p
-                for p in a.pairs
-                if {p.verdict.name_a, p.verdict.name_b} == {expected[0], expected[-1]}
-            ),
-            None,
-        )
-        ends_ok = pair is not None and pair.safer == expected[0]
+    ends_ok, ends_p = get_mode(mode).ends(a, expected[0], expected[-1])
     return {
         "case": a.case,
         "mode": mode,
@@ -270,7 +191,7 @@ def order_check(
         "expected": list(expected),
         "tau": kendall_tau(order, list(expected)),
         "ends_significant": ends_ok,
-        "ends_p": end_cmp.p if end_cmp is not None else math.nan,
+        "ends_p": ends_p,
         "significant_adjacent": sum(sig),
         "adjacent": len(sig),
     }
@@ -307,11 +228,9 @@ def write_ranking(
         "|---|---|---:|---|---|---:|---|---|---|",
     ]
     for r in rows:
-        digits = 2 if r["mode"] == "paper" else 3
-        if r["mode"] == "paper":
-            ci = fmt_interval(r["lo"], r["hi"], digits)
-        else:
-            ci = seed_interval_text(r["lo"], r["hi"], r["n_seeds"], digits)
+        mode = get_mode(r["mode"])
+        digits = mode.digits
+        ci = mode.interval_text(r["lo"], r["hi"], r["n_seeds"], digits)
         ci = f" ({ci})" if ci else ""
         lines.append(
             f"| {r['case']} | {r['mode']} | {r['rank']} | {r['vut']} | "
@@ -356,7 +275,6 @@ def main(argv: Sequence[str] | None = None) -> None:
 
     from sumo_ayss.cli import prog
     from sumo_ayss.config.budget import BUDGET_CHOICES, BUDGET_HELP
-    from sumo_ayss.config.report import MODES
     from sumo_ayss.pipeline import (
         add_budget_flags,
         budget_overrides,
@@ -384,7 +302,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--budget", choices=BUDGET_CHOICES, default=None, help=BUDGET_HELP)
     parser.add_argument(
         "--mode",
-        choices=list(MODES),
+        choices=list(mode_names()),
         default=None,
         help="replace report.mode (default crossplay: every SPCP against every VUT, run "
         "after the grid; rows of every other mode available follow)",

@@ -107,9 +107,6 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-#: The step callback (old name, kept for tests that patch it).
-_CandidateCallback = CandidateCallback
-
 
 class Trainer:
     """Owns one run: its folder, env(s), model, candidates and evaluation table.

@@ -1010,7 +1010,7 @@ def test_a_garbled_table_or_json_file_is_a_table_error_naming_it(tmp_path: Path)
         read_json(tmp_path / "crossplay.json")
     with pytest.raises(TableError, match="cannot read"):
         read_json(tmp_path)  # a folder
-    from sumo_ayss.report.discriminability import read_record
+    from sumo_ayss.report.sections.discriminability import read_record
 
     _garble(tmp_path / "discriminability.json")
     assert read_record(tmp_path / "discriminability.json") is None  # logged, not raised

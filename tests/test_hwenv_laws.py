@@ -8,14 +8,8 @@ import pytest
 
 from sumo_ayss.config import ActuatorConfig, EnvConfig, SimConfig
 from sumo_ayss.errors import ConfigError
-from sumo_ayss.hwenv_laws import (
-    HighwayEnvIDM,
-    HighwayEnvPov,
-    KinematicState,
-    bicycle_step,
-    collision_check,
-    idm_acceleration,
-)
+from sumo_ayss.hwenv_kinematics import KinematicState, bicycle_step, collision_check
+from sumo_ayss.hwenv_laws import HighwayEnvIDM, HighwayEnvPov, idm_acceleration
 from sumo_ayss.sim.actuator import pov_acceleration
 
 

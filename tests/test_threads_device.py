@@ -13,7 +13,7 @@ from sumo_ayss.config import TrainConfig, load_experiment
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.threads import THREAD_ENV_VARS, set_torch_threads, single_thread_env
 from sumo_ayss.train import check_device, train
-from tests.test_train import tiny_config
+from tests.training.test_train import tiny_config
 
 
 def test_single_thread_env_sets_only_unset_variables(monkeypatch: pytest.MonkeyPatch) -> None:

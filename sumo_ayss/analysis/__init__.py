@@ -1,11 +1,11 @@
 """Pure-math analysis of AYSS results: metrics, statistics, safety index and ranking.
 
-Depends on numpy and the standard library only (no SUMO, no torch), so reports and tests can
-use it on any machine.
+Depends on numpy, scipy and the standard library only (no SUMO, no torch), so reports and
+tests can use it on any machine.
 
 * :mod:`.metrics` — time to collision, Δv̄.
-* :mod:`.validate`, :mod:`.student_t`, :mod:`.stats`, :mod:`.bootstrap` — argument checks,
-  Student t, intervals and binned means, hierarchical bootstraps.
+* :mod:`.validate`, :mod:`.stats`, :mod:`.bootstrap` — argument checks,
+  Student t (scipy), intervals and binned means, hierarchical bootstraps.
 * :mod:`.safety_index`, :mod:`.verdict`, :mod:`.ranking` — safety index per VUT, pairwise
   verdicts, rankings; :mod:`.significance` — the report's two-test rule.
 * :mod:`.seeds`, :mod:`.premise` — seed-level (exposure) ranking, the premise check.

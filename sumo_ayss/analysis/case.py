@@ -28,10 +28,8 @@ from sumo_ayss.analysis.crossplay import (
     NO_CROSSPLAY_TABLE,
     CrossplayInput,
     CrossplayMatrix,
-    crossplay_sentence,
     rank_crossplay,
 )
-from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.analysis.harm import HARM_RANGE, VutOutcome, vut_outcomes
 from sumo_ayss.analysis.premise import Premise, premise_check
 from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex, rank, safety_index
@@ -40,19 +38,19 @@ from sumo_ayss.analysis.seeds import (
     SeedRankRow,
     SeedScores,
     rank_seeds,
-    verdict_sentence,
+    ranking_line,
+    seed_ranking_line,
 )
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
 from sumo_ayss.cases import Case, case_info
 from sumo_ayss.errors import ConfigError
+from sumo_ayss.modes import CROSSPLAY, EXPOSURE, get_mode
 
 __all__ = [
-    "EXPOSURE_SCORE",
     "CaseAnalysis",
     "CaseOptions",
     "analyse_case",
-    "exposure_sentence",
-    "premise_sentence",
+    "ranking_line",
     "run_label",
     "seed_ranking_line",
     "vut_safety_index",
@@ -191,14 +189,14 @@ class CaseAnalysis:
     headline_kind: Literal["safer", "none", "warning"] = "warning"
     ranking_line: str = ""
     problems: list[str] = field(default_factory=list)
-    mode: str = "exposure"
+    mode: str = EXPOSURE.name
     exposure_rows: list[SeedRankRow] = field(default_factory=list)
     exposure_pairs: list[SeedComparison] = field(default_factory=list)
     exposure_scores: dict[str, dict[int, float]] = field(default_factory=dict)
     premise: Premise | None = None
     paper_headline: str = ""
     paper_ranking_line: str = ""
-    ranking_mode: str = "exposure"
+    ranking_mode: str = EXPOSURE.name
     crossplay: CrossplayMatrix | None = None
     crossplay_rows: list[SeedRankRow] = field(default_factory=list)
     crossplay_pairs: list[SeedComparison] = field(default_factory=list)
@@ -207,10 +205,6 @@ class CaseAnalysis:
     crossplay_missing: str = ""
     crossplay_diagonal: tuple[tuple[str, int, int, int], ...] = ()
     outcomes: dict[str, dict[str, VutOutcome]] = field(default_factory=dict)
-
-
-EXPOSURE_SCORE = "bring about {amount} {more_less} harm per episode"
-"""How an exposure difference reads in a verdict sentence."""
 
 
 def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
@@ -231,7 +225,7 @@ def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
             out.problems.append(f"{vut}: no outcome table with a seed, so no exposure")
     out.exposure_scores = {sc.name: dict(sc.values) for sc in scores}
     if counts:
-        out.outcomes["exposure"] = vut_outcomes(counts, options.level)
+        out.outcomes[EXPOSURE.name] = vut_outcomes(counts, options.level)
     if scores:
         out.exposure_rows, out.exposure_pairs = rank_seeds(
             scores,
@@ -281,43 +275,11 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -
         return
     out.crossplay, out.crossplay_path = m, found.path
     out.crossplay_diagonal = found.diagonal
-    out.outcomes["crossplay"] = vut_outcomes(
+    out.outcomes[CROSSPLAY.name] = vut_outcomes(
         {v: (*m.crashes(v), m.vut_mobility(v)) for v in m.vuts}, options.level
     )
     out.crossplay_rows, out.crossplay_pairs = rank_crossplay(
         m, blocks=options.crossplay_blocks, level=options.level, alpha=options.welch_alpha
-    )
-
-
-def exposure_sentence(c: SeedComparison) -> str:
-    """The exposure-mode verdict sentence of one comparison."""
-    return verdict_sentence(
-        c, higher_is_safer=False, score=EXPOSURE_SCORE, unit="", mode="exposure", digits=3
-    )
-
-
-def premise_sentence(premise: Premise | None, options: CaseOptions) -> str:
-    """One sentence: did the SPCPs reach the same overall outcome?"""
-    if premise is None or not premise.metrics:
-        return "Premise check: needs outcome summaries of at least two VUTs."
-    parts = []
-    for m in premise.metrics:
-        unit = f" {m.spec.unit}" if m.spec.unit else ""
-        parts.append(
-            f"{m.spec.name} spread {fmt_num(m.spread * m.spec.scale)}{unit} "
-            f"(tolerance {fmt_num(m.tolerance * m.spec.scale)}{unit}"
-            f"{'' if m.met else ', exceeded'})"
-        )
-    if premise.met:
-        return (
-            "Premise met: the SPCPs of all VUTs reached the same overall outcome within the "
-            "stated tolerances (" + "; ".join(parts) + ")."
-        )
-    return (
-        "Premise NOT met: the SPCPs of different VUTs did not reach the same overall outcome ("
-        + "; ".join(parts)
-        + "), so a comparison of their aggressiveness (paper mode) is confounded by the "
-        "difference in outcome."
     )
 
 
@@ -388,72 +350,8 @@ def analyse_case(
     out.paper_headline, out.paper_ranking_line = out.headline, out.ranking_line
     _crossplay(out, options, crossplay or CrossplayInput())
     out.mode = out.ranking_mode = options.mode
-    if options.mode == "exposure":
-        _exposure_headline(out)
-    elif options.mode == "crossplay":
-        _crossplay_headline(out)
+    get_mode(options.mode).headline(out)  # the paper mode's headline unless another mode's
     return out
-
-
-def ranking_line(names: Sequence[str], significant_next: Sequence[bool]) -> str:
-    """``"a > b ≈ c"``: ``>`` where a VUT differs significantly from the next, ``≈`` where
-    not. VUTs joined by ``≈`` are listed by name, so that a tie reads the same in every
-    mode (the order inside it is not a finding).
-
-    Args:
-        names: VUTs safest first.
-        significant_next: Per VUT but the last, whether it differs significantly from the
-            next one.
-    """
-    if not names:
-        return ""
-    groups: list[list[str]] = [[names[0]]]
-    for sig, name in zip(significant_next, names[1:], strict=True):
-        if sig:
-            groups.append([name])
-        else:
-            groups[-1].append(name)
-    return " > ".join(" ≈ ".join(sorted(g)) for g in groups)
-
-
-def seed_ranking_line(rows: Sequence[SeedRankRow]) -> str:
-    """:func:`ranking_line` of a seed-level ranking."""
-    return ranking_line([r.name for r in rows], [bool(r.significant_vs_next) for r in rows[:-1]])
-
-
-def _crossplay_headline(out: CaseAnalysis) -> None:
-    """Headline and ranking line of the cross-play mode; without a table, the exposure
-    mode's, after a sentence that says so."""
-    rows = out.crossplay_rows
-    if len(rows) < 2 or rows[0].vs_next is None:
-        _exposure_headline(out)
-        out.ranking_mode = "exposure"
-        reason = out.crossplay_missing or "the cross-play table ranks fewer than two VUTs"
-        out.headline = f"[crossplay mode] {reason}. Shown instead, labelled: {out.headline}"
-        out.headline_kind = "warning"
-        return
-    top = rows[0].vs_next
-    out.headline = crossplay_sentence(top, out.crossplay_blocks)
-    out.headline_kind = "safer" if top.significant else "none"
-    out.ranking_line = seed_ranking_line(rows)
-
-
-def _exposure_headline(out: CaseAnalysis) -> None:
-    """Headline and ranking line of the exposure mode."""
-    rows = out.exposure_rows
-    if len(rows) < 2:
-        out.headline = "[exposure mode] No verdict yet: a verdict needs outcomes of two VUTs."
-        out.headline_kind = "warning"
-        out.ranking_line = rows[0].name if rows else ""
-        return
-    top = rows[0].vs_next
-    assert top is not None
-    out.headline = exposure_sentence(top)
-    out.headline_kind = "safer" if top.significant else "none"
-    if out.info.exposure_caution:
-        out.headline += " " + out.info.exposure_caution
-        out.headline_kind = "warning"
-    out.ranking_line = seed_ranking_line(rows)
 
 
 def _headline(out: CaseAnalysis) -> None:

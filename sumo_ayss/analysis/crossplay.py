@@ -49,7 +49,6 @@ __all__ = [
     "CrossplayInput",
     "CrossplayMatrix",
     "crossplay_matrix",
-    "crossplay_sentence",
     "rank_crossplay",
 ]
 
@@ -237,36 +236,4 @@ def rank_crossplay(
     """
     return rank_seeds(
         m.scores(blocks), higher_is_safer=False, level=level, alpha=alpha, bounds=HARM_RANGE
-    )
-
-
-def _fmt(x: float) -> str:
-    return f"{x:.3f}".replace("-", "−")
-
-
-def crossplay_sentence(c: SeedComparison, blocks: str = "seed") -> str:
-    """One quotable sentence for a cross-play comparison (A ranked above B)."""
-    unit = "training seeds (blocks of opponents)" if blocks == "seed" else "opponent SPCPs"
-    pct = f"{100 * c.level:g} %"
-    b_higher = c.difference < 0
-    lo, hi = (-c.hi, -c.lo) if b_higher else (c.lo, c.hi)
-    if math.isfinite(lo) and math.isfinite(hi):
-        ci = f"{_fmt(lo)}–{_fmt(hi)}" if lo >= 0 else f"{_fmt(lo)} to {_fmt(hi)}"
-    else:
-        ci = "interval undefined"
-    if not math.isfinite(c.p):
-        p = "p undefined"
-    else:
-        p = "p < 0.001" if c.p < 0.001 else f"p = {c.p:.3f}"
-    stats = f"{pct} CI {ci}; paired t-test over {c.n_a} {unit}, {p}"
-    more = "more" if b_higher else "less"
-    what = (
-        f"the pooled SPCPs bring about {abs(c.difference):.3f} {more} harm per episode "
-        f"against {c.name_b} than against {c.name_a}"
-    )
-    if c.significant and c.difference < 0:
-        return f"[crossplay mode] {c.name_a} is safer than {c.name_b}: {what} ({stats})."
-    return (
-        f"[crossplay mode] No significant difference in safety between {c.name_a} and "
-        f"{c.name_b}: {what} ({stats})."
     )

@@ -1,4 +1,4 @@
-"""Seed-level comparison and ranking of VUTs (numpy and the stdlib only).
+"""Seed-level comparison and ranking of VUTs (numpy, scipy and the stdlib).
 
 One training seed of one VUT gives one SPCP; its score (a scalar, e.g. the mean harm per
 episode it brings about over the common outcome scenarios) is **one observation**. Samples inside
@@ -28,7 +28,6 @@ from typing import Literal
 
 import numpy as np
 
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
 from sumo_ayss.analysis.seed_intervals import UNBOUNDED, Bounds, seed_mean_ci
 from sumo_ayss.analysis.stats import check_level, student_t_sf, t_quantile
 from sumo_ayss.errors import ConfigError
@@ -40,7 +39,8 @@ __all__ = [
     "compare_seeds",
     "kendall_tau",
     "rank_seeds",
-    "verdict_sentence",
+    "ranking_line",
+    "seed_ranking_line",
 ]
 
 SeedTest = Literal["paired t", "Welch t", "none"]
@@ -293,49 +293,27 @@ def kendall_tau(order: Sequence[str], truth: Sequence[str]) -> float:
     return (concordant - discordant) / (concordant + discordant)
 
 
-def verdict_sentence(
-    c: SeedComparison,
-    *,
-    higher_is_safer: bool,
-    score: str,
-    unit: str,
-    mode: str,
-    digits: int = 2,
-) -> str:
-    """One quotable sentence for a seed-level comparison.
+def ranking_line(names: Sequence[str], significant_next: Sequence[bool]) -> str:
+    """``"a > b ≈ c"``: ``>`` where a VUT differs significantly from the next, ``≈`` where
+    not. VUTs joined by ``≈`` are listed by name, so that a tie reads the same in every
+    mode (the order inside it is not a finding).
 
     Args:
-        c: The comparison (A ranked above B).
-        higher_is_safer: Orientation of the score.
-        score: What the score is, as "their SPCPs ..." completes it, e.g.
-            ``"bring about {amount} {more_less} harm per episode"`` with ``{amount}`` and
-            ``{more_less}`` filled in here.
-        unit: Unit appended to the amount ("" for none).
-        mode: Analysis mode named at the start of the sentence.
-        digits: Decimals of the amount and its interval.
+        names: VUTs safest first.
+        significant_next: Per VUT but the last, whether it differs significantly from the
+            next one.
     """
-    pct = f"{100 * c.level:g} %"
-    if c.test == "paired t":
-        how = f"paired t-test over {c.n_a} shared seeds"
-    elif c.test == "Welch t":
-        how = f"Welch t-test, {c.n_a} vs {c.n_b} seeds"
-    else:
-        how = f"no test: {c.n_a} vs {c.n_b} seeds"
-    # Stated as "B's SPCPs <score> than A's" (A ranked safer), with the interval of the
-    # stated amount: of B - A when B scores higher, of A - B otherwise.
-    b_higher = c.difference < 0
-    lo, hi = (-c.hi, -c.lo) if b_higher else (c.lo, c.hi)
-    ci = fmt_interval(lo, hi, digits, missing="interval undefined")
-    stats = f"{pct} CI {ci}; {how}, p {fmt_p(c.p, undefined='undefined')}"
-    amount = fmt_num(abs(c.difference), digits, minus="-", missing="nan")
-    amount += f" {unit}" if unit else ""
-    what = score.format(amount=amount, more_less="more" if b_higher else "less")
-    if c.significant and (c.difference > 0) == higher_is_safer:
-        return (
-            f"[{mode} mode] {c.name_a} is safer than {c.name_b}: {c.name_b}'s SPCPs {what} "
-            f"than {c.name_a}'s ({stats})."
-        )
-    return (
-        f"[{mode} mode] No significant difference in safety between {c.name_a} and "
-        f"{c.name_b}: {c.name_b}'s SPCPs {what} than {c.name_a}'s ({stats})."
-    )
+    if not names:
+        return ""
+    groups: list[list[str]] = [[names[0]]]
+    for sig, name in zip(significant_next, names[1:], strict=True):
+        if sig:
+            groups.append([name])
+        else:
+            groups[-1].append(name)
+    return " > ".join(" ≈ ".join(sorted(g)) for g in groups)
+
+
+def seed_ranking_line(rows: Sequence[SeedRankRow]) -> str:
+    """:func:`ranking_line` of a seed-level ranking."""
+    return ranking_line([r.name for r in rows], [bool(r.significant_vs_next) for r in rows[:-1]])

@@ -1,11 +1,14 @@
-"""Confidence intervals and effect sizes for AYSS indicators (numpy and the stdlib only).
+"""Confidence intervals, t-tests and effect sizes for AYSS indicators (numpy and scipy).
 
+* :func:`student_t_sf`, :func:`t_quantile` — Student's t distribution (``scipy.stats.t``),
+  with our argument checks.
+* :func:`welch_t_test` — two-sided unequal-variance test of equal means.
 * :func:`mean_ci` — mean with a Student t interval.
 * :func:`binned_mean_ci` — per-bin means with t intervals, e.g. indicator vs headway.
 * :func:`cohens_d` — standardised mean difference with the pooled standard deviation.
 
-Re-exported from their modules: the Student t functions (:mod:`.student_t`), the bootstraps
-(:mod:`.bootstrap`) and the argument checks (:mod:`.validate`).
+Re-exported from their modules: the bootstraps (:mod:`.bootstrap`) and the argument checks
+(:mod:`.validate`).
 """
 
 from __future__ import annotations
@@ -16,10 +19,10 @@ from statistics import NormalDist
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy import stats as _scipy_stats
 
 from sumo_ayss.analysis.bootstrap import RngLike, bootstrap_ci, hierarchical_bootstrap
-from sumo_ayss.analysis.student_t import student_t_sf, t_quantile, welch_t_test
-from sumo_ayss.analysis.validate import check_level, finite_1d
+from sumo_ayss.analysis.validate import check_level, finite_1d, is_real
 from sumo_ayss.errors import ConfigError
 
 __all__ = [
@@ -38,6 +41,74 @@ __all__ = [
     "welch_t_test",
     "wilson_interval",
 ]
+
+
+# --------------------------------------------------------------------------- Student t
+
+
+def _check_df(df: float) -> float:
+    if not is_real(df) or not df > 0.0:
+        raise ConfigError(f"df: expected a positive number, got {df!r}")
+    return float(df)
+
+
+def student_t_sf(t: float, df: float) -> float:
+    """Upper tail P(T > t) of Student's t distribution (``scipy.stats.t.sf``).
+
+    Args:
+        t: Quantile (dimensionless).
+        df: Degrees of freedom, > 0 (non-integer allowed; ``math.inf`` gives the normal).
+
+    Returns:
+        The survival function at ``t``, in [0, 1].
+
+    Raises:
+        ConfigError: If ``df`` is not positive.
+    """
+    return float(_scipy_stats.t.sf(t, _check_df(df)))
+
+
+def t_quantile(p: float, df: float) -> float:
+    """Quantile function of Student's t distribution, t_{p, df} (``scipy.stats.t.ppf``).
+
+    Args:
+        p: Probability in (0, 1).
+        df: Degrees of freedom, > 0 (non-integer allowed; ``math.inf`` gives the normal).
+
+    Returns:
+        The value t with P(T <= t) = p (dimensionless).
+
+    Raises:
+        ConfigError: If ``p`` is not in (0, 1) or ``df`` is not positive.
+    """
+    p = check_level(p, "p")
+    return float(_scipy_stats.t.ppf(p, _check_df(df)))
+
+
+def welch_t_test(x: ArrayLike, y: ArrayLike) -> tuple[float, float, float]:
+    """Welch's unequal-variance t-test of ``mean(x) = mean(y)``, two-sided.
+
+    Args:
+        x: First sample, shape ``(n_x,)``, finite, n_x >= 2.
+        y: Second sample, shape ``(n_y,)``, finite, n_y >= 2.
+
+    Returns:
+        ``(t, df, p)``: the statistic (positive when ``x`` is larger on average), the
+        Welch-Satterthwaite degrees of freedom and the two-sided p-value. All NaN when both
+        samples have zero variance.
+
+    Raises:
+        ConfigError: If a sample has fewer than two values or is not finite.
+    """
+    xs, ys = finite_1d(x, "x"), finite_1d(y, "y")
+    if xs.size < 2 or ys.size < 2:
+        raise ConfigError("x and y: Welch's t-test needs at least two values in each sample")
+    va, vb = float(xs.var(ddof=1)) / xs.size, float(ys.var(ddof=1)) / ys.size
+    if va + vb == 0.0:
+        return math.nan, math.nan, math.nan
+    t = float(xs.mean() - ys.mean()) / math.sqrt(va + vb)
+    df = (va + vb) ** 2 / (va**2 / (xs.size - 1) + vb**2 / (ys.size - 1))
+    return t, df, min(1.0, 2.0 * student_t_sf(abs(t), df))
 
 
 # --------------------------------------------------------------------------- intervals

@@ -1,4 +1,4 @@
-"""Pairwise verdict between two VUTs from their safety indices (numpy and the stdlib only).
+"""Pairwise verdict between two VUTs from their safety indices (numpy, scipy and the stdlib).
 
 :func:`compare` pairs the bootstrap replicates of two :class:`~.safety_index.SafetyIndex`
 and states which VUT is safer, by how much and how sure that is, as one quotable sentence.
@@ -14,8 +14,7 @@ import numpy as np
 from sumo_ayss.analysis.bootstrap import bootstrap_ci
 from sumo_ayss.analysis.formatting import fmt_interval, fmt_p
 from sumo_ayss.analysis.safety_index import Indicator, SafetyIndex
-from sumo_ayss.analysis.stats import cohens_d
-from sumo_ayss.analysis.student_t import welch_t_test
+from sumo_ayss.analysis.stats import cohens_d, welch_t_test
 from sumo_ayss.analysis.validate import check_level
 from sumo_ayss.errors import ConfigError
 

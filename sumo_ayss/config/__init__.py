@@ -56,14 +56,13 @@ from sumo_ayss.config.pipeline import (
     PipelineConfig,
     load_pipeline,
 )
-from sumo_ayss.config.report import MODES, ReportOptions
+from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.config.yaml_io import read_yaml, safe_load_yaml, write_yaml
 from sumo_ayss.validation import SEED_MAX, check_out_dir, check_seed, check_sumo_network
 
 __all__ = [
     "DEFAULT_AYSS_SEED",
     "MANAGED_SUMO_OPTIONS",
-    "MODES",
     "PROJECT_ROOT",
     "SEED_MAX",
     "ActuatorConfig",

@@ -12,13 +12,8 @@ from __future__ import annotations
 from sumo_ayss.config import ActuatorConfig, EnvConfig
 from sumo_ayss.controllers import ControlledVut
 from sumo_ayss.envs.odd import InitialCondition
-from sumo_ayss.hwenv_laws import (
-    HighwayEnvIDM,
-    HighwayEnvPov,
-    KinematicState,
-    LateralParams,
-    collision_check,
-)
+from sumo_ayss.hwenv_kinematics import KinematicState, collision_check
+from sumo_ayss.hwenv_laws import HighwayEnvIDM, HighwayEnvPov, LateralParams
 from sumo_ayss.sim.actuator import next_speed, pov_acceleration
 from sumo_ayss.sim.pair import VehiclePair
 

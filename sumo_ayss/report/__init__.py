@@ -41,7 +41,6 @@ _LAZY = {
     "load_crossplay": "sumo_ayss.report.episodes",
     "load_run": "sumo_ayss.report.load",
     "ReportOptions": "sumo_ayss.config.report",
-    "MODES": "sumo_ayss.config.report",
 }
 """Public names and their modules, imported on first use: importing the package loads
 neither matplotlib nor the document."""

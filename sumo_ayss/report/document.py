@@ -25,8 +25,9 @@ from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis, analyse_case, vut_safety_index
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict, significance_rule
-from sumo_ayss.config.report import MODES, ReportOptions
+from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.errors import ConfigError
+from sumo_ayss.modes import get_mode
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -174,7 +175,7 @@ def modes_paragraph(analyses: Sequence[CaseAnalysis], mode: str) -> str:
             f"compares two. Mode asked for: {mode}."
         )
     used = list(dict.fromkeys(a.ranking_mode for a in with_verdict))
-    text = " ".join(f"{MODES[m]}" for m in used)
+    text = " ".join(get_mode(m).description for m in used)
     if used == [mode]:
         return f"Verdicts above are in {mode} mode. {text}"
     fell_back = ", ".join(a.case for a in with_verdict if a.ranking_mode != mode)

@@ -29,7 +29,7 @@ from sumo_ayss.analysis.ranking import SafetyIndex
 from sumo_ayss.analysis.seed_intervals import binned_seed_means
 from sumo_ayss.cases import case_info
 from sumo_ayss.config import RewardConfig
-from sumo_ayss.plots import plot_reward_shapes
+from sumo_ayss.envs.rewards import adversarial_reward_array
 from sumo_ayss.report.figstyle import (
     DPI,
     no_data,
@@ -53,18 +53,58 @@ __all__ = [
 # --------------------------------------------------------------------------- reward shapes
 
 
-def reward_shapes_figure(reward: RewardConfig, path: Path) -> Path:
-    """Draws the reward shapes with :func:`sumo_ayss.plots.plot_reward_shapes`.
+def reward_shapes_figure(reward: RewardConfig, path: Path, *, styled: bool = True) -> Path:
+    """Draws R = α_A·R_A(h) for the same-lane and the lane-change shapes of ``reward``.
 
     Args:
         reward: The runs' reward configuration.
         path: PNG file to write.
+        styled: In the report's style (:func:`~.figstyle.style`); False: matplotlib's
+            defaults (``docs/reward_shapes.png``, ``scripts/reward_shapes.py``).
 
     Returns:
         ``path``.
     """
+    if not styled:
+        return _draw_reward_shapes(reward, path)
     with style():
-        return plot_reward_shapes(reward, path)
+        return _draw_reward_shapes(reward, path)
+
+
+def _draw_reward_shapes(cfg: RewardConfig, path: Path) -> Path:
+    fig = Figure(figsize=(10, 3.6), constrained_layout=True)
+    axes = fig.subplots(1, 2)
+    panels = [
+        ("same lane (car-following; cut-in after the change)", cfg.same_lane, 25.0),
+        ("while changing lanes (cut-in)", cfg.lane_change, 8.0),
+    ]
+    for ax, (title, shape, h_max) in zip(axes, panels, strict=True):
+        h = np.linspace(0.0, h_max, 801)
+        r = cfg.alpha_adversarial * adversarial_reward_array(h, shape)
+        ax.plot(h, r, color="tab:blue", lw=2, label=f"R = α_A·R_A ({shape.kind})")
+        ax.axvline(
+            shape.peak_m, color="tab:green", ls="--", lw=1, label=f"peak h = {shape.peak_m} m"
+        )
+        ax.axvline(
+            shape.zero_m, color="tab:gray", ls=":", lw=1, label=f"zero for h ≥ {shape.zero_m} m"
+        )
+        contact = cfg.alpha_adversarial * shape.value_at_contact
+        ax.scatter([0.0], [contact], color="tab:blue", zorder=3, s=12)
+        ax.set_title(title)
+        ax.set_xlabel("headway h [m]")
+        ax.set_ylabel("reward per step")
+        ax.set_ylim(-0.05, cfg.alpha_adversarial * 1.05)
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper right", fontsize=8)
+    fig.suptitle(
+        f"Adversarial reward shapes; a collision step gets the minimum {cfg.min_reward:g} "
+        "and ends the episode",
+        fontsize=10,
+    )
+    from sumo_ayss.atomic import atomic_write_with
+
+    atomic_write_with(path, lambda tmp: fig.savefig(tmp, dpi=120))
+    return path
 
 
 # --------------------------------------------------------------------------- learning curves

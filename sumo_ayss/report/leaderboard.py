@@ -3,7 +3,7 @@
 One table per case at the top of the report (:func:`leaderboard_table`) and the same rows
 as plain text at the end of ``pipeline`` and ``rank`` (:func:`leaderboard_text`), so the
 terminal and the report say the same thing. The rows come from the mode the case's
-headline comes from (``CaseAnalysis.ranking_mode``): cross-play, exposure or paper.
+headline comes from (``CaseAnalysis.ranking_mode``, its :attr:`~sumo_ayss.modes.Mode.standings`).
 """
 
 from __future__ import annotations
@@ -12,19 +12,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from sumo_ayss.analysis.case import CaseAnalysis
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
-from sumo_ayss.analysis.seed_intervals import seed_interval_text
+from sumo_ayss.analysis.formatting import fmt_p
+from sumo_ayss.modes import EXPOSURE, get_mode
 from sumo_ayss.report.blocks import Table
 from sumo_ayss.report.sections.common import crash_cell
 
 __all__ = ["LeaderRow", "leaderboard_rows", "leaderboard_table", "leaderboard_text"]
-
-#: What the score column holds per mode, with its orientation.
-SCORE_NAMES = {
-    "crossplay": "cross-play harm H per episode (lower = safer)",
-    "exposure": "exposure harm per episode (lower = safer)",
-    "paper": "safety index (higher = safer)",
-}
 
 
 @dataclass(frozen=True)
@@ -56,36 +49,21 @@ def _vs_next(significant: bool | None, nxt: str | None, p: str) -> str:
 
 
 def leaderboard_rows(a: CaseAnalysis) -> list[LeaderRow]:
-    """The leaderboard of one case in its ranking mode, safest first (empty without one)."""
-    outcomes = a.outcomes.get(a.ranking_mode) or a.outcomes.get("exposure", {})
+    """The leaderboard of one case in its ranking mode, safest first (empty without one).
+
+    The crash rates are the ranking mode's outcomes, else the VUTs' own SPCPs' (exposure).
+    """
+    mode = get_mode(a.ranking_mode)
+    outcomes = a.outcomes.get(a.ranking_mode) or a.outcomes.get(EXPOSURE.name, {})
     rows: list[LeaderRow] = []
-    if a.ranking_mode in ("crossplay", "exposure"):
-        seed_rows = a.crossplay_rows if a.ranking_mode == "crossplay" else a.exposure_rows
-        for i, r in enumerate(seed_rows):
-            nxt = seed_rows[i + 1].name if i + 1 < len(seed_rows) else None
-            c = r.vs_next
-            p = f"{c.test}, p {fmt_p(c.p)}" if c is not None else ""
-            score = f"{fmt_num(r.mean, 3)} ({seed_interval_text(r.lo, r.hi, r.n_seeds, 3)})"
-            verdict = _vs_next(c.significant if c else None, nxt, p)
-            if c is not None and c.test == "none":
-                verdict = f"no test against {nxt}: {c.n_a} vs {c.n_b} seed(s), a test needs 2"
-            rows.append(LeaderRow(r.rank, r.name, score, crash_cell(outcomes.get(r.name)), verdict))
-        return rows
-    pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
-    for i, ranked in enumerate(a.ranking):
-        nxt = a.ranking[i + 1].name if i + 1 < len(a.ranking) else None
-        pair = pairs.get((ranked.name, nxt)) if nxt else None
-        p = f"Welch t, p {fmt_p(pair.verdict.p_seed_welch)}" if pair else "not comparable"
-        ci = fmt_interval(ranked.lo, ranked.hi)
-        unit = a.info.indicator.unit
-        score = f"{fmt_num(ranked.point)} {unit}" + (f" ({ci})" if ci else "")
+    for s in mode.standings(a):
+        p = f"{s.test}, p {fmt_p(s.p)}" if s.p is not None else "not comparable"
+        verdict = _vs_next(s.significant, s.next_vut, p)
+        if s.test == "none":
+            verdict = f"no test against {s.next_vut}: {s.n_a} vs {s.n_b} seed(s), a test needs 2"
         rows.append(
             LeaderRow(
-                ranked.rank,
-                ranked.name,
-                score,
-                crash_cell(outcomes.get(ranked.name)),
-                _vs_next(pair.significant if pair else None, nxt, p),
+                s.rank, s.vut, mode.score_text(a, s), crash_cell(outcomes.get(s.vut)), verdict
             )
         )
     return rows
@@ -97,10 +75,11 @@ def leaderboard_table(a: CaseAnalysis, level: float) -> Table | None:
     if not rows:
         return None
     pct = f"{100 * level:g} %"
-    interval = "bootstrap interval" if a.ranking_mode == "paper" else "t-interval over seeds"
+    mode = get_mode(a.ranking_mode)
+    interval = mode.interval_name
     return Table(
         f"{a.info.title}: leaderboard ({a.ranking_mode} mode), safest first",
-        ("rank", "VUT", f"{SCORE_NAMES[a.ranking_mode]} ({pct} CI)", "crash rate", "vs next"),
+        ("rank", "VUT", f"{mode.score_name} ({pct} CI)", "crash rate", "vs next"),
         tuple((str(r.rank), r.vut, r.score, r.crash_rate, r.vs_next) for r in rows),
         (True, False, True, True, False),
         f"Score: {pct} {interval} (none with fewer than three seeds). Crash rate: episodes "
@@ -119,7 +98,7 @@ def leaderboard_text(analyses: Sequence[CaseAnalysis]) -> str:
     for a in analyses:
         rows = leaderboard_rows(a)
         lines.append(f"{a.case}: leaderboard ({a.ranking_mode} mode), safest first")
-        lines.append(f"  score: {SCORE_NAMES[a.ranking_mode]}")
+        lines.append(f"  score: {get_mode(a.ranking_mode).score_name}")
         if not rows:
             lines.append(f"  no ranking: {a.headline}")
         width = max((len(r.vut) for r in rows), default=0)

@@ -33,6 +33,7 @@ from sumo_ayss.analysis.measure_ranking import (
     r157_rows,
 )
 from sumo_ayss.errors import AyssError
+from sumo_ayss.modes import CROSSPLAY, EXPOSURE
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA, RunFolder, read_table
 
 __all__ = ["MEASURES_CSV", "CaseMeasures", "case_measures", "write_measures"]
@@ -89,8 +90,8 @@ class CaseMeasures:
 
 def _primary(a: CaseAnalysis) -> tuple[str, tuple[str, ...]]:
     if a.crossplay_rows:
-        return "crossplay", tuple(r.name for r in a.crossplay_rows)
-    return "exposure", tuple(r.name for r in a.exposure_rows)
+        return CROSSPLAY.name, tuple(r.name for r in a.crossplay_rows)
+    return EXPOSURE.name, tuple(r.name for r in a.exposure_rows)
 
 
 def _pool_columns(a: CaseAnalysis) -> tuple[str, dict[str, np.ndarray]] | None:

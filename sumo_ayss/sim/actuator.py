@@ -10,9 +10,6 @@ Sign convention: acceleration > 0 speeds up, < 0 brakes. Units m/s, m/s², s.
 
 from __future__ import annotations
 
-import numpy as np
-import numpy.typing as npt
-
 from sumo_ayss.config import ActuatorConfig
 
 
@@ -30,18 +27,6 @@ def pov_acceleration(speed_mps: float, target_speed_mps: float, cfg: ActuatorCon
     target = min(max(target_speed_mps, 0.0), cfg.max_speed_mps)
     accel = (target - speed_mps) / cfg.time_constant_s
     return min(max(accel, cfg.accel_min_mps2), cfg.accel_max_mps2)
-
-
-def pov_acceleration_array(
-    speed_mps: npt.ArrayLike, target_speed_mps: npt.ArrayLike, cfg: ActuatorConfig
-) -> npt.NDArray[np.float64]:
-    """Vectorised :func:`pov_acceleration` (same law, elementwise)."""
-    if cfg.mode == "highway_env":
-        v_target = np.asarray(target_speed_mps, dtype=float)
-        return (v_target - np.asarray(speed_mps, dtype=float)) / cfg.time_constant_s
-    target = np.clip(np.asarray(target_speed_mps, dtype=float), 0.0, cfg.max_speed_mps)
-    accel = (target - np.asarray(speed_mps, dtype=float)) / cfg.time_constant_s
-    return np.clip(accel, cfg.accel_min_mps2, cfg.accel_max_mps2)
 
 
 def next_speed(speed_mps: float, accel_mps2: float, dt_s: float, cfg: ActuatorConfig) -> float:

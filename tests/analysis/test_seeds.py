@@ -127,7 +127,7 @@ def test_kendall_tau():
 
 
 def test_verdict_sentence_states_amount_with_its_interval():
-    from sumo_ayss.analysis.seeds import verdict_sentence
+    from sumo_ayss.modes.seed_level import verdict_sentence
 
     safe, risky = _scores("safe", [9.0, 10.1, 8.0]), _scores("risky", [11.0, 12.2, 10.1])
     c = compare_seeds(safe, risky)

@@ -49,10 +49,10 @@ def test_t_quantile_symmetry_and_median() -> None:
 
 
 def test_t_quantile_general_path_matches_closed_forms() -> None:
-    # df = 1 and 2 use closed forms; a hair off them goes through the incomplete beta.
+    # Continuity of scipy.stats.t around df = 1 and 2 (closed forms in some implementations).
     assert t_quantile(0.975, 1 + 1e-9) == pytest.approx(t_quantile(0.975, 1), abs=1e-6)
     assert t_quantile(0.975, 2 + 1e-9) == pytest.approx(t_quantile(0.975, 2), abs=1e-6)
-    # Continuity at the switch to the Cornish-Fisher expansion.
+    # Continuity at large df.
     assert t_quantile(0.975, 99_999) == pytest.approx(t_quantile(0.975, 100_001), abs=1e-8)
 
 

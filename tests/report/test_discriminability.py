@@ -11,7 +11,7 @@ from sumo_ayss.analysis.discriminability import BoxGrid, compare_responses
 from sumo_ayss.discriminability import JSON_NAME, write_outputs
 from sumo_ayss.report import write_report
 from sumo_ayss.report.blocks import FigureBlock, Table
-from sumo_ayss.report.discriminability import discriminability_blocks, read_record
+from sumo_ayss.report.sections.discriminability import discriminability_blocks, read_record
 from tests.report.test_report import FAST, make_run
 
 

@@ -150,7 +150,7 @@ def test_braking_crashes_more_than_holding_on_the_same_scenarios(cf_env_7: CarFo
 
 # --------------------------------------------------------------------------- evaluate CLI
 
-#: tests/test_train.py's tiny learner: small nets, 600 steps, a candidate every 200.
+#: tests/training/test_train.py's tiny learner: small nets, 600 steps, a candidate every 200.
 TINY = tiny_experiment()
 
 

@@ -12,16 +12,22 @@ from pathlib import Path
 
 import numpy as np
 
-from sumo_ayss.analysis.case import CaseAnalysis, premise_sentence, seed_ranking_line
+from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.config.report import ReportOptions
+from sumo_ayss.modes import get_mode
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragraph, Table
-from sumo_ayss.report.discriminability import discriminability_blocks
 from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.crossplay import crossplay_blocks
+from sumo_ayss.report.sections.discriminability import discriminability_blocks
 from sumo_ayss.report.sections.measures import measures_blocks
-from sumo_ayss.report.sections.outcome import exposure_blocks, outcome_blocks, premise_blocks
+from sumo_ayss.report.sections.outcome import (
+    exposure_blocks,
+    outcome_blocks,
+    premise_blocks,
+    premise_sentence,
+)
 from sumo_ayss.report.sections.paper import paper_blocks
 
 __all__ = ["case_blocks", "verdict_lines"]
@@ -57,14 +63,9 @@ def verdict_lines(a: CaseAnalysis, options: ReportOptions) -> tuple[str, ...]:
     lines = [a.headline]
     if a.ranking_line:
         lines.append(f"Ranking ({a.ranking_mode} mode), safest first: {a.ranking_line}")
-    if a.ranking_mode == "crossplay" and a.exposure_rows:
-        lines.append(f"Ranking (exposure mode), safest first: {seed_ranking_line(a.exposure_rows)}")
+    lines += get_mode(a.ranking_mode).companion_lines(a)
     lines.append(premise_sentence(a.premise, options))
-    if a.mode != "paper":
-        paper = a.paper_headline
-        if a.paper_ranking_line:
-            paper += f" Ranking (paper mode): {a.paper_ranking_line}."
-        lines.append(paper)
+    lines += get_mode(a.mode).closing_lines(a)
     return tuple(lines)
 
 

@@ -6,10 +6,11 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis
-from sumo_ayss.analysis.crossplay import crossplay_sentence
 from sumo_ayss.analysis.formatting import fmt_num, fmt_p
 from sumo_ayss.analysis.seed_intervals import seed_interval_text
 from sumo_ayss.config.report import ReportOptions
+from sumo_ayss.modes import CROSSPLAY
+from sumo_ayss.modes.crossplay import crossplay_sentence
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -86,7 +87,7 @@ def crossplay_blocks(
             f"ranking. Table: {where}.",
         )
     )
-    outcomes = a.outcomes.get("crossplay", {})
+    outcomes = a.outcomes.get(CROSSPLAY.name, {})
     rows = []
     for r in a.crossplay_rows:
         nxt = r.vs_next

@@ -5,11 +5,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
-from sumo_ayss.analysis.case import CaseAnalysis, exposure_sentence, premise_sentence
+from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.formatting import fmt_num, fmt_p
+from sumo_ayss.analysis.premise import Premise
 from sumo_ayss.analysis.seed_intervals import seed_interval_text
 from sumo_ayss.cases import OUTCOME_COLUMNS
-from sumo_ayss.config.report import MODES, ReportOptions
+from sumo_ayss.config.report import ReportOptions
+from sumo_ayss.modes import EXPOSURE
+from sumo_ayss.modes.exposure import exposure_sentence
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -103,6 +106,31 @@ def outcome_blocks(a: CaseAnalysis) -> list[Block]:
     return blocks
 
 
+def premise_sentence(premise: Premise | None, options: ReportOptions) -> str:
+    """One sentence: did the SPCPs reach the same overall outcome?"""
+    if premise is None or not premise.metrics:
+        return "Premise check: needs outcome summaries of at least two VUTs."
+    parts = []
+    for m in premise.metrics:
+        unit = f" {m.spec.unit}" if m.spec.unit else ""
+        parts.append(
+            f"{m.spec.name} spread {fmt_num(m.spread * m.spec.scale)}{unit} "
+            f"(tolerance {fmt_num(m.tolerance * m.spec.scale)}{unit}"
+            f"{'' if m.met else ', exceeded'})"
+        )
+    if premise.met:
+        return (
+            "Premise met: the SPCPs of all VUTs reached the same overall outcome within the "
+            "stated tolerances (" + "; ".join(parts) + ")."
+        )
+    return (
+        "Premise NOT met: the SPCPs of different VUTs did not reach the same overall outcome ("
+        + "; ".join(parts)
+        + "), so a comparison of their aggressiveness (paper mode) is confounded by the "
+        "difference in outcome."
+    )
+
+
 def premise_blocks(a: CaseAnalysis, options: ReportOptions) -> list[Block]:
     blocks: list[Block] = [Heading("(e) Premise check: the same overall outcome?", 3)]
     premise = a.premise
@@ -157,12 +185,12 @@ def exposure_blocks(
     a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
     blocks: list[Block] = [Heading("(f) Exposure ranking", 3)]
-    blocks.append(Paragraph(MODES["exposure"]))
+    blocks.append(Paragraph(EXPOSURE.description))
     if not a.exposure_rows:
         return [*blocks, Paragraph("No exposure: no outcome summaries in this case yet.")]
     pct = f"{100 * options.level:g} %"
     scores = a.exposure_scores
-    outcomes = a.outcomes.get("exposure", {})
+    outcomes = a.outcomes.get(EXPOSURE.name, {})
     path = seed_scores_figure(
         a.exposure_rows,
         scores,

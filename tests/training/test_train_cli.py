@@ -19,7 +19,7 @@ from sumo_ayss.errors import CheckpointError
 from sumo_ayss.run_folder import RunConfig, RunFolder, write_run_config
 from sumo_ayss.train import main
 from sumo_ayss.training.config_check import check_same_config, config_differences
-from tests.test_train import tiny_config
+from tests.training.test_train import tiny_config
 
 
 def test_train_without_config_refuses_and_names_the_paper_configs(tmp_path: Path) -> None:

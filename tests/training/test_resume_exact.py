@@ -2,8 +2,8 @@
 
 The kill is simulated in-process by a BaseException raised from SB3's step callback (the
 files on disk are then exactly what a SIGKILL at that step leaves, every write being
-atomic); ``tests/test_train.py`` kills a real process. Compared: every eval.csv row (but its
-wall-clock time) and the selected SPCP.
+atomic); ``tests/training/test_train.py`` kills a real process. Compared: every eval.csv
+row (but its wall-clock time) and the selected SPCP.
 """
 
 from __future__ import annotations
@@ -17,7 +17,8 @@ import yaml
 
 from sumo_ayss.config import ExperimentConfig, load_experiment
 from sumo_ayss.run_folder import read_eval_table
-from sumo_ayss.train import _CandidateCallback, train
+from sumo_ayss.train import train
+from sumo_ayss.training.callback import CandidateCallback
 from tests.helpers import TINY_AGENT
 
 pytestmark = pytest.mark.sumo
@@ -59,15 +60,15 @@ def _spcp(run: Path) -> tuple[Any, Any]:
 def _killed_then_resumed(
     cfg: ExperimentConfig, out: Path, kill_at: int, monkeypatch: pytest.MonkeyPatch
 ) -> Path:
-    original = _CandidateCallback._on_step
+    original = CandidateCallback._on_step
 
-    def on_step(self: _CandidateCallback) -> bool:
+    def on_step(self: CandidateCallback) -> bool:
         if self.num_timesteps >= kill_at:
             raise _Killed
         return original(self)
 
     with monkeypatch.context() as m:
-        m.setattr(_CandidateCallback, "_on_step", on_step)
+        m.setattr(CandidateCallback, "_on_step", on_step)
         with pytest.raises(_Killed):
             train(cfg, seed=0, out=out)
     return train(cfg, seed=0, out=out, resume=True)
@@ -121,15 +122,15 @@ def test_leftovers_of_a_killed_checkpoint_are_cleaned_up(
 ) -> None:
     cfg = _config(tmp_path, total=400, every=200)
     out = tmp_path / "runs"
-    original = _CandidateCallback._on_step
+    original = CandidateCallback._on_step
 
-    def on_step(self: _CandidateCallback) -> bool:
+    def on_step(self: CandidateCallback) -> bool:
         if self.num_timesteps >= 300:
             raise _Killed
         return original(self)
 
     with monkeypatch.context() as m:
-        m.setattr(_CandidateCallback, "_on_step", on_step)
+        m.setattr(CandidateCallback, "_on_step", on_step)
         with pytest.raises(_Killed):
             train(cfg, seed=0, out=out)
     run = out / "car_following" / "pi1" / "seed_0"

@@ -94,7 +94,7 @@ def test_sigkilled_training_resumes_and_keeps_earlier_candidates(tmp_path: Path)
     assert done.returncode == 0, done.stderr[-2000:]
     rows = read_eval_table(run / "eval.csv")
     steps = [r["step"] for r in rows]
-    # The resumed run ends where the uninterrupted one would (tests/test_resume_exact.py).
+    # The resumed run ends where the uninterrupted one would (tests/training/test_resume_exact.py).
     assert steps == sorted(set(steps)) and steps[-1] == 2400
     assert len(rows) == 8  # one candidate per 300 steps, none lost, none doubled
     for path, data in before.items():  # candidates written before the kill are kept as-is

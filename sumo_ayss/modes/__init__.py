@@ -1,0 +1,52 @@
+"""The ranking-mode registry: one :class:`Mode` record per way of ranking VUTs, one module
+per mode, registered the way :mod:`sumo_ayss.cases` registers cases.
+
+A mode decides how a case's VUTs are scored, ranked and compared, and how its verdicts
+read: ``crossplay`` (default; every SPCP against every VUT), ``exposure`` (each VUT's own
+SPCPs) and ``paper`` (the paper's AYSS safety index). The rest of the package asks the
+registry (``get_mode(options.mode).standings(analysis)``) instead of branching on mode
+names: the configuration validates ``report.mode`` against it, the analysis sets the
+headline through :attr:`Mode.headline`, ``rank`` writes ``ranking.csv`` from
+:attr:`Mode.standings`, the report's leaderboard and verdict callout read the mode's hooks,
+and the pipeline runs the cross-play stage when :attr:`Mode.runs_crossplay`.
+
+Layering: like the case records, this package imports only the standard library, the
+error tree and the range checks at module level (the configuration reads it without numpy);
+its hooks import :mod:`sumo_ayss.analysis` when called, and nothing above it.
+
+Adding a mode: one module here that calls :func:`register_mode` with its record, imported
+below (rows of the modes follow in registry order).
+"""
+
+from __future__ import annotations
+
+# The built-in modes, registered in import order (ranking rows follow it).
+from sumo_ayss.modes.crossplay import CROSSPLAY
+from sumo_ayss.modes.exposure import EXPOSURE
+from sumo_ayss.modes.paper import PAPER
+from sumo_ayss.modes.registry import (
+    Mode,
+    Standing,
+    get_mode,
+    mode_names,
+    register_mode,
+    registered_modes,
+    unregister_mode,
+)
+
+#: The mode of a report and a ranking unless ``report.mode`` says otherwise.
+DEFAULT_MODE = CROSSPLAY.name
+
+__all__ = [
+    "CROSSPLAY",
+    "DEFAULT_MODE",
+    "EXPOSURE",
+    "PAPER",
+    "Mode",
+    "Standing",
+    "get_mode",
+    "mode_names",
+    "register_mode",
+    "registered_modes",
+    "unregister_mode",
+]

@@ -1,0 +1,125 @@
+"""Cross-play mode (the default): every SPCP of a case against every VUT; a VUT's score is
+the mean harm per episode the pooled SPCPs bring about (:mod:`sumo_ayss.analysis.crossplay`).
+
+Needs the case's ``crossplay.csv`` (the pipeline runs the cross-play stage in this mode);
+without it the headline falls back to the exposure mode's and says so.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from sumo_ayss.modes.registry import Mode, Standing, register_mode
+from sumo_ayss.modes.seed_level import (
+    INTERVAL_NAME,
+    paper_verdict_lines,
+    seed_ends,
+    seed_interval,
+    seed_score_text,
+    seed_standings,
+)
+
+if TYPE_CHECKING:
+    from sumo_ayss.analysis.case import CaseAnalysis
+    from sumo_ayss.analysis.seeds import SeedComparison
+
+__all__ = ["CROSSPLAY", "crossplay_headline", "crossplay_sentence"]
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.3f}".replace("-", "−")
+
+
+def crossplay_sentence(c: SeedComparison, blocks: str = "seed") -> str:
+    """One quotable sentence for a cross-play comparison (A ranked above B)."""
+    unit = "training seeds (blocks of opponents)" if blocks == "seed" else "opponent SPCPs"
+    pct = f"{100 * c.level:g} %"
+    b_higher = c.difference < 0
+    lo, hi = (-c.hi, -c.lo) if b_higher else (c.lo, c.hi)
+    if math.isfinite(lo) and math.isfinite(hi):
+        ci = f"{_fmt(lo)}–{_fmt(hi)}" if lo >= 0 else f"{_fmt(lo)} to {_fmt(hi)}"
+    else:
+        ci = "interval undefined"
+    if not math.isfinite(c.p):
+        p = "p undefined"
+    else:
+        p = "p < 0.001" if c.p < 0.001 else f"p = {c.p:.3f}"
+    stats = f"{pct} CI {ci}; paired t-test over {c.n_a} {unit}, {p}"
+    more = "more" if b_higher else "less"
+    what = (
+        f"the pooled SPCPs bring about {abs(c.difference):.3f} {more} harm per episode "
+        f"against {c.name_b} than against {c.name_a}"
+    )
+    if c.significant and c.difference < 0:
+        return f"[crossplay mode] {c.name_a} is safer than {c.name_b}: {what} ({stats})."
+    return (
+        f"[crossplay mode] No significant difference in safety between {c.name_a} and "
+        f"{c.name_b}: {what} ({stats})."
+    )
+
+
+def crossplay_headline(out: CaseAnalysis) -> None:
+    """Headline and ranking line of the cross-play mode; without a table, the exposure
+    mode's, after a sentence that says so."""
+    from sumo_ayss.analysis.seeds import seed_ranking_line
+    from sumo_ayss.modes.exposure import EXPOSURE, exposure_headline
+
+    rows = out.crossplay_rows
+    if len(rows) < 2 or rows[0].vs_next is None:
+        exposure_headline(out)
+        out.ranking_mode = EXPOSURE.name
+        reason = out.crossplay_missing or "the cross-play table ranks fewer than two VUTs"
+        out.headline = f"[crossplay mode] {reason}. Shown instead, labelled: {out.headline}"
+        out.headline_kind = "warning"
+        return
+    top = rows[0].vs_next
+    out.headline = crossplay_sentence(top, out.crossplay_blocks)
+    out.headline_kind = "safer" if top.significant else "none"
+    out.ranking_line = seed_ranking_line(rows)
+
+
+def _standings(a: CaseAnalysis) -> list[Standing]:
+    return seed_standings(a.crossplay_rows, lambda c: crossplay_sentence(c, a.crossplay_blocks))
+
+
+def _companion_lines(a: CaseAnalysis) -> list[str]:
+    """The exposure ranking beside the cross-play one."""
+    from sumo_ayss.analysis.seeds import seed_ranking_line
+
+    if not a.exposure_rows:
+        return []
+    return [f"Ranking (exposure mode), safest first: {seed_ranking_line(a.exposure_rows)}"]
+
+
+CROSSPLAY = register_mode(
+    Mode(
+        name="crossplay",
+        description=(
+            "Cross-play mode (default): every SPCP of a case drives against every VUT of the "
+            "case on the same outcome scenarios; a VUT's score H is the mean harm per episode "
+            "this pooled population of opponents brings about against it (1 for a collision, "
+            "else the near-miss reward paid over the most an episode can pay), and a lower H "
+            "is a safer VUT. A collision is the worst outcome for the VUT, never its gain. A "
+            "difference between two VUTs is read within each opponent, so the search noise "
+            "of one SPCP cancels; two VUTs are compared by a paired t-test over "
+            "training-seed blocks (block s = the mean over seed s's opponents; "
+            "report.crossplay_blocks: opponent makes every opponent a block); significant "
+            "when p < alpha. Crash rate and mobility (mean VUT speed) stand beside the "
+            "score; a VUT far slower than the others is flagged TIMID."
+        ),
+        score_name="cross-play harm H per episode (lower = safer)",
+        interval_name=INTERVAL_NAME,
+        digits=3,
+        available=lambda a: bool(a.crossplay_rows),
+        standings=_standings,
+        headline=crossplay_headline,
+        unit=lambda a: "harm/episode, pooled SPCPs (lower = safer)",
+        ends=lambda a, safest, least: seed_ends(a.crossplay_pairs, safest, least),
+        score_text=seed_score_text,
+        interval_text=seed_interval,
+        companion_lines=_companion_lines,
+        closing_lines=paper_verdict_lines,
+        runs_crossplay=True,
+    )
+)

@@ -1,0 +1,179 @@
+"""The ranking-mode record, its registry and the uniform standing a mode ranks by (see
+:mod:`sumo_ayss.modes`).
+
+Standard library, :mod:`sumo_ayss.errors` and :mod:`sumo_ayss.validation` only: the
+configuration validates ``report.mode`` against this registry without loading numpy.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from sumo_ayss.errors import ConfigError
+from sumo_ayss.validation import require, suggest
+
+if TYPE_CHECKING:
+    from sumo_ayss.analysis.case import CaseAnalysis
+
+__all__ = [
+    "Mode",
+    "Standing",
+    "get_mode",
+    "mode_names",
+    "register_mode",
+    "registered_modes",
+    "unregister_mode",
+]
+
+_NAME = re.compile(r"[a-z][a-z0-9_]*")
+
+
+@dataclass(frozen=True)
+class Standing:
+    """One VUT's place in one mode's ranking of a case, the same shape in every mode.
+
+    Attributes:
+        rank: 1 for the safest.
+        vut: VUT name.
+        score: The mode's score (its unit: :attr:`Mode.unit`).
+        lo: Lower bound of the score's interval (NaN where there is none).
+        hi: Upper bound.
+        n_seeds: Training seeds (or blocks) behind the score.
+        next_vut: The VUT ranked next, None for the last.
+        significant: The mode's verdict against ``next_vut`` (significantly safer or not);
+            None for the last, or when the two are not comparable.
+        ranked_apart: Whether the ranking itself separates this VUT from the next (the
+            order check counts these adjacent pairs).
+        p: p-value of the mode's test against ``next_vut``; None without a test.
+        test: The test's name (``"paired t"``, ``"Welch t"``, ``"none"``); "" without one.
+        n_a: Seeds of this VUT in that test.
+        n_b: Seeds of the next VUT in that test.
+        vs_next: The verdict sentence against ``next_vut``; "" for the last.
+    """
+
+    rank: int
+    vut: str
+    score: float
+    lo: float
+    hi: float
+    n_seeds: int
+    next_vut: str | None
+    significant: bool | None
+    ranked_apart: bool
+    p: float | None = None
+    test: str = ""
+    n_a: int = 0
+    n_b: int = 0
+    vs_next: str = ""
+
+
+@dataclass(frozen=True)
+class Mode:
+    """A ranking mode: how a case's VUTs are scored, ranked and compared, and how that reads.
+
+    The hooks read a :class:`~sumo_ayss.analysis.case.CaseAnalysis`; a mode module imports
+    what they need inside them, so that this record stays light.
+
+    Attributes:
+        name: The mode's name in ``report.mode``, ``--mode`` and ``ranking.csv``.
+        description: The paragraph the report writes about the mode.
+        score_name: What the score is, with its orientation (leaderboard, terminal).
+        interval_name: What the score's interval is (leaderboard footnote).
+        digits: Decimals of the score in ``ranking.md``.
+        runs_crossplay: The pipeline runs the cross-play stage before the report.
+        needs_safety_index: Ranking in this mode needs the AYSS safety indices (the slow
+            bootstrap); a ranking in another mode skips them.
+        available: Whether the mode has a ranking of this case.
+        standings: The case's ranking in this mode, safest first.
+        headline: Sets the analysis's ``headline``, ``headline_kind``, ``ranking_line`` and
+            ``ranking_mode`` when this mode was asked for (called after every mode's data is
+            computed and ``headline`` holds the paper mode's).
+        unit: The score's unit text in ``ranking.csv`` and ``ranking.md``.
+        ends: ``(found, p)`` for a known safest and least safe VUT: whether this mode
+            finds the first significantly safer than the second, and the p-value (NaN when
+            the mode has none).
+        score_text: The score with its interval as the leaderboard writes it.
+        interval_text: ``(lo, hi, n_seeds, digits)`` -> the interval as ``ranking.md``
+            writes it ("" without one).
+        companion_lines: Verdict-callout lines after the ranking line, when this mode gave
+            the headline (e.g. the other modes' rankings).
+        closing_lines: Verdict-callout lines after the premise check, when this mode was
+            asked for.
+    """
+
+    name: str
+    description: str
+    score_name: str
+    interval_name: str
+    digits: int
+    available: Callable[[CaseAnalysis], bool]
+    standings: Callable[[CaseAnalysis], list[Standing]]
+    headline: Callable[[CaseAnalysis], None]
+    unit: Callable[[CaseAnalysis], str]
+    ends: Callable[[CaseAnalysis, str, str], tuple[bool, float]]
+    score_text: Callable[[CaseAnalysis, Standing], str]
+    interval_text: Callable[[float, float, int, int], str]
+    companion_lines: Callable[[CaseAnalysis], list[str]]
+    closing_lines: Callable[[CaseAnalysis], list[str]]
+    runs_crossplay: bool = False
+    needs_safety_index: bool = False
+
+    def __post_init__(self) -> None:
+        require(
+            isinstance(self.name, str) and _NAME.fullmatch(self.name) is not None,
+            f"mode name must be lower-case letters, digits and '_', got {self.name!r}",
+        )
+
+
+# --------------------------------------------------------------------------- the registry
+
+_REGISTRY: dict[str, Mode] = {}
+
+
+def register_mode(mode: Mode, *, replace: bool = False) -> Mode:
+    """Add ``mode`` to the registry (in order: its rows follow the earlier modes') and
+    return it. Registering the same record again is a no-op; another record under a known
+    name needs ``replace=True``.
+
+    Raises:
+        ConfigError: If the name is taken by another record.
+    """
+    old = _REGISTRY.get(mode.name)
+    require(
+        old is None or old == mode or replace,
+        f"mode {mode.name!r} is already registered (pass replace=True to replace it)",
+    )
+    _REGISTRY[mode.name] = mode
+    return mode
+
+
+def unregister_mode(name: str) -> Mode:
+    """Remove a registered mode (tests, plugins) and return its record."""
+    return _REGISTRY.pop(get_mode(name).name)
+
+
+def get_mode(name: str) -> Mode:
+    """The registered mode ``name``.
+
+    Raises:
+        ConfigError: Naming the registered modes, if ``name`` is none of them.
+    """
+    mode = _REGISTRY.get(name) if isinstance(name, str) else None
+    if mode is None:
+        names = mode_names()
+        hint = suggest(name, names) if isinstance(name, str) else ""
+        raise ConfigError(f"unknown mode {name!r}{hint}; allowed: {list(names)}")
+    return mode
+
+
+def mode_names() -> tuple[str, ...]:
+    """The registered modes' names, in registry order."""
+    return tuple(_REGISTRY)
+
+
+def registered_modes() -> tuple[Mode, ...]:
+    """The registered modes, in registry order."""
+    return tuple(_REGISTRY.values())

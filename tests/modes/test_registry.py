@@ -1,0 +1,72 @@
+"""The ranking-mode registry: the built-in modes, lookups, and a mode added as a plug-in."""
+
+from __future__ import annotations
+
+import dataclasses
+import subprocess
+import sys
+
+import pytest
+
+from sumo_ayss.config.report import ReportOptions
+from sumo_ayss.errors import ConfigError
+from sumo_ayss.modes import (
+    CROSSPLAY,
+    DEFAULT_MODE,
+    EXPOSURE,
+    PAPER,
+    get_mode,
+    mode_names,
+    register_mode,
+    unregister_mode,
+)
+from sumo_ayss.rank import analyse, ranking_rows
+from tests.report.test_report import make_run
+
+
+def test_built_in_modes_in_registry_order_with_the_default_first() -> None:
+    assert mode_names()[:3] == ("crossplay", "exposure", "paper")
+    assert DEFAULT_MODE == CROSSPLAY.name == ReportOptions().mode
+    assert get_mode("paper") is PAPER
+    assert CROSSPLAY.runs_crossplay and not EXPOSURE.runs_crossplay
+    assert PAPER.needs_safety_index and not CROSSPLAY.needs_safety_index
+
+
+def test_an_unknown_mode_is_refused_with_the_registered_ones_named() -> None:
+    with pytest.raises(ConfigError, match=r"unknown mode 'exposur'.*'exposure'"):
+        get_mode("exposur")
+    with pytest.raises(ConfigError, match=r"report\.mode must be one of"):
+        ReportOptions(mode="nonsense")
+
+
+def test_registering_another_record_under_a_taken_name_needs_replace() -> None:
+    with pytest.raises(ConfigError, match="already registered"):
+        register_mode(dataclasses.replace(EXPOSURE, digits=4))
+    assert register_mode(EXPOSURE) is EXPOSURE  # the same record again: a no-op
+
+
+def test_a_new_mode_is_one_record_that_config_and_rank_pick_up(tmp_path) -> None:
+    """A mode registered at run time (here: exposure's ranking under another name and
+    unit) is accepted by ``report.mode``, heads the ranking and tags its rows."""
+    mode = dataclasses.replace(EXPOSURE, name="own_harm", unit=lambda a: "harm (plug-in)")
+    register_mode(mode)
+    try:
+        dirs = [make_run(tmp_path, "car_following", v, s) for v in ("pi1", "pi2") for s in (0, 1)]
+        rows = ranking_rows(analyse(dirs, ReportOptions(mode="own_harm", n_boot=50)))
+        assert [r["mode"] for r in rows] == ["own_harm"] * 2 + ["exposure"] * 2
+        assert {r["unit"] for r in rows[:2]} == {"harm (plug-in)"}
+        assert [r["vut"] for r in rows[:2]] == [r["vut"] for r in rows[2:]]
+    finally:
+        unregister_mode("own_harm")
+    assert "own_harm" not in mode_names()
+
+
+def test_the_registry_loads_without_the_analysis() -> None:
+    """The configuration validates ``report.mode`` here: importing it stays light (the
+    hooks import the analysis, and scipy with it, when called)."""
+    code = (
+        "import sys, sumo_ayss.modes; "
+        "print(sorted(m for m in ('scipy', 'sumo_ayss.analysis') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
