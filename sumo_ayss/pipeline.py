@@ -194,7 +194,7 @@ def final_messages(result: PipelineResult) -> list[str]:
 
         training = {r.path: r.training for r in result.runs}
         runs = [(s.spec.name, training[Path(s.spec.run_dir).resolve()]) for s in done]
-        seeds = fewest_seeds((s.spec.case, s.spec.vut) for s in done)
+        seeds = fewest_seeds((r.case, r.vut) for r in result.runs)
         lines += [f"WARNING: {w}" for w in trust_warnings(runs, seeds)]
     if result.report is not None:
         lines.append(f"report: {result.report}")
