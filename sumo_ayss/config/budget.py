@@ -5,11 +5,13 @@ A pipeline's ``budget`` names one of :data:`BUDGETS`; the pipeline's own ``total
 every experiment's ``train`` section as its file says (the behaviour before budgets).
 
 * ``verdict`` (the default): 20,000 transitions per run, a candidate every 5,000, four
-  training seeds per VUT. Chosen from the verdict's learning curve (docs/performance.md,
-  ``scripts/verdict_curve.py``): on the braking and ACC ladders (six seeds each, every
-  4-seed subset) the cross-play ranking had Kendall τ = 1 with significant ends in both
-  cases from 10,000 transitions on with four seeds, where three seeds at 100,000 (the paper's
-  budget) took about 3.5 times the CPU-seconds.
+  training seeds per VUT, 20,000 AYSS draws. Chosen from the verdict's learning curve
+  (docs/performance.md, ``scripts/verdict_curve.py``): on the braking and ACC ladders (six
+  seeds each, every 4-seed subset) the cross-play ranking had Kendall τ = 1 with significant
+  ends in both cases at 20,000 transitions with four seeds, at under a third of the
+  CPU-seconds of three seeds at 100,000 (the paper's budget); checked with real runs on
+  fresh seeds of every ladder. The AYSS draws feed only the paper's reading (``report.mode:
+  paper``), not the cross-play verdict; that reading wants the paper budget.
 * ``paper``: the paper's protocol, 100,000 transitions, a candidate every 10,000, three
   seeds: what every committed study before budgets ran.
 
@@ -35,18 +37,22 @@ class Budget:
         eval_every: Transitions between two SPCP candidates (``train.eval_every``).
         seeds: Training seeds per VUT when ``grid.seeds`` is not given (seeds 0 .. n-1).
         summary: One line for help texts and the benchmark.
+        n_ayss: AYSS Monte Carlo draws per run when neither ``evaluate.n_ayss`` nor
+            ``evaluate.ayss.n_samples`` is given; None: the AYSS section's default (100,000).
     """
 
     total_timesteps: int
     eval_every: int
     seeds: int
     summary: str
+    n_ayss: int | None = None
 
     def describe(self) -> str:
         """``"20,000 transitions, a candidate every 5,000, 4 seeds per VUT: ..."``."""
+        ayss = "" if self.n_ayss is None else f", {self.n_ayss:,} AYSS draws"
         return (
             f"{self.total_timesteps:,} transitions, a candidate every {self.eval_every:,}, "
-            f"{self.seeds} seeds per VUT: {self.summary}"
+            f"{self.seeds} seeds per VUT{ayss}: {self.summary}"
         )
 
 
@@ -57,6 +63,7 @@ BUDGETS: Mapping[str, Budget] = MappingProxyType(
             5_000,
             4,
             "the least compute that ranked every ladder right (issue 26, docs/performance.md)",
+            n_ayss=20_000,
         ),
         "paper": Budget(100_000, 10_000, 3, "the paper's protocol"),
     }

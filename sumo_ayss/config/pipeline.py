@@ -118,6 +118,15 @@ class PipelineConfig:
                 object.__setattr__(self, "total_timesteps", b.total_timesteps)
             if self.eval_every is None:
                 object.__setattr__(self, "eval_every", b.eval_every)
+            ev = self.evaluate
+            if (
+                b.n_ayss is not None
+                and ev.n_ayss is None
+                and ev.ayss.n_samples == AyssConfig().n_samples
+            ):
+                ayss = dataclasses.replace(ev.ayss, n_samples=b.n_ayss)
+                evaluate = dataclasses.replace(ev, n_ayss=b.n_ayss, ayss=ayss)
+                object.__setattr__(self, "evaluate", evaluate)
         if self.grid.seeds is None:
             n = BUDGETS[self.budget].seeds if self.budget is not None else 3
             object.__setattr__(self, "grid", dataclasses.replace(self.grid, seeds=tuple(range(n))))

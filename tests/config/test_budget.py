@@ -98,3 +98,13 @@ def test_committed_studies_still_train_what_they_ran(config: str) -> None:
     total, every, seeds = _trained(path)
     assert (total, every, len(seeds)) == ({100_000}, {10_000}, 3)
     assert seeds == tuple(sorted(yaml.safe_load(path.read_text())["grid"]["seeds"]))
+
+
+def test_the_verdict_budget_draws_fewer_ayss_samples_unless_told(tmp_path: Path) -> None:
+    verdict = load_pipeline(_yaml(tmp_path))
+    assert verdict.evaluate.ayss.n_samples == BUDGETS["verdict"].n_ayss == 20_000
+    assert load_pipeline(_yaml(tmp_path, budget="paper")).evaluate.ayss.n_samples == 100_000
+    told = load_pipeline(_yaml(tmp_path, evaluate={"n_ayss": 5000}))
+    assert told.evaluate.ayss.n_samples == 5000
+    told = load_pipeline(_yaml(tmp_path, evaluate={"ayss": {"n_samples": 7000}}))
+    assert told.evaluate.ayss.n_samples == 7000
