@@ -91,8 +91,9 @@ class PipelineConfig:
     out: Path = Path("runs") / "paper"
     budget: str | None = DEFAULT_BUDGET
     """A named budget (:data:`~sumo_ayss.config.budget.BUDGETS`: ``verdict``, the default, or
-    ``paper``) that sets ``total_timesteps``, ``eval_every`` and ``grid.seeds`` where they are
-    not given; None: every experiment's ``train`` section as its file says."""
+    ``paper``) that sets ``total_timesteps``, ``eval_every``, ``grid.seeds`` and the AYSS
+    draws where they are not given; None: every experiment's ``train`` section as its file
+    says."""
     total_timesteps: int | None = None
     """Transitions per run for every experiment; None: the budget's (or the experiment's)."""
     eval_every: int | None = None
