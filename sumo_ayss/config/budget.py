@@ -9,9 +9,12 @@ every experiment's ``train`` section as its file says (the behaviour before budg
   (docs/performance.md, ``scripts/verdict_curve.py``): on the braking and ACC ladders (six
   seeds each, every 4-seed subset) the cross-play ranking had Kendall τ = 1 with significant
   ends in both cases at 20,000 transitions with four seeds, at under a third of the
-  CPU-seconds of three seeds at 100,000 (the paper's budget); checked with real runs on
-  fresh seeds of every ladder. The AYSS draws feed only the paper's reading (``report.mode:
-  paper``), not the cross-play verdict; that reading wants the paper budget.
+  CPU-seconds of three seeds at 100,000 (the paper's budget). Real runs on fresh seeds
+  ordered every ladder right (τ = 1) with significant ends on all but one ladder-case
+  (minGap, car-following: p 0.11 with 4 seeds, 0.012 with 6): more seeds, not more
+  transitions, is the lever when the ends are not significant. The AYSS draws feed only the
+  paper's reading (``report.mode: paper``), not the cross-play verdict; that reading wants
+  the paper budget.
 * ``paper``: the paper's protocol, 100,000 transitions, a candidate every 10,000, three
   seeds: what every committed study before budgets ran.
 
@@ -62,7 +65,7 @@ BUDGETS: Mapping[str, Budget] = MappingProxyType(
             20_000,
             5_000,
             4,
-            "the least compute that ranked every ladder right (issue 26, docs/performance.md)",
+            "the least compute that ordered every validation ladder right (docs/performance.md)",
             n_ayss=20_000,
         ),
         "paper": Budget(100_000, 10_000, 3, "the paper's protocol"),

@@ -44,7 +44,7 @@ if TYPE_CHECKING:
 
 TRUSTED_TIMESTEPS = min(b.total_timesteps for b in BUDGETS.values())
 """Training transitions per run below which verdicts are flagged as not to be trusted: the
-smallest named budget's (``verdict``, 20,000), the least that ranked every validation ladder
+smallest named budget's (``verdict``, 20,000), the least that ordered every validation ladder
 right with its seeds (docs/performance.md)."""
 
 NOISE_SE = 2.0
@@ -170,7 +170,7 @@ def trust_warnings(
         budgets = ", ".join(f"{b:,}" for b in small)
         out.append(
             f"Small training budget: {budgets} transitions per run, below the "
-            f"{TRUSTED_TIMESTEPS:,} of the smallest budget that ranked every validation "
+            f"{TRUSTED_TIMESTEPS:,} of the smallest budget that ordered every validation "
             "ladder right. The SPCPs are undertrained; the verdicts and rankings below are "
             "NOT to be trusted (a demonstration of the machinery, not a result)."
         )

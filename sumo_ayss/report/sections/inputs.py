@@ -49,7 +49,7 @@ def training_table(runs: Sequence[Run]) -> Table:
             "candidate; 'plateau' when the last candidate's mean evaluation reward is within "
             f"{NOISE_SE:g} standard errors (SE, the SPCP's std / sqrt(episodes)) of the "
             "SPCP's; 'peaked' when it is further below. Below "
-            f"{TRUSTED_TIMESTEPS:,} transitions (the smallest budget that ranked every "
+            f"{TRUSTED_TIMESTEPS:,} transitions (the smallest budget that ordered every "
             "validation ladder right, with 4 seeds per VUT) verdicts are not to be trusted."
         ),
     )
