@@ -356,10 +356,18 @@ def write_discriminability(cfg: PipelineConfig) -> None:
             logger.warning("discriminability of %s not computed: %s", case, e)
 
 
-def add_budget_flags(parser: argparse.ArgumentParser) -> None:
-    """``--total-timesteps``, ``--eval-every``, ``--n-outcome``, ``--n-ayss``: a small
-    budget without writing a YAML. They replace the config's values and are written into
-    ``pipeline.json`` and every run's ``config.yaml`` like them."""
+def add_config_flags(parser: argparse.ArgumentParser) -> None:
+    """The flags ``pipeline`` and ``rank`` share to replace parts of the config: ``--out``,
+    ``--workers``, ``--seeds``, ``--budget`` and the budget overrides ``--total-timesteps``,
+    ``--eval-every``, ``--n-outcome``, ``--n-ayss`` (a small budget without writing a YAML).
+    They are written into ``pipeline.json`` and every run's ``config.yaml`` like the YAML's
+    own values; :func:`config_from_args` applies them."""
+    parser.add_argument("--out", type=Path, default=None, help="replace the config's out")
+    parser.add_argument("--workers", type=int, default=None)
+    parser.add_argument(
+        "--seeds", type=int, nargs="+", default=None, help="replace grid.seeds (e.g. 100 101 102)"
+    )
+    parser.add_argument("--budget", choices=BUDGET_CHOICES, default=None, help=BUDGET_HELP)
     group = parser.add_argument_group(
         "budget overrides (replace the config's or the named --budget's values; written into "
         "pipeline.json and each run's config.yaml)"
@@ -376,14 +384,19 @@ def add_budget_flags(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--n-ayss", type=int, default=None, help="AYSS Monte Carlo draws per SPCP")
 
 
-def budget_overrides(args: argparse.Namespace) -> dict[str, int | None]:
-    """The budget flags of :func:`add_budget_flags` as :func:`load_pipeline` overrides."""
-    return {
-        "total_timesteps": args.total_timesteps,
-        "eval_every": args.eval_every,
-        "n_outcome": args.n_outcome,
-        "n_ayss": args.n_ayss,
-    }
+def config_from_args(args: argparse.Namespace) -> PipelineConfig:
+    """``args.config`` with the flags of :func:`add_config_flags` applied."""
+    return load_pipeline(
+        args.config,
+        out=args.out,
+        workers=args.workers,
+        seeds=args.seeds,
+        budget=args.budget,
+        total_timesteps=args.total_timesteps,
+        eval_every=args.eval_every,
+        n_outcome=args.n_outcome,
+        n_ayss=args.n_ayss,
+    )
 
 
 def main(argv: Sequence[str] | None = None) -> None:
@@ -393,12 +406,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument(
         "config", type=Path, help="pipeline YAML (configs/paper.yaml runs the paper's grid)"
     )
-    parser.add_argument("--out", type=Path, default=None)
-    parser.add_argument("--workers", type=int, default=None)
-    parser.add_argument(
-        "--seeds", type=int, nargs="+", default=None, help="replace grid.seeds (e.g. 100 101 102)"
-    )
-    parser.add_argument("--budget", choices=BUDGET_CHOICES, default=None, help=BUDGET_HELP)
+    add_config_flags(parser)
     parser.add_argument("--backend", choices=["local", "ray"], default="local")
     parser.add_argument("--address", default=None, help="Ray cluster address (ray backend)")
     parser.add_argument(
@@ -407,18 +415,10 @@ def main(argv: Sequence[str] | None = None) -> None:
         help="no live table: one log line per job event (the default when stdout is not a "
         "terminal)",
     )
-    add_budget_flags(parser)
     args = parser.parse_args(argv)
     console = configure_logging(not args.no_live)
     try:
-        cfg = load_pipeline(
-            args.config,
-            out=args.out,
-            workers=args.workers,
-            seeds=args.seeds,
-            budget=args.budget,
-            **budget_overrides(args),
-        )
+        cfg = config_from_args(args)
         result = run_pipeline(
             cfg,
             backend=args.backend,

@@ -274,13 +274,11 @@ def main(argv: Sequence[str] | None = None) -> None:
     import dataclasses
 
     from sumo_ayss.cli import prog
-    from sumo_ayss.config.budget import BUDGET_CHOICES, BUDGET_HELP
     from sumo_ayss.pipeline import (
-        add_budget_flags,
-        budget_overrides,
+        add_config_flags,
+        config_from_args,
         configure_logging,
         final_messages,
-        load_pipeline,
         plan_jobs,
         run_pipeline,
     )
@@ -294,12 +292,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         "harm the pooled SPCPs bring about; lower = safer).",
     )
     parser.add_argument("config", type=Path, help="pipeline YAML listing the VUTs to rank")
-    parser.add_argument("--workers", type=int, default=None)
-    parser.add_argument("--out", type=Path, default=None, help="replace the config's out")
-    parser.add_argument(
-        "--seeds", type=int, nargs="+", default=None, help="replace grid.seeds (e.g. 100 101 102)"
-    )
-    parser.add_argument("--budget", choices=BUDGET_CHOICES, default=None, help=BUDGET_HELP)
+    add_config_flags(parser)
     parser.add_argument(
         "--mode",
         choices=list(mode_names()),
@@ -315,19 +308,11 @@ def main(argv: Sequence[str] | None = None) -> None:
     )
     parser.add_argument("--no-live", action="store_true", help="no live table (log lines)")
     parser.add_argument("--strict", action="store_true", help=STRICT_HELP)
-    add_budget_flags(parser)
     args = parser.parse_args(argv)
     console = configure_logging(not args.no_live)
     result = None
     try:
-        cfg = load_pipeline(
-            args.config,
-            workers=args.workers,
-            out=args.out,
-            seeds=args.seeds,
-            budget=args.budget,
-            **budget_overrides(args),
-        )
+        cfg = config_from_args(args)
         if args.mode is not None:
             cfg = dataclasses.replace(cfg, report=dataclasses.replace(cfg.report, mode=args.mode))
         if args.no_run:
