@@ -36,12 +36,14 @@ from sumo_ayss.catalog import controller_imports
 from sumo_ayss.cli import prog
 from sumo_ayss.errors import AyssError, CheckpointError, TableError
 from sumo_ayss.run_folder import (
+    CROSSPLAY_SCHEMA,
     CaseFolder,
     CrossplayOpponent,
     CrossplayRecord,
     RunFolder,
     case_dir_for,
     read_crossplay_json,
+    read_table,
     run_dir_for,
     write_crossplay_json,
     write_table,
@@ -108,6 +110,10 @@ def run_case(
     csv_path, json_path = folder.crossplay_csv, folder.crossplay_json
     case = runs[0].config.env.case
     requested = CrossplayRecord(case, n, seed, pool, (), 0.0)
+    envs: dict[str, Any] = {}
+    for r in runs:
+        envs.setdefault(r.config.env.vut, r.config.env)
+    earlier = None  # a table of a smaller pool that this one extends (new seeds added)
     if not force and csv_path.is_file() and json_path.is_file():
         try:
             done = read_crossplay_json(json_path)
@@ -118,22 +124,64 @@ def run_case(
                 logger.info("%s: cross-play done with these settings and SPCPs; skipped", case_dir)
                 check_diagonal(done.diagonal, case)
                 return csv_path
-    outcomes = {(r.config.env.vut, r.seed): _outcome_table(r.run_dir, n, seed) for r in runs}
-    envs: dict[str, Any] = {}
-    for r in runs:
-        envs.setdefault(r.config.env.vut, r.config.env)
-    opponents = [Opponent(r.config.env.vut, r.seed, functools.partial(load_spcp, r)) for r in runs]
+            if done.extended_by(requested) and done.diagonal and done.vuts == tuple(envs):
+                earlier = done
+    if earlier is not None:
+        old = set(earlier.opponents)
+        runs_to_play = [r for r, o in zip(runs, pool, strict=True) if o not in old]
+        logger.info(
+            "%s: cross-play of %d new SPCPs (the table of the other %d is kept)",
+            case_dir,
+            len(runs_to_play),
+            len(old),
+        )
+    else:
+        runs_to_play = runs
+    outcomes = {
+        (r.config.env.vut, r.seed): _outcome_table(r.run_dir, n, seed) for r in runs_to_play
+    }
+    opponents = [
+        Opponent(r.config.env.vut, r.seed, functools.partial(load_spcp, r)) for r in runs_to_play
+    ]
     t0 = time.perf_counter()
     with controller_imports(trust_controller):
         table = run_crossplay(envs, opponents, n=n, seed=seed, progress=progress)
     wall_s = time.perf_counter() - t0
     checks = tuple(diagonal_check(table, v, s, out) for (v, s), out in outcomes.items())
+    if earlier is not None:
+        table = _merged(read_table(csv_path, CROSSPLAY_SCHEMA), table, tuple(envs), pool)
+        checks = _merged_checks(earlier.diagonal, checks, pool)
+        wall_s += earlier.wall_s
     folder.path.mkdir(parents=True, exist_ok=True)
     write_table(csv_path, table)
     record = dataclasses.replace(requested, vuts=tuple(envs), wall_s=wall_s, diagonal=checks)
     write_crossplay_json(json_path, record)
     check_diagonal(checks, case)
     return csv_path
+
+
+def _merged(old: Any, new: Any, vuts: tuple[str, ...], pool: tuple[Any, ...]) -> Any:
+    """The rows of ``old`` and ``new`` in the order one run over the whole pool writes them:
+    VUT, then opponent (pool order), then scenario. Each (VUT, opponent) cell is its own
+    fresh simulation, so the merged table equals that run's."""
+    from sumo_ayss.run_folder import table_from_rows
+
+    order = {(o.vut, o.seed): j for j, o in enumerate(pool)}
+    rows = [*old.rows(), *new.rows()]
+    rows.sort(
+        key=lambda r: (
+            vuts.index(r["vut"]),
+            order[(r["opponent_vut"], r["opponent_seed"])],
+            r["scenario"],
+        )
+    )
+    return table_from_rows(CROSSPLAY_SCHEMA, rows)
+
+
+def _merged_checks(old: Sequence[Any], new: Sequence[Any], pool: tuple[Any, ...]) -> tuple:
+    """The diagonal checks of both tables, in pool order."""
+    by_run = {(c.vut, c.seed): c for c in (*old, *new)}
+    return tuple(by_run[(o.vut, o.seed)] for o in pool if (o.vut, o.seed) in by_run)
 
 
 def _outcome_table(run_dir: Path, n: int, seed: int) -> Any:

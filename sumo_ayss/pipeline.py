@@ -106,44 +106,62 @@ def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
     """Resolve every job's experiment; bad grids are refused here, before any job runs.
 
     Each case's experiment file is parsed once; a job receives that frozen record with its
-    VUT set (workers never parse it again).
+    VUT set (workers never parse it again). A case's seeds are ``grid.seeds`` plus those
+    adaptive seeding already added (:func:`sumo_ayss.adaptive.case_seeds`).
     """
+    from sumo_ayss.adaptive import case_seeds
+
     jobs = []
     for case in cfg.grid.cases:
-        exp = load_experiment(cfg.experiments[case])
-        if exp.env.case != case:
-            raise ConfigError(
-                f"experiments.{case}: {cfg.experiments[case]} is a {exp.env.case!r} experiment"
-            )
-        overrides: dict[str, Any] = {"progress_bar": False}
-        if cfg.total_timesteps is not None:
-            overrides["total_timesteps"] = cfg.total_timesteps
-        if cfg.eval_every is not None:
-            overrides["eval_every"] = cfg.eval_every
-        exp = dataclasses.replace(exp, train=dataclasses.replace(exp.train, **overrides))
-        if cfg.vuts:
-            exp = dataclasses.replace(
-                exp, env=dataclasses.replace(exp.env, vuts={**exp.env.vuts, **cfg.vuts})
-            )
+        exp = _case_experiment(cfg, case)
         for vut in cfg.grid.vuts:
-            if vut not in exp.env.vuts:
-                raise ConfigError(
-                    f"grid.vuts: {vut!r} is not a VUT of the {case} experiment"
-                    f"{suggest(vut, exp.env.vuts)}; allowed: {sorted(exp.env.vuts)}"
-                )
-            for seed in cfg.seeds:
-                jobs.append(
-                    JobSpec(
-                        case=case,
-                        vut=vut,
-                        seed=int(seed),
-                        experiment=exp.with_vut(vut),
-                        out=str(cfg.out),
-                        n_outcome=cfg.evaluate.n_outcome,
-                        ayss=cfg.evaluate.ayss,
-                    )
-                )
+            for seed in case_seeds(cfg, case):
+                jobs.append(_job(cfg, exp, case, vut, seed))
     return jobs
+
+
+def plan_seed(cfg: PipelineConfig, case: str, seed: int) -> list[JobSpec]:
+    """One seed's jobs of one case, every VUT (adaptive seeding adds them)."""
+    exp = _case_experiment(cfg, case)
+    return [_job(cfg, exp, case, vut, seed) for vut in cfg.grid.vuts]
+
+
+def _job(cfg: PipelineConfig, exp: Any, case: str, vut: str, seed: int) -> JobSpec:
+    return JobSpec(
+        case=case,
+        vut=vut,
+        seed=int(seed),
+        experiment=exp.with_vut(vut),
+        out=str(cfg.out),
+        n_outcome=cfg.evaluate.n_outcome,
+        ayss=cfg.evaluate.ayss,
+    )
+
+
+def _case_experiment(cfg: PipelineConfig, case: str) -> Any:
+    """The case's experiment with the pipeline's overrides; its VUTs checked."""
+    exp = load_experiment(cfg.experiments[case])
+    if exp.env.case != case:
+        raise ConfigError(
+            f"experiments.{case}: {cfg.experiments[case]} is a {exp.env.case!r} experiment"
+        )
+    overrides: dict[str, Any] = {"progress_bar": False}
+    if cfg.total_timesteps is not None:
+        overrides["total_timesteps"] = cfg.total_timesteps
+    if cfg.eval_every is not None:
+        overrides["eval_every"] = cfg.eval_every
+    exp = dataclasses.replace(exp, train=dataclasses.replace(exp.train, **overrides))
+    if cfg.vuts:
+        exp = dataclasses.replace(
+            exp, env=dataclasses.replace(exp.env, vuts={**exp.env.vuts, **cfg.vuts})
+        )
+    for vut in cfg.grid.vuts:
+        if vut not in exp.env.vuts:
+            raise ConfigError(
+                f"grid.vuts: {vut!r} is not a VUT of the {case} experiment"
+                f"{suggest(vut, exp.env.vuts)}; allowed: {sorted(exp.env.vuts)}"
+            )
+    return exp
 
 
 def _relative_paths(data: Any, base: Path) -> Any:
@@ -239,27 +257,35 @@ def _run_locked(
 
     atomic_write_json(cfg.out / "pipeline.json", _relative_paths(to_dict(cfg), cfg.out))
     after = ", ".join(stages_after_grid(cfg))
-    if backend == "ray":
-        from sumo_ayss.ray_backend import run_grid_ray
+    if backend == "local" and live and console is None and sys.stdout.isatty():
+        from rich.console import Console
 
-        statuses = run_grid_ray(jobs, cfg.retries, address, after=after)
-    else:
-        if live and console is None and sys.stdout.isatty():
-            from rich.console import Console
+        console = Console()
 
-            console = Console()
-        statuses = run_grid_local(
-            jobs,
-            min(cfg.n_workers, len(jobs)),
+    def run_jobs(todo: list[JobSpec]) -> list[JobStatus]:
+        if backend == "ray":
+            from sumo_ayss.ray_backend import run_grid_ray
+
+            return run_grid_ray(todo, cfg.retries, address, after=after)
+        return run_grid_local(
+            todo,
+            min(cfg.n_workers, len(todo)),
             cfg.retries,
             console if live else None,
             after=after,
         )
+
+    statuses = run_jobs(jobs)
+    mode = get_mode(cfg.report.mode)
+    if mode.runs_crossplay and any(s.state == "done" for s in statuses):
+        run_crossplay_stage(cfg, statuses)
+    from sumo_ayss.adaptive import is_adaptive, run_adaptive
+
+    if is_adaptive(cfg):
+        statuses = run_adaptive(cfg, statuses, run_jobs, run_crossplay_stage, plan_seed)
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
     if not finished:
         return PipelineResult(statuses, None, [], [])
-    if get_mode(cfg.report.mode).runs_crossplay:
-        run_crossplay_stage(cfg, statuses)
     write_discriminability(cfg)
     from sumo_ayss.report.document import load_runs, write_report_for
     from sumo_ayss.report.load import analyse_runs
@@ -277,6 +303,10 @@ def stages_after_grid(cfg: PipelineConfig) -> list[str]:
     stages = ["discriminability"] if several else []
     if several and get_mode(cfg.report.mode).runs_crossplay:
         stages.append("cross-play")
+    from sumo_ayss.adaptive import is_adaptive
+
+    if is_adaptive(cfg):
+        stages.append(f"adaptive seeding (up to {cfg.max_seeds} seeds)")
     return [*stages, "the report"]
 
 
@@ -297,9 +327,15 @@ def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> l
     if len(cfg.grid.vuts) < 2:
         logger.info("cross-play skipped: the grid has one VUT (cross-play compares two or more)")
         return []
+    from sumo_ayss.adaptive import case_seeds
+
     written = []
     for case in cfg.grid.cases:
-        jobs = [s for s in statuses if s.spec.case == case]
+        seeds = case_seeds(cfg, case)
+        jobs = sorted(  # grid order (VUT, then seed), also after adaptive seeding added seeds
+            (s for s in statuses if s.spec.case == case),
+            key=lambda s: (cfg.grid.vuts.index(s.spec.vut), seeds.index(s.spec.seed)),
+        )
         failed = [s.spec.name for s in jobs if s.state != "done"]
         if failed:
             logger.warning(
@@ -382,6 +418,13 @@ def add_config_flags(parser: argparse.ArgumentParser) -> None:
         "--n-outcome", type=int, default=None, help="outcome episodes per SPCP (paper: 200)"
     )
     group.add_argument("--n-ayss", type=int, default=None, help="AYSS Monte Carlo draws per SPCP")
+    group.add_argument(
+        "--max-seeds",
+        type=int,
+        default=None,
+        help="adaptive seeding: add seeds to a case whose ranking has not settled, up to this "
+        "many per VUT (default: the budget's when it chose the seeds, verdict 6; else fixed)",
+    )
 
 
 def config_from_args(args: argparse.Namespace) -> PipelineConfig:
@@ -396,6 +439,7 @@ def config_from_args(args: argparse.Namespace) -> PipelineConfig:
         eval_every=args.eval_every,
         n_outcome=args.n_outcome,
         n_ayss=args.n_ayss,
+        max_seeds=args.max_seeds,
     )
 
 

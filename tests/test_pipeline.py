@@ -252,3 +252,54 @@ def test_progress_is_logged_per_job_event_and_small_budget_is_flagged(
     assert messages[-1] == f"report: {report}"
     for written in (cfg.out / "pipeline.json", report, report.with_name("summary.md")):
         assert str(tmp_path) not in written.read_text(), written  # no machine paths
+
+
+@pytest.mark.sumo
+def test_adaptive_seeding_adds_seeds_until_the_cap_and_extends_crossplay(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A ranking that cannot settle (a significance level no test reaches) gets one seed at a
+    time up to max_seeds; each look is recorded; cross-play drives only the new opponents and
+    its table equals a full rerun's; a rerun adds nothing."""
+    from sumo_ayss.crossplay import run_case
+    from sumo_ayss.run_folder import read_adaptive
+
+    path = write_configs(tmp_path, [0, 1], max_seeds=3, report={"welch_alpha": 1e-12})
+    cfg = load_pipeline(path)
+    assert cfg.added_seeds == (2,)
+    with caplog.at_level(logging.INFO):
+        statuses, _report, runs, _ = run_pipeline(cfg, live=False)
+    assert "cross-play of 2 new SPCPs (the table of the other 4 is kept)" in caplog.text
+    assert "adaptive seeding, car_following: not settled at 2 seeds per VUT" in caplog.text
+    assert sorted((s.spec.vut, s.spec.seed) for s in statuses) == [
+        (v, s) for v in ("pi1", "pi2") for s in (0, 1, 2)
+    ]
+    assert all(s.state == "done" for s in statuses) and len(runs) == 6
+    case = cfg.out / "car_following"
+    record = read_adaptive(case / "adaptive.json")
+    assert record.seeds == (0, 1, 2) and [x.n_seeds for x in record.looks] == [2, 3]
+    assert not record.settled and record.looks[0].gate_level > 0
+    crossplay = json.loads((case / "crossplay.json").read_text())
+    assert [(o["vut"], o["seed"]) for o in crossplay["opponents"]] == [
+        ("pi1", 0),
+        ("pi1", 1),
+        ("pi1", 2),
+        ("pi2", 0),
+        ("pi2", 1),
+        ("pi2", 2),
+    ]
+    assert len(crossplay["diagonal"]) == 6
+    kept = (case / "crossplay.csv").read_bytes()
+    full = tmp_path / "full"
+    run_case(
+        [s.spec.run_dir for s in sorted(statuses, key=lambda s: (s.spec.vut, s.spec.seed))],
+        full,
+        n=10,
+        seed=4242,
+        force=True,
+    )
+    assert (full / "crossplay.csv").read_bytes() == kept  # the extended table = a full run
+    again = run_pipeline(cfg, live=False)  # resume: the same 6 jobs, nothing added
+    assert len(again.statuses) == 6
+    assert read_adaptive(case / "adaptive.json").looks == record.looks
+    assert (case / "crossplay.csv").read_bytes() == kept

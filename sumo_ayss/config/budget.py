@@ -42,6 +42,9 @@ class Budget:
         summary: One line for help texts and the benchmark.
         n_ayss: AYSS Monte Carlo draws per run when neither ``evaluate.n_ayss`` nor
             ``evaluate.ayss.n_samples`` is given; None: the AYSS section's default (100,000).
+        max_seeds: Adaptive seeding's cap when the budget also chose the seeds: a case
+            whose cross-play ranking has not settled gets one more seed per VUT at a time,
+            up to this many (:mod:`sumo_ayss.adaptive`); None: a fixed grid of ``seeds``.
     """
 
     total_timesteps: int
@@ -49,13 +52,17 @@ class Budget:
     seeds: int
     summary: str
     n_ayss: int | None = None
+    max_seeds: int | None = None
 
     def describe(self) -> str:
         """``"20,000 transitions, a candidate every 5,000, 4 seeds per VUT: ..."``."""
         ayss = "" if self.n_ayss is None else f", {self.n_ayss:,} AYSS draws"
+        seeds = f"{self.seeds} seeds per VUT"
+        if self.max_seeds is not None and self.max_seeds > self.seeds:
+            seeds = f"{self.seeds} seeds per VUT, up to {self.max_seeds} until the ranking settles"
         return (
             f"{self.total_timesteps:,} transitions, a candidate every {self.eval_every:,}, "
-            f"{self.seeds} seeds per VUT{ayss}: {self.summary}"
+            f"{seeds}{ayss}: {self.summary}"
         )
 
 
@@ -67,6 +74,7 @@ BUDGETS: Mapping[str, Budget] = MappingProxyType(
             4,
             "the least compute that ordered every validation ladder right (docs/performance.md)",
             n_ayss=20_000,
+            max_seeds=6,
         ),
         "paper": Budget(100_000, 10_000, 3, "the paper's protocol"),
     }

@@ -98,6 +98,11 @@ class PipelineConfig:
     """Transitions per run for every experiment; None: the budget's (or the experiment's)."""
     eval_every: int | None = None
     """Transitions between SPCP candidates; None: the budget's (or the experiment's)."""
+    max_seeds: int | None = None
+    """Adaptive seeding: a case whose cross-play ranking has not settled after ``grid.seeds``
+    gets one more seed per VUT at a time (the next integer after the last seed), up to this
+    many seeds per VUT (:mod:`sumo_ayss.adaptive`). None: the budget's cap when the budget
+    also chose the seeds (``verdict``: 6), else ``len(grid.seeds)``, a fixed grid."""
     evaluate: EvaluateConfig = field(default_factory=EvaluateConfig)
     vuts: Mapping[str, VehicleType] = field(default_factory=dict)
     """Extra VUTs (catalog syntax, as in ``env.vuts``) added to every case's experiment, so
@@ -131,6 +136,18 @@ class PipelineConfig:
         if self.grid.seeds is None:
             n = BUDGETS[self.budget].seeds if self.budget is not None else 3
             object.__setattr__(self, "grid", dataclasses.replace(self.grid, seeds=tuple(range(n))))
+            if self.max_seeds is None and self.budget is not None:
+                object.__setattr__(self, "max_seeds", BUDGETS[self.budget].max_seeds)
+        n_seeds = len(self.seeds)
+        if self.max_seeds is None:
+            object.__setattr__(self, "max_seeds", n_seeds)
+        require(
+            isinstance(self.max_seeds, int)
+            and not isinstance(self.max_seeds, bool)
+            and n_seeds <= self.max_seeds <= MAX_SEEDS_CAP,
+            f"max_seeds must be an integer from the {n_seeds} seeds of grid.seeds to "
+            f"{MAX_SEEDS_CAP} (absent: the budget's cap, or a fixed grid), got {self.max_seeds!r}",
+        )
         for name in ("total_timesteps", "eval_every"):
             value = getattr(self, name)
             require(
@@ -175,8 +192,20 @@ class PipelineConfig:
         return self.grid.seeds
 
     @property
+    def added_seeds(self) -> tuple[int, ...]:
+        """The seeds adaptive seeding may add, in order: the integers after the last of
+        ``grid.seeds``, ``max_seeds - len(grid.seeds)`` of them (empty: a fixed grid)."""
+        assert self.max_seeds is not None  # resolved in __post_init__
+        last = max(self.seeds)
+        return tuple(range(last + 1, last + 1 + self.max_seeds - len(self.seeds)))
+
+    @property
     def n_workers(self) -> int:
         return self.workers or os.cpu_count() or 1
+
+
+MAX_SEEDS_CAP = 64
+"""The most seeds per VUT adaptive seeding may reach."""
 
 
 def load_pipeline(path: str | Path | None, **overrides: Any) -> PipelineConfig:
@@ -195,11 +224,13 @@ def load_pipeline(path: str | Path | None, **overrides: Any) -> PipelineConfig:
     if "budget" in clean:
         budget = clean.pop("budget")
         data["budget"] = None if budget == "none" else budget
+    seeds = clean.pop("seeds", None)
+    if seeds is not None:  # before the budget resolves: named seeds make a fixed grid
+        data["grid"] = {**(data.get("grid") or {}), "seeds": [int(x) for x in seeds]}
+    if "max_seeds" in clean:
+        data["max_seeds"] = clean.pop("max_seeds")
     base = PROJECT_ROOT if path is None else Path(path).resolve().parent
     cfg = build(PipelineConfig, data, "", base) if data else PipelineConfig()
-    seeds = clean.pop("seeds", None)
-    if seeds is not None:
-        clean["grid"] = dataclasses.replace(cfg.grid, seeds=tuple(int(x) for x in seeds))
     evaluate = cfg.evaluate
     n_outcome = clean.pop("n_outcome", None)
     if n_outcome is not None:

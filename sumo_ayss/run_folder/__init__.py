@@ -42,6 +42,12 @@ these names or parses one of these files. Imports neither SUMO nor torch.
 
 from __future__ import annotations
 
+from sumo_ayss.run_folder.adaptive import (
+    AdaptiveLook,
+    AdaptiveRecord,
+    read_adaptive,
+    write_adaptive,
+)
 from sumo_ayss.run_folder.crossplay import (
     CrossplayOpponent,
     CrossplayRecord,
@@ -57,6 +63,7 @@ from sumo_ayss.run_folder.eval_table import (
 )
 from sumo_ayss.run_folder.jsonio import read_json, write_json
 from sumo_ayss.run_folder.layout import (
+    ADAPTIVE_JSON,
     AYSS_CSV,
     AYSS_JSON,
     CHECKPOINTS_DIR,
@@ -144,6 +151,7 @@ from sumo_ayss.run_folder.table import (
 )
 
 __all__ = [
+    "ADAPTIVE_JSON",
     "AYSS_CSV",
     "AYSS_JSON",
     "AYSS_SCHEMA",
@@ -175,6 +183,8 @@ __all__ = [
     "TB_DIR",
     "TORCH_RNG_PT",
     "VERSIONS_JSON",
+    "AdaptiveLook",
+    "AdaptiveRecord",
     "AyssRecord",
     "CaseFolder",
     "Column",
@@ -195,6 +205,7 @@ __all__ = [
     "case_dir_for",
     "find_run_dirs",
     "is_run_dir",
+    "read_adaptive",
     "read_ayss_json",
     "read_checkpoint_state",
     "read_command",
@@ -216,6 +227,7 @@ __all__ = [
     "schema_markdown",
     "seed_of_dir",
     "table_from_rows",
+    "write_adaptive",
     "write_ayss_json",
     "write_checkpoint_state",
     "write_command",

@@ -119,6 +119,12 @@ class CrossplayRecord:
         mine = (self.n, self.seed, self.opponents, self.rollout)
         return mine == (other.n, other.seed, other.opponents, other.rollout)
 
+    def extended_by(self, other: CrossplayRecord) -> bool:
+        """Whether ``other`` is this run with more opponents (same scenarios, same rollout,
+        every opponent of this one among them): only the new ones need driving."""
+        same = (self.n, self.seed, self.rollout) == (other.n, other.seed, other.rollout)
+        return same and set(self.opponents) < set(other.opponents)
+
 
 def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
     """Write ``crossplay.json``."""

@@ -16,6 +16,7 @@ from pathlib import Path
 from sumo_ayss.errors import ConfigError
 
 __all__ = [
+    "ADAPTIVE_JSON",
     "AYSS_CSV",
     "AYSS_JSON",
     "CHECKPOINTS_DIR",
@@ -104,6 +105,7 @@ JOB_LOG = "job.log"
 CROSSPLAY_CSV = "crossplay.csv"
 """One row per (VUT, opponent SPCP, scenario) (:data:`~.schemas.CROSSPLAY_SCHEMA`)."""
 CROSSPLAY_JSON = "crossplay.json"
+ADAPTIVE_JSON = "adaptive.json"
 """Cross-play record: settings, opponents with their SPCP's SHA-256, wall time."""
 
 _SEED_DIR = re.compile(r"^seed_(-?\d+)$")
@@ -255,6 +257,11 @@ class CaseFolder:
     def crossplay_json(self) -> Path:
         """``crossplay.json``."""
         return self.path / CROSSPLAY_JSON
+
+    @property
+    def adaptive_json(self) -> Path:
+        """``adaptive.json`` (adaptive seeding's looks, :mod:`.adaptive`)."""
+        return self.path / ADAPTIVE_JSON
 
 
 def is_run_dir(path: Path) -> bool:

@@ -108,3 +108,27 @@ def test_the_verdict_budget_draws_fewer_ayss_samples_unless_told(tmp_path: Path)
     assert told.evaluate.ayss.n_samples == 5000
     told = load_pipeline(_yaml(tmp_path, evaluate={"ayss": {"n_samples": 7000}}))
     assert told.evaluate.ayss.n_samples == 7000
+
+
+def test_adaptive_seeding_cap_comes_with_the_budgets_seeds_only(tmp_path: Path) -> None:
+    """The verdict budget's seeds may grow to its cap; named seeds make a fixed grid unless
+    max_seeds is given; a cap below the seeds is refused by name."""
+    path = _yaml(tmp_path)
+    cfg = load_pipeline(path)
+    assert cfg.seeds == (0, 1, 2, 3) and cfg.max_seeds == BUDGETS["verdict"].max_seeds == 6
+    assert cfg.added_seeds == (4, 5)
+    fixed = load_pipeline(path, seeds=[401, 402, 403, 404])
+    assert fixed.max_seeds == 4 and fixed.added_seeds == ()
+    grown = load_pipeline(path, seeds=[401, 402, 403, 404], max_seeds=6)
+    assert grown.added_seeds == (405, 406)
+    assert load_pipeline(path, budget="paper").added_seeds == ()
+    with pytest.raises(ConfigError, match=r"max_seeds must be an integer from the 4 seeds"):
+        load_pipeline(path, max_seeds=3)
+    assert (
+        load_pipeline(
+            _yaml(tmp_path, grid={"cases": ["cut_in"], "vuts": ["pi1"], "seeds": [0, 1]})
+        ).max_seeds
+        == 2
+    )
+    with pytest.raises(ConfigError, match="max_seeds"):
+        load_pipeline(_yaml(tmp_path, max_seeds="six"))

@@ -310,3 +310,22 @@ def test_crossplay_files_of_a_case_folder_round_trip(tmp_path: Path) -> None:
 
 def test_run_folder_imports_neither_torch_nor_libsumo() -> None:
     assert loaded_among("import sumo_ayss.run_folder", ("torch", "libsumo")) == []
+
+
+def test_adaptive_record_round_trips_and_refuses_another_layout(tmp_path: Path) -> None:
+    import math
+
+    from sumo_ayss.run_folder import AdaptiveLook, AdaptiveRecord, read_adaptive, write_adaptive
+
+    look = AdaptiveLook(4, math.nan, 0.027, "a", "b", 0.11, 0.05, False)
+    record = AdaptiveRecord((0, 1, 2, 3), 6, 0.05, (0, 1, 2, 3, 4), (look,))
+    path = tmp_path / "adaptive.json"
+    write_adaptive(path, record)
+    back = read_adaptive(path)
+    assert back.seeds == record.seeds and back.first_seeds == (0, 1, 2, 3)
+    assert math.isnan(back.looks[0].omnibus_p) and back.looks[0].ends_p == 0.11
+    assert not back.settled and back.same_plan((0, 1, 2, 3), 6, 0.05)
+    assert not back.same_plan((0, 1, 2), 6, 0.05)
+    path.write_text('{"format": 1, "looks": "x"}')
+    with pytest.raises(TableError, match="not an adaptive-seeding record"):
+        read_adaptive(path)

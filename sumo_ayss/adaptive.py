@@ -1,0 +1,173 @@
+"""Adaptive seeding: add training seeds to a case only while its ranking has not settled.
+
+The ``verdict`` budget starts every case with 4 seeds per VUT and caps it at 6
+(``max_seeds``, :mod:`sumo_ayss.config.pipeline`). After the grid and the cross-play stage,
+each case is looked at (:func:`sumo_ayss.analysis.sequential.settle_check`: an F gate over
+all VUTs at a level calibrated for the repeated looks, and the report's paired t of the
+current ends); a case that has not settled gets one more seed per VUT (the next integer
+after the last seed), its new jobs run, its cross-play table is extended with the new
+opponents only, and it is looked at again, until it settles or reaches the cap. Cases
+that settled are not touched again.
+
+Every look is written to ``<out>/<case>/adaptive.json`` (:mod:`sumo_ayss.run_folder.adaptive`)
+*before* the next seed's jobs start, so a pipeline killed mid-look resumes with the seeds it
+had added (:func:`case_seeds`, used by :func:`sumo_ayss.pipeline.plan_jobs`) and a rerun of
+a finished grid repeats the same looks on the same tables.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from sumo_ayss.config import PipelineConfig
+from sumo_ayss.errors import AyssError
+from sumo_ayss.jobs import JobSpec
+from sumo_ayss.progress import JobStatus
+from sumo_ayss.run_folder import (
+    AdaptiveLook,
+    AdaptiveRecord,
+    CaseFolder,
+    case_dir_for,
+    read_adaptive,
+    write_adaptive,
+)
+
+logger = logging.getLogger("sumo_ayss.adaptive")
+
+__all__ = ["case_seeds", "is_adaptive", "read_record", "run_adaptive"]
+
+RunJobs = Callable[[list[JobSpec]], list[JobStatus]]
+"""Runs a list of jobs on the pipeline's backend and returns their statuses."""
+
+CrossplayStage = Callable[[PipelineConfig, Sequence[JobStatus]], list[Path]]
+"""The pipeline's cross-play stage (:func:`sumo_ayss.pipeline.run_crossplay_stage`)."""
+
+
+def is_adaptive(cfg: PipelineConfig) -> bool:
+    """Whether the grid may add seeds: a cap above ``grid.seeds``, two or more VUTs, and a
+    ranking mode that runs cross-play (the looks read the cross-play table)."""
+    from sumo_ayss.modes import get_mode
+
+    assert cfg.max_seeds is not None  # resolved by the config
+    return (
+        cfg.max_seeds > len(cfg.seeds)
+        and len(cfg.grid.vuts) >= 2
+        and get_mode(cfg.report.mode).runs_crossplay
+    )
+
+
+def read_record(cfg: PipelineConfig, case: str) -> AdaptiveRecord | None:
+    """The case's record if it belongs to this configuration's schedule, else None (no
+    record, an unreadable one, or one made with other seeds, cap or level)."""
+    path = CaseFolder(case_dir_for(cfg.out, case)).adaptive_json
+    if not path.is_file():
+        return None
+    try:
+        record = read_adaptive(path)
+    except AyssError as exc:
+        logger.warning("%s; adaptive seeding of %s starts over", exc, case)
+        return None
+    assert cfg.max_seeds is not None
+    if not record.same_plan(cfg.seeds, cfg.max_seeds, cfg.report.welch_alpha):
+        return None
+    return record
+
+
+def case_seeds(cfg: PipelineConfig, case: str) -> tuple[int, ...]:
+    """The case's seeds: ``grid.seeds`` plus those adaptive seeding already added (read
+    from its record, so that a resumed pipeline runs them again)."""
+    if not is_adaptive(cfg):
+        return cfg.seeds
+    record = read_record(cfg, case)
+    return cfg.seeds if record is None else record.seeds
+
+
+def _look(cfg: PipelineConfig, case: str, run_dirs: Sequence[Path]) -> AdaptiveLook:
+    """One look at a case from its cross-play table."""
+    from sumo_ayss.analysis.sequential import looks_of, settle_check
+    from sumo_ayss.crossplay import read_matrix
+
+    assert cfg.max_seeds is not None
+    matrix = read_matrix(run_dirs)
+    check = settle_check(
+        matrix.scores("seed"),  # seed blocks: the independent replications
+        looks_of(len(cfg.seeds), cfg.max_seeds),
+        cfg.report.welch_alpha,
+    )
+    return AdaptiveLook(**dataclasses.asdict(check))
+
+
+def _describe(case: str, look: AdaptiveLook) -> str:
+    verdict = "settled" if look.settled else "not settled"
+    return (
+        f"adaptive seeding, {case}: {verdict} at {look.n_seeds} seeds per VUT (F gate p "
+        f"{look.omnibus_p:.3g} against {look.gate_level:.3g}; ends {look.safest} vs "
+        f"{look.least_safe}: p {look.ends_p:.3g} against {look.alpha:g})"
+    )
+
+
+def run_adaptive(
+    cfg: PipelineConfig,
+    statuses: list[JobStatus],
+    run_jobs: RunJobs,
+    crossplay_stage: CrossplayStage,
+    plan: Callable[[PipelineConfig, str, int], list[JobSpec]],
+) -> list[JobStatus]:
+    """Look at every case, add seeds to those not settled, until each settles or reaches
+    ``max_seeds``; return ``statuses`` with the added jobs' statuses appended.
+
+    ``plan(cfg, case, seed)`` gives one seed's jobs of a case. A case with a failed job or
+    without a cross-play table is left as it is (logged).
+    """
+    assert cfg.max_seeds is not None
+    statuses = list(statuses)
+    active = list(cfg.grid.cases)
+    while active:
+        grow = []
+        for case in active:
+            jobs = [s for s in statuses if s.spec.case == case]
+            if any(s.state != "done" for s in jobs):
+                logger.warning("adaptive seeding of %s stopped: a job is not done", case)
+                continue
+            try:
+                look = _look(cfg, case, [s.spec.run_dir for s in jobs])
+            except AyssError as exc:
+                logger.warning("adaptive seeding of %s stopped: %s", case, exc)
+                continue
+            record = _record_look(cfg, case, look)
+            logger.info(_describe(case, look))
+            if not look.settled and len(record.seeds) < cfg.max_seeds:
+                grow.append((case, record))
+            elif not look.settled:
+                logger.info("adaptive seeding, %s: at the cap of %d seeds", case, cfg.max_seeds)
+        new_jobs = []
+        for case, record in grow:
+            seed = cfg.added_seeds[len(record.seeds) - len(cfg.seeds)]
+            # The record names the seed before its jobs start: a kill resumes with it.
+            path = CaseFolder(case_dir_for(cfg.out, case)).adaptive_json
+            write_adaptive(path, dataclasses.replace(record, seeds=(*record.seeds, seed)))
+            logger.info("adaptive seeding, %s: adding seed %d for every VUT", case, seed)
+            new_jobs += plan(cfg, case, seed)
+        if not new_jobs:
+            break
+        statuses += run_jobs(new_jobs)
+        active = [case for case, _ in grow]
+        only = dataclasses.replace(cfg, grid=dataclasses.replace(cfg.grid, cases=tuple(active)))
+        crossplay_stage(only, [s for s in statuses if s.spec.case in active])
+    return statuses
+
+
+def _record_look(cfg: PipelineConfig, case: str, look: AdaptiveLook) -> AdaptiveRecord:
+    """Append ``look`` to the case's record (replacing a look at the same seed count: a
+    rerun repeats it) and write it."""
+    assert cfg.max_seeds is not None
+    record = read_record(cfg, case)
+    if record is None:
+        record = AdaptiveRecord(cfg.seeds, cfg.max_seeds, cfg.report.welch_alpha, cfg.seeds, ())
+    looks = (*tuple(x for x in record.looks if x.n_seeds < look.n_seeds), look)
+    record = dataclasses.replace(record, looks=looks)
+    write_adaptive(CaseFolder(case_dir_for(cfg.out, case)).adaptive_json, record)
+    return record

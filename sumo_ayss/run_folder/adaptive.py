@@ -1,0 +1,116 @@
+"""``<out>/<case>/adaptive.json``: the looks of adaptive seeding at one case, and its seeds.
+
+Written by the pipeline after every look (:mod:`sumo_ayss.adaptive`); read by the pipeline
+when it resumes (the seeds already added are part of the grid) and by ``rank --no-run``.
+The statistics of a look are :class:`sumo_ayss.analysis.sequential.SettleCheck`; this module
+stores them as plain records.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from sumo_ayss.errors import TableError
+from sumo_ayss.run_folder.jsonio import read_json, write_json
+
+__all__ = ["ADAPTIVE_FORMAT", "AdaptiveLook", "AdaptiveRecord", "read_adaptive", "write_adaptive"]
+
+ADAPTIVE_FORMAT = 1
+"""Version of the file's layout."""
+
+
+@dataclass(frozen=True)
+class AdaptiveLook:
+    """One look (see :class:`sumo_ayss.analysis.sequential.SettleCheck` for the fields):
+    seeds per VUT, the F gate's p and level, the current ends and their paired-t p and level,
+    and whether the ranking counted as settled."""
+
+    n_seeds: int
+    omnibus_p: float
+    gate_level: float
+    safest: str
+    least_safe: str
+    ends_p: float
+    alpha: float
+    settled: bool
+
+
+@dataclass(frozen=True)
+class AdaptiveRecord:
+    """Adaptive seeding at one case.
+
+    Attributes:
+        first_seeds: The grid's own seeds (``grid.seeds``), where every case starts.
+        max_seeds: The cap on seeds per VUT.
+        alpha: The procedure's false-positive rate.
+        seeds: Every seed the case's VUTs were trained on so far, in the order added.
+        looks: Every look so far, in order.
+    """
+
+    first_seeds: tuple[int, ...]
+    max_seeds: int
+    alpha: float
+    seeds: tuple[int, ...]
+    looks: tuple[AdaptiveLook, ...]
+
+    @property
+    def settled(self) -> bool:
+        """Whether the last look found the ranking settled."""
+        return bool(self.looks) and self.looks[-1].settled
+
+    def same_plan(self, first_seeds: tuple[int, ...], max_seeds: int, alpha: float) -> bool:
+        """Whether this record belongs to the same schedule (a changed config starts over)."""
+        return (self.first_seeds, self.max_seeds, self.alpha) == (
+            tuple(first_seeds),
+            max_seeds,
+            alpha,
+        )
+
+
+def write_adaptive(path: str | Path, record: AdaptiveRecord) -> None:
+    """Write ``adaptive.json`` atomically."""
+    data = asdict(record)
+    data["format"] = ADAPTIVE_FORMAT
+    write_json(path, data)
+
+
+def _float(value: Any) -> float:
+    return math.nan if value is None else float(value)
+
+
+def read_adaptive(path: str | Path) -> AdaptiveRecord:
+    """Read ``adaptive.json``.
+
+    Raises:
+        TableError: If the file is missing, unreadable or not in this layout.
+    """
+    data = read_json(path)
+    try:
+        if data.get("format") != ADAPTIVE_FORMAT:
+            raise TableError(f"{path}: format {data.get('format')!r}, expected {ADAPTIVE_FORMAT}")
+        looks: list[Mapping[str, Any]] = data["looks"]
+        return AdaptiveRecord(
+            first_seeds=tuple(int(s) for s in data["first_seeds"]),
+            max_seeds=int(data["max_seeds"]),
+            alpha=float(data["alpha"]),
+            seeds=tuple(int(s) for s in data["seeds"]),
+            looks=tuple(
+                AdaptiveLook(
+                    n_seeds=int(x["n_seeds"]),
+                    omnibus_p=_float(x["omnibus_p"]),
+                    gate_level=float(x["gate_level"]),
+                    safest=str(x["safest"]),
+                    least_safe=str(x["least_safe"]),
+                    ends_p=_float(x["ends_p"]),
+                    alpha=float(x["alpha"]),
+                    settled=bool(x["settled"]),
+                )
+                for x in looks
+            ),
+        )
+    except (KeyError, TypeError, ValueError) as exc:
+        raise TableError(f"{path}: not an adaptive-seeding record ({exc!r})") from None
