@@ -37,7 +37,7 @@ from sumo_ayss.run_folder import (
 
 logger = logging.getLogger("sumo_ayss.adaptive")
 
-__all__ = ["case_seeds", "is_adaptive", "read_record", "run_adaptive"]
+__all__ = ["case_seeds", "is_adaptive", "read_record", "run_adaptive", "summary_lines"]
 
 RunJobs = Callable[[list[JobSpec]], list[JobStatus]]
 """Runs a list of jobs on the pipeline's backend and returns their statuses."""
@@ -171,3 +171,28 @@ def _record_look(cfg: PipelineConfig, case: str, look: AdaptiveLook) -> Adaptive
     record = dataclasses.replace(record, looks=looks)
     write_adaptive(CaseFolder(case_dir_for(cfg.out, case)).adaptive_json, record)
     return record
+
+
+def summary_lines(cfg: PipelineConfig) -> list[str]:
+    """One line per case of an adaptive grid: where its seeding stopped and why."""
+    if not is_adaptive(cfg):
+        return []
+    lines = []
+    for case in cfg.grid.cases:
+        record = read_record(cfg, case)
+        if record is None or not record.looks:
+            continue
+        look = record.looks[-1]
+        if look.settled:
+            why = "settled"
+        elif look.n_seeds >= record.max_seeds:
+            why = f"not settled at the cap (max_seeds {record.max_seeds})"
+        else:
+            why = "not settled, stopped before the cap (a job or cross-play failed: the log)"
+        lines.append(
+            f"adaptive seeding, {case}: {why} with {look.n_seeds} seeds per VUT "
+            f"(ends {look.safest} vs {look.least_safe}: p {look.ends_p:.3g}; F gate p "
+            f"{look.omnibus_p:.3g} against {look.gate_level:.3g}; {record.alpha:g} false "
+            "positives over the looks)"
+        )
+    return lines

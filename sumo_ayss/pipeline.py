@@ -100,6 +100,7 @@ class PipelineResult(NamedTuple):
     report: Path | None
     runs: list[Run]
     analyses: list[CaseAnalysis]
+    cfg: PipelineConfig | None = None
 
 
 def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
@@ -214,6 +215,10 @@ def final_messages(result: PipelineResult) -> list[str]:
         runs = [(s.spec.name, training[Path(s.spec.run_dir).resolve()]) for s in done]
         seeds = fewest_seeds((r.case, r.vut) for r in result.runs)
         lines += [f"WARNING: {w}" for w in trust_warnings(runs, seeds)]
+    if result.cfg is not None:
+        from sumo_ayss.adaptive import summary_lines
+
+        lines += summary_lines(result.cfg)
     if result.report is not None:
         lines.append(f"report: {result.report}")
     return lines
@@ -285,7 +290,7 @@ def _run_locked(
         statuses = run_adaptive(cfg, statuses, run_jobs, run_crossplay_stage, plan_seed)
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
     if not finished:
-        return PipelineResult(statuses, None, [], [])
+        return PipelineResult(statuses, None, [], [], cfg)
     write_discriminability(cfg)
     from sumo_ayss.report.document import load_runs, write_report_for
     from sumo_ayss.report.load import analyse_runs
@@ -294,7 +299,7 @@ def _run_locked(
     runs = load_runs(finished)
     analyses = analyse_runs(runs, cfg.report)  # once per case: the report's and rank's
     report = write_report_for(runs, cfg.out / "report", analyses=analyses, options=cfg.report)
-    return PipelineResult(statuses, report, runs, analyses)
+    return PipelineResult(statuses, report, runs, analyses, cfg)
 
 
 def stages_after_grid(cfg: PipelineConfig) -> list[str]:
