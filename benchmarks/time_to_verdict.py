@@ -89,6 +89,13 @@ def verdict(run_out: Path, case: str) -> dict:
     checks = json.loads((run_out / "order_check.json").read_text())["cases"]
     c = next(x for x in checks if x["case"] == case and x["mode"] == "crossplay")
     c["correct"] = c["tau"] == 1.0 and bool(c["ends_significant"])
+    adaptive = run_out / case / "adaptive.json"  # adaptive seeding's last look
+    ranking = json.loads((run_out / "pipeline.json").read_text())["grid"]["seeds"]
+    c["seeds"] = (
+        json.loads(adaptive.read_text())["looks"][-1]["n_seeds"]
+        if adaptive.is_file()
+        else len(ranking)
+    )
     return c
 
 
@@ -117,7 +124,7 @@ def main() -> None:
             correct += v["correct"]
             complete &= m["complete"]
             lines.append(
-                f"| {budget} | {case} | {v['tau']:.2f} | {v['ends_p']:.3g} | "
+                f"| {budget} | {case} | {v['seeds']} | {v['tau']:.2f} | {v['ends_p']:.3g} | "
                 f"{v['significant_adjacent']} of {v['adjacent']} | "
                 f"{'yes' if v['correct'] else 'no'} | {m['cpu_s']:.0f} | {m['wall_s']:.0f} |"
                 + ("" if m["complete"] else " resumed: CPU-s partial |")
@@ -128,9 +135,10 @@ def main() -> None:
     for name in a.budgets:
         print(f"  {name}: {b[name].describe()}")
     print(
-        "| budget | case | Kendall τ | ends p | significant adjacent | correct | CPU-s | wall s |"
+        "| budget | case | seeds per VUT | Kendall τ | ends p | significant adjacent | correct | "
+        "CPU-s | wall s |"
     )
-    print("|---|---|---:|---:|---|---|---:|---:|")
+    print("|---|---|---:|---:|---:|---|---|---:|---:|")
     print("\n".join(lines))
     print()
     print("| budget | correct rankings | CPU-s | CPU-s per correct ranking |")
