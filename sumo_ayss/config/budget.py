@@ -5,18 +5,22 @@ A pipeline's ``budget`` names one of :data:`BUDGETS`; the pipeline's own ``total
 every experiment's ``train`` section as its file says (the behaviour before budgets).
 
 * ``verdict`` (the default): 20,000 transitions per run, a candidate every 5,000, four
-  training seeds per VUT, 20,000 AYSS draws. Chosen from the verdict's learning curve
+  training seeds per VUT to start with and **adaptive seeding** up to six (a case whose
+  cross-play ranking has not settled gets one more seed per VUT at a time,
+  :mod:`sumo_ayss.adaptive`), 20,000 AYSS draws. Chosen from the verdict's learning curve
   (docs/performance.md, ``scripts/verdict_curve.py``): on the braking and ACC ladders (six
   seeds each, every 4-seed subset) the cross-play ranking had Kendall τ = 1 with significant
   ends in both cases at 20,000 transitions with four seeds, at under a third of the
   CPU-seconds of three seeds at 100,000 (the paper's budget). Real runs on fresh seeds
-  ordered every ladder right (τ = 1) with significant ends on all but one ladder-case
-  (minGap, car-following: p 0.11 with 4 seeds, 0.012 with 6): more seeds, not more
-  transitions, is the lever when the ends are not significant. The AYSS draws feed only the
-  paper's reading (``report.mode: paper``), not the cross-play verdict; that reading wants
-  the paper budget.
+  ordered every ladder right (τ = 1) with significant ends on all but one ladder-case with
+  four seeds (minGap, car-following: p 0.11); adaptive seeding settled it at five (p 0.037).
+  The AYSS draws feed only the paper's reading (``report.mode: paper``), not the cross-play
+  verdict; that reading wants the paper budget.
 * ``paper``: the paper's protocol, 100,000 transitions, a candidate every 10,000, three
   seeds: what every committed study before budgets ran.
+
+Adaptive seeding applies only when the budget chose the seeds: a pipeline that names
+``grid.seeds`` (or ``--seeds``) gets exactly those, unless it also sets ``max_seeds``.
 
 A budget is recorded in the run folders through the resolved configuration (``pipeline.json``
 and each run's ``config.yaml`` hold the numbers it set).
