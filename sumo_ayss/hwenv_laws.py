@@ -3,7 +3,7 @@
 The paper ran on highway-env. This module restates, constant for constant, the laws of
 highway-env 1.8.2 (``highway_env/vehicle/behavior.py``, ``controller.py``,
 ``kinematics.py``; unchanged up to 1.12) so that SUMO vehicles can be driven by them
-(:mod:`sumo_ayss.envs.pair_env`, ``env.actuator.mode: highway_env`` and the VUT catalog's
+(:mod:`sumo_ayss.laws.highway_env`, ``env.actuator.mode: highway_env`` and the VUT catalog's
 ``hwenv_pi1``/``hwenv_pi2``). No SUMO here: the env and the cross-check test against
 highway-env itself (``tests/test_hwenv_crosscheck.py``) both call this code.
 
@@ -43,8 +43,7 @@ IDM car at standstill closer than ``DISTANCE_WANTED`` backs away). A SUMO vehicl
 drive backwards, so :func:`bicycle_step` floors the speed at ``min_speed_mps`` (0 by
 default, set it to −40 for highway-env's bound where no SUMO vehicle is involved).
 
-The state, the bicycle and the collision test live in :mod:`sumo_ayss.hwenv_kinematics`
-(imported from there).
+The state, the bicycle and the collision test live in :mod:`sumo_ayss.hwenv_kinematics`.
 """
 
 from __future__ import annotations
@@ -56,6 +55,7 @@ from dataclasses import dataclass
 from sumo_ayss.hwenv_kinematics import KinematicState, bicycle_step, not_zero
 
 __all__ = [
+    "HIGHWAY_ENV_IDM_TARGET",
     "HIGHWAY_ENV_VERSION",
     "HighwayEnvIDM",
     "HighwayEnvPov",
@@ -67,6 +67,10 @@ __all__ = [
 
 #: The highway-env release these laws are copied from (and cross-checked against).
 HIGHWAY_ENV_VERSION = "1.8.2"
+
+#: The controller ``target`` of :class:`HighwayEnvIDM` (the catalog's ``hwenv_pi1`` /
+#: ``hwenv_pi2``; run folders' ``config.yaml`` name it, so it stays this module's path).
+HIGHWAY_ENV_IDM_TARGET = "sumo_ayss.hwenv_laws:HighwayEnvIDM"
 
 
 # ------------------------------------------------------------------ POV (ControlledVehicle)
@@ -172,10 +176,11 @@ class HighwayEnvIDM:
 
     Used two ways:
 
-    * by the env (:mod:`sumo_ayss.envs.pair_env`), which recognises this class and drives
-      the VUT with :meth:`advance`: ``substeps`` explicit-Euler steps of the exact law per
-      SUMO step, each re-evaluated against the POV's state at that sub-instant
-      (highway-env's 15 Hz inside a 5 Hz decision);
+    * by the env's law :class:`~sumo_ayss.laws.highway_env.HighwayEnvIdmVut` (chosen for
+      the target :data:`HIGHWAY_ENV_IDM_TARGET`), which drives the VUT with
+      :meth:`advance`: ``substeps`` explicit-Euler steps of the exact law per SUMO step,
+      each re-evaluated against the POV's state at that sub-instant (highway-env's 15 Hz
+      inside a 5 Hz decision);
     * as a plain :class:`~sumo_ayss.controllers.Controller` (:meth:`acceleration`, one
       evaluation per SUMO step from the sensed bumper-to-bumper gap), e.g. by code that
       only knows the controller protocol.

@@ -1,8 +1,9 @@
 """A user controller as the VUT: the protocol without SUMO, then driven through SUMO.
 
 The SUMO tests step a :class:`~sumo_ayss.sim.pair.VehiclePair` by hand (session + pair +
-:class:`~sumo_ayss.controllers.ControlledVut`), the way the env hook does before each
-SUMO step, so they do not depend on :class:`~sumo_ayss.envs.pair_env.PairEnv`.
+:class:`~sumo_ayss.controllers.ControlledVut`), the way the env's controller law
+(:class:`~sumo_ayss.laws.controller.ControllerVut`) does before each SUMO step, so they do
+not depend on :class:`~sumo_ayss.envs.pair_env.PairEnv`.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from sumo_ayss.controllers import (
     bound_acceleration,
     commanded_speed,
 )
+from sumo_ayss.envs import make_env
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.sim.pair import VutSensing
 
@@ -338,36 +340,6 @@ def test_cut_in_counts_as_leader_once_it_reaches_into_the_lane() -> None:
         assert (True, 1) in seen and (True, 0) in seen
 
 
-def hooked_env(cfg: EnvConfig) -> Any:
-    """The case's env with the PairEnv hook proposed in the report, if not built in yet."""
-    from sumo_ayss.envs.car_following import CarFollowingEnv
-    from sumo_ayss.envs.cut_in import CutInEnv
-
-    base: type = CutInEnv if cfg.case == "cut_in" else CarFollowingEnv
-
-    class Hooked(base):
-        def __init__(self, config: EnvConfig) -> None:
-            super().__init__(config, sumo_seed=0)
-            self._my_ctl: ControlledVut | None = None
-            if not hasattr(self, "_vut_control"):  # the hook is not in PairEnv yet
-                self._my_ctl = ControlledVut.from_vehicle_type(
-                    config.vut_type, config.sim.step_length_s
-                )
-
-        def start_episode(self, ic: Any) -> Any:
-            out = super().start_episode(ic)
-            if self._my_ctl is not None:
-                self._my_ctl.start(self._pair)
-            return out
-
-        def command_pov(self) -> None:
-            super().command_pov()
-            if self._my_ctl is not None:
-                self._my_ctl.before_step(self._pair)
-
-    return Hooked(cfg)
-
-
 @pytest.mark.sumo
 @pytest.mark.parametrize("case", ["car_following", "cut_in"])
 def test_controller_vut_in_env(case: str) -> None:
@@ -376,7 +348,7 @@ def test_controller_vut_in_env(case: str) -> None:
     from sumo_ayss.envs.odd import InitialCondition
 
     cfg = EnvConfig(case=case, vut="acc", vuts={"acc": VehicleType(controller=acc_spec(2.0))})  # type: ignore[arg-type]
-    env = hooked_env(cfg)
+    env = make_env(cfg, sumo_seed=0)  # its VUT law drives the controller (sumo_ayss.laws)
     gap = 30.0 if case == "car_following" else 8.0
     actions = [1] * 25 if case == "car_following" else [0] + [16] * 24
     try:

@@ -100,6 +100,7 @@ from sumo_ayss.envs.pair_env import (
 )
 from sumo_ayss.envs.rewards import adversarial_reward
 from sumo_ayss.errors import ActionError
+from sumo_ayss.laws import VehicleLaws
 from sumo_ayss.sim.pair import PairPlacement
 
 #: Action index of the lane change.
@@ -115,9 +116,6 @@ N_ACTIONS = FIRST_SPEED_ACTION + MAX_TARGET_SPEED_MPS - MIN_TARGET_SPEED_MPS + 1
 #: Lane indices at the start of an episode (0 = rightmost).
 VUT_LANE = 0
 POV_LANE = 1
-
-#: |lateral offset| [m] or |lateral speed| [m/s] below which the POV counts as not changing.
-_LATERAL_EPS = 1e-9
 
 
 def target_speed_mps(action: int) -> float:
@@ -165,6 +163,7 @@ class CutInEnv(PairEnv):
         config: environment configuration of the cut-in case; default: its defaults.
         vut: shortcut to override ``config.vut``.
         sumo_seed: SUMO's ``--seed``; default: drawn from the env's RNG at the first reset.
+        laws: The POV's and the VUT's laws; default: built from the config.
     """
 
     CASE: ClassVar[str] = CUT_IN.name
@@ -180,15 +179,15 @@ class CutInEnv(PairEnv):
         *,
         vut: str | None = None,
         sumo_seed: int | None = None,
+        laws: VehicleLaws | None = None,
     ) -> None:
-        super().__init__(config, vut=vut, sumo_seed=sumo_seed)
+        super().__init__(config, vut=vut, sumo_seed=sumo_seed, laws=laws)
         self._lane_request_s = self.config.episode_s
         self._lane_change_cfg = self.config.reward.lane_change
         self._same_lane_cfg = self.config.reward.same_lane
         self._vut_length_m = self.config.vut_type.length_m
         # h at which the POV's front is level with the VUT's rear (POV entirely behind).
         self._both_lengths_m = self._pov_length_m + self._vut_length_m
-        self._lc_done_m = self.config.actuator.lane_change_done_m
         self._lane: LaneState | None = None
         self._target_mps = 0.0
         self._lc_started = False
@@ -238,15 +237,11 @@ class CutInEnv(PairEnv):
         if action == LANE_CHANGE:
             if lane.same_lane or lane.changing:
                 self._lc_ignored = True
-            elif self._hw_pov is not None:
-                # highway-env's ControlledVehicle: the lane change is a new target lane for
-                # its steering loop (integrated in Python, put into SUMO each step).
-                self._hw_pov.target_lane_y_m = pair.lane_centre_y_m(lane.vut_lane)
-                self._lc_started = True
             else:
-                # The request's duration only says how long SUMO keeps trying; the motion
-                # itself takes --lanechange.duration. Keep it for the whole episode.
-                pair.change_pov_lane(lane.vut_lane, self._lane_request_s)
+                # SUMO's request lasts the whole episode (its duration only says how long
+                # SUMO keeps trying; the motion takes --lanechange.duration); highway-env's
+                # POV retargets its steering loop instead.
+                self._pov_law.change_lane(pair, lane.vut_lane, self._lane_request_s)
                 self._lc_started = True
         else:
             self._target_mps = target_speed_mps(action)
@@ -283,16 +278,8 @@ class CutInEnv(PairEnv):
         lat_pov, lat_vut = pair.lateral_speeds()
         (pov_x, pov_y), (vut_x, vut_y) = pair.world_fronts()
         pov_len, vut_len = self._pov_length_m, self._vut_length_m
-        hw = self._hw_pov
-        if hw is None:
-            changing = abs(offset) > _LATERAL_EPS or abs(lat_pov) > _LATERAL_EPS
-            pov_vx = k.pov_speed_mps
-        else:
-            # highway-env's POV: velocity = speed along its heading (SUMO, moved by moveToXY,
-            # reports no lateral speed); changing until settled near the target centre line.
-            st = hw.state
-            pov_vx, lat_pov = st.vx_mps, st.vy_mps
-            changing = abs(st.y_m - hw.target_lane_y_m) > self._lc_done_m
+        # The POV's velocity and "changing lanes" as its law defines them.
+        pov_vx, lat_pov, changing = self._pov_law.lane_motion(k.pov_speed_mps, offset, lat_pov)
         dvb = _delta_v_bar(
             (vut_x - 0.5 * vut_len) - (pov_x - 0.5 * pov_len),
             vut_y - pov_y,

@@ -5,10 +5,10 @@ action decoding and reward. Timing: the policy acts every ``decision_period_s`` 
 5 Hz); an episode lasts ``episode_s`` (5 s, 25 decisions) and ends *truncated* after the
 last decision, or *terminated* at a collision.
 
-Paper-fidelity mode (docs/paper_fidelity.md): with ``env.actuator.mode: highway_env`` and/or
-a :class:`~sumo_ayss.hwenv_laws.HighwayEnvIDM` VUT (``hwenv_pi1``/``hwenv_pi2``), the env
-integrates highway-env's laws itself at ``env.actuator.substeps`` sub-steps per SUMO step
-and gives SUMO the exact end state (:mod:`sumo_ayss.envs.hwenv_actuation`).
+What moves the two vehicles over each SUMO step is their laws (:mod:`sumo_ayss.laws`): the
+POV's (our clipped actuator, or highway-env's ControlledVehicle in paper-fidelity mode) and
+the VUT's (SUMO's own model, a user controller, or highway-env's IDM), built once from the
+configuration and called by the episode phases below.
 """
 
 from __future__ import annotations
@@ -26,12 +26,10 @@ from gymnasium import spaces
 
 from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config import EnvConfig
-from sumo_ayss.controllers import ControlledVut
-from sumo_ayss.envs.hwenv_actuation import HighwayEnvLaws
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_condition
 from sumo_ayss.envs.rewards import total_reward
 from sumo_ayss.errors import ActionError, ConfigError
-from sumo_ayss.sim.actuator import next_speed, pov_acceleration
+from sumo_ayss.laws import VehicleLaws, build_laws
 from sumo_ayss.sim.network import ROAD_EDGE, ROAD_LENGTH_M, network_path
 from sumo_ayss.sim.pair import PairPlacement, VehiclePair
 from sumo_ayss.sim.session import SumoSession
@@ -87,7 +85,7 @@ class PairKinematics(NamedTuple):
     headway_m: float
 
 
-class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
+class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
     """Base env: one VUT and one POV in the process's SUMO simulation.
 
     Args:
@@ -95,6 +93,9 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         vut: shortcut to override ``config.vut`` (a name from ``config.vuts``).
         sumo_seed: SUMO's ``--seed``, an int in [0, 2**31 - 1]; default: drawn from the
             env's RNG at the first reset.
+        laws: The POV's and the VUT's laws (fresh ones: they hold an episode's state);
+            default: :func:`~sumo_ayss.laws.build_laws` of the (final) config, which
+            imports and builds a controller VUT's controller.
     """
 
     # ``metadata`` is gymnasium.Env's own, ``{"render_modes": []}``: no rendering.
@@ -119,6 +120,7 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         *,
         vut: str | None = None,
         sumo_seed: int | None = None,
+        laws: VehicleLaws | None = None,
     ) -> None:
         super().__init__()
         sumo_seed = check_sumo_seed(sumo_seed)
@@ -143,21 +145,12 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         self._pair: VehiclePair | None = None
         # Per-step constants, looked up once (config properties compute on each access).
         self._pov_length_m = config.pov.length_m
-        self._dt_s = config.sim.step_length_s
         self._substeps = config.steps_per_decision
         self._max_decisions = config.max_decisions
-        self._actuator = config.actuator
         self._reward_cfg = config.reward
-        # A user controller VUT (None for SUMO's own models): it computes the VUT's speed
-        # before every SUMO step, from what a real vehicle would sense.
-        self._vut_control = ControlledVut.from_vehicle_type(
-            config.vut_type, self._dt_s, f"env.vuts.{config.vut}.controller"
-        )
-        self._init_hwenv(config)
+        self._pov_law, self._vut_law = laws if laws is not None else build_laws(config)
         self._decisions = 0
-        self._v_pov = 0.0
         self._target = 0.0  # the POV's target speed of the current decision [m/s]
-        self._accel = 0.0  # the POV's acceleration in the last SUMO step [m/s²]
         self._shared = False  # a member of a PairVecEnv (see join_shared)
         self._k: PairKinematics | None = None
         self.initial_condition: InitialCondition | None = None
@@ -292,7 +285,7 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
 
     def _check_initial_condition(self, ic: InitialCondition) -> None:
         """Refuse a given initial condition the road and the actuator cannot realise."""
-        v_max = min(SPEED_HIGH_MPS, self._actuator.max_speed_mps)
+        v_max = min(SPEED_HIGH_MPS, self.config.actuator.max_speed_mps)
         checks = (
             ("pov_speed_mps", ic.pov_speed_mps, 0.0, v_max),
             ("vut_speed_mps", ic.vut_speed_mps, 0.0, SPEED_HIGH_MPS),
@@ -314,14 +307,11 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         pair = self._pair
         assert pair is not None
         pair.place(self._placement(ic))
-        if self._vut_control is not None:
-            self._vut_control.start(pair)  # speed mode 0 for the VUT, controller.reset()
-        if self._hw:
-            self._start_hwenv(pair, ic)
+        self._vut_law.start(pair, ic.vut_speed_mps)
+        self._pov_law.start(pair, ic.pov_speed_mps)
         self.initial_condition = ic
         self._done = False
         self._decisions = 0
-        self._v_pov = ic.pov_speed_mps
         k = self._k = self._kinematics()
         info = {
             "headway_m": k.headway_m,
@@ -336,21 +326,14 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         """Validate and apply ``action`` (lane commands, the POV's target speed)."""
         assert self._k is not None
         self._target = self._apply_action(self._validate_action(action), self._k)
-        self._accel = 0.0
 
     def command_pov(self) -> None:
-        """The actuator's next POV speed, commanded for the coming SUMO step."""
+        """The POV's law, then the VUT's, command the coming SUMO step."""
         pair = self._pair
         assert pair is not None
-        if self._hw:
-            self._command_hwenv(pair)
-            return
-        actuator = self._actuator
-        accel = self._accel = pov_acceleration(self._v_pov, self._target, actuator)
-        v = self._v_pov = next_speed(self._v_pov, accel, self._dt_s, actuator)
-        pair.command_pov_speed(v)
-        if self._vut_control is not None:
-            self._vut_control.before_step(pair)  # the controller's speed for the coming step
+        pov = self._pov_law
+        pov.command(pair, self._target)
+        self._vut_law.command(pair, pov)
 
     def end_decision(
         self, collided: bool
@@ -366,10 +349,10 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         """
         pair = self._pair
         assert pair is not None
-        if self._hw_pending is not None:
-            self._sync_hwenv_speeds(pair)
-        if self._hw_collisions:
-            collided = self._hw_collided
+        vut_law = self._vut_law
+        self._pov_law.sync(pair)
+        vut_law.sync(pair)
+        collided = vut_law.collided(collided)
         self._decisions += 1
         k = self._k = self._kinematics()
         r_a, extra = self._reward_terms(k, collided)
@@ -382,12 +365,8 @@ class PairEnv(HighwayEnvLaws, gym.Env[npt.NDArray[np.float32], np.int64]):
         info = {
             "headway_m": k.headway_m,
             "ttc_s": time_to_collision_s(k.headway_m, k.vut_speed_mps, k.pov_speed_mps),
-            "pov_accel_mps2": self._accel,
-            "vut_accel_mps2": (
-                pair.vut_accel_mps2()
-                if self._hw_vut is None or self._vut_control is None
-                else self._vut_control.last_command_mps2
-            ),
+            "pov_accel_mps2": self._pov_law.accel_mps2(pair),
+            "vut_accel_mps2": vut_law.accel_mps2(pair),
             "target_speed_mps": self._target,
             "vut_speed_mps": k.vut_speed_mps,
             "collision": collided,
