@@ -303,3 +303,19 @@ def test_adaptive_seeding_adds_seeds_until_the_cap_and_extends_crossplay(
     assert len(again.statuses) == 6
     assert read_adaptive(case / "adaptive.json").looks == record.looks
     assert (case / "crossplay.csv").read_bytes() == kept
+
+
+def test_a_resumed_adaptive_grid_plans_the_seeds_its_record_added(tmp_path: Path) -> None:
+    """A pipeline killed after adaptive seeding named a new seed runs that seed's jobs on
+    resume; a record of another schedule (other seeds, cap or level) is ignored."""
+    from sumo_ayss.run_folder import AdaptiveRecord, write_adaptive
+
+    cfg = load_pipeline(write_configs(tmp_path, [0, 1], max_seeds=4))
+    assert {j.seed for j in plan_jobs(cfg)} == {0, 1}
+    record = tmp_path / "runs" / "car_following" / "adaptive.json"
+    record.parent.mkdir(parents=True)
+    write_adaptive(record, AdaptiveRecord((0, 1), 4, 0.05, (0, 1, 2), ()))
+    planned = [(j.vut, j.seed) for j in plan_jobs(cfg)]
+    assert planned == [(v, s) for v in ("pi1", "pi2") for s in (0, 1, 2)]
+    write_adaptive(record, AdaptiveRecord((0, 1), 5, 0.05, (0, 1, 2), ()))  # another cap
+    assert {j.seed for j in plan_jobs(cfg)} == {0, 1}
