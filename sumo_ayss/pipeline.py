@@ -54,7 +54,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, NamedTuple
 
 from sumo_ayss.cli import prog
-from sumo_ayss.config import PipelineConfig, check_out_dir, load_experiment, load_pipeline, to_dict
+from sumo_ayss.config import (
+    ExperimentConfig,
+    PipelineConfig,
+    check_out_dir,
+    load_experiment,
+    load_pipeline,
+    to_dict,
+)
 from sumo_ayss.config.budget import BUDGET_CHOICES, BUDGET_HELP
 from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.folder_lock import output_lock
@@ -127,7 +134,7 @@ def plan_seed(cfg: PipelineConfig, case: str, seed: int) -> list[JobSpec]:
     return [_job(cfg, exp, case, vut, seed) for vut in cfg.grid.vuts]
 
 
-def _job(cfg: PipelineConfig, exp: Any, case: str, vut: str, seed: int) -> JobSpec:
+def _job(cfg: PipelineConfig, exp: ExperimentConfig, case: str, vut: str, seed: int) -> JobSpec:
     return JobSpec(
         case=case,
         vut=vut,
@@ -139,7 +146,7 @@ def _job(cfg: PipelineConfig, exp: Any, case: str, vut: str, seed: int) -> JobSp
     )
 
 
-def _case_experiment(cfg: PipelineConfig, case: str) -> Any:
+def _case_experiment(cfg: PipelineConfig, case: str) -> ExperimentConfig:
     """The case's experiment with the pipeline's overrides; its VUTs checked."""
     exp = load_experiment(cfg.experiments[case])
     if exp.env.case != case:
