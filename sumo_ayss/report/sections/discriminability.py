@@ -23,8 +23,8 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.cases import case_info
+from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.report import figstyle
 from sumo_ayss.report.blocks import Block, FigureBlock, Heading, Paragraph, Table
 
