@@ -106,14 +106,6 @@ class SeedBands:
         self.centers, self.means, self.lo, self.hi = centers, means, lo, hi
         self.n_seeds, self.per_seed = n_seeds, per_seed
 
-    @property
-    def band_kind(self) -> str:
-        """What the band is, for a legend: t-interval, range of two seeds, or none."""
-        most = int(self.n_seeds.max()) if self.n_seeds.size else 0
-        if most >= MIN_SEEDS_FOR_INTERVAL:
-            return "t-interval over seeds"
-        return "range of the 2 seeds" if most == 2 else "one seed: no band"
-
 
 def binned_seed_means(
     seeds: Sequence[tuple[ArrayLike, ArrayLike]],
