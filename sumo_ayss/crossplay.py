@@ -245,10 +245,10 @@ def main(argv: Sequence[str] | None = None) -> None:
     import sys
 
     from sumo_ayss.analysis.crossplay import rank_crossplay
-    from sumo_ayss.analysis.seed_intervals import seed_interval_text
     from sumo_ayss.analysis.seeds import kendall_tau
     from sumo_ayss.config import load_pipeline
     from sumo_ayss.modes.crossplay import crossplay_sentence
+    from sumo_ayss.modes.formatting import seed_interval_text
     from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
 
     args = parse_args(argv)

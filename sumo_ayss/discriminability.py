@@ -225,8 +225,10 @@ def compute(
 def summary_lines(result: Discriminability, grid: BoxGrid | None = None) -> list[str]:
     """One line per pair, e.g. ``pi1 vs pi2 differ in 11.9 % of the AYSS box; none below h ≈
     2.95 m``."""
+    from sumo_ayss.report.sections.discriminability import pair_summary
+
     step = grid.headway_step_m + grid.h_m[0] if grid is not None else None
-    return [p.summary(result.threshold_mps2, step) for p in result.pairs]
+    return [pair_summary(p, result.threshold_mps2, step) for p in result.pairs]
 
 
 def write_outputs(meta: dict[str, Any], out_dir: str | Path, *, figure: bool = True) -> list[Path]:

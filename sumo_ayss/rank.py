@@ -41,10 +41,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.analysis.case import CaseAnalysis
-from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.modes import Mode, get_mode, mode_names, registered_modes
+from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.run_folder import OUTCOME_JSON, RunFolder
 
 if TYPE_CHECKING:

@@ -9,9 +9,11 @@ tests can use it on any machine.
 * :mod:`.safety_index`, :mod:`.verdict`, :mod:`.ranking` — safety index per VUT, pairwise
   verdicts, rankings; :mod:`.significance` — the report's two-test rule.
 * :mod:`.seeds`, :mod:`.premise` — seed-level (exposure) ranking, the premise check.
-* :mod:`.case` — everything above for one case's runs (:func:`.case.analyse_case`);
-  :mod:`.cases` names each case's indicator.
-* :mod:`.formatting` — how numbers, intervals and p-values read in sentences and tables.
+* :mod:`.case` — everything above for one case's runs (:func:`.case.analyse_case`), with
+  the verdict of the mode asked for as a record (:mod:`.case_verdict`).
+
+Numbers and records only: the ranking modes (:mod:`sumo_ayss.modes`) word the verdicts, the
+report (:mod:`sumo_ayss.report`) the rest.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Statistics of one case: safety indices, rankings, verdicts and headlines per mode.
+"""Statistics of one case: safety indices, rankings and verdicts per mode.
 
 :func:`analyse_case` turns the runs of one case (any objects shaped like
 :class:`sumo_ayss.report.load.Run`) into a :class:`CaseAnalysis`: the paper mode (AYSS
@@ -6,26 +6,26 @@ safety index per VUT, hierarchical bootstrap, pairwise verdicts under
 :func:`~.significance.pair_verdict`), the exposure mode (seed-level ranking of the mean harm
 per episode of each VUT's own SPCPs, :mod:`.harm`), the cross-play mode (the case's
 cross-play matrix, which its loader read from ``crossplay.csv``, :mod:`.crossplay`) and the
-premise check. Both the
-report and :mod:`sumo_ayss.rank` read it; the pipeline analyses each case once and hands the
-analysis to both. Nothing here reads a file, draws or renders.
+premise check, and the verdict of the mode asked for as a record
+(:class:`~.case_verdict.CaseVerdict`). Both the report and :mod:`sumo_ayss.rank` read it
+(the modes word its verdicts); the pipeline analyses each case once and hands the analysis
+to both. Nothing here reads a file, draws, renders or words a verdict.
 """
 
 from __future__ import annotations
 
-import itertools
 import logging
 import zlib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal, Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
+from sumo_ayss.analysis.case_verdict import CaseVerdict, paper_verdict
 from sumo_ayss.analysis.crossplay import (
-    CROSSPLAY_COMMAND,
-    NO_CROSSPLAY_TABLE,
+    CrossplayGap,
     CrossplayInput,
     CrossplayMatrix,
     rank_crossplay,
@@ -33,26 +33,18 @@ from sumo_ayss.analysis.crossplay import (
 from sumo_ayss.analysis.harm import HARM_RANGE, VutOutcome, vut_outcomes
 from sumo_ayss.analysis.premise import Premise, premise_check
 from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex, rank, safety_index
-from sumo_ayss.analysis.seeds import (
-    SeedComparison,
-    SeedRankRow,
-    SeedScores,
-    rank_seeds,
-    ranking_line,
-    seed_ranking_line,
-)
+from sumo_ayss.analysis.seeds import SeedComparison, SeedRankRow, SeedScores, rank_seeds
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
 from sumo_ayss.cases import Case, case_info
 from sumo_ayss.errors import ConfigError
-from sumo_ayss.modes import CROSSPLAY, EXPOSURE, get_mode
+from sumo_ayss.modes import CROSSPLAY, EXPOSURE, PAPER, get_mode
 
 __all__ = [
     "CaseAnalysis",
     "CaseOptions",
+    "CaseVerdict",
     "analyse_case",
-    "ranking_line",
     "run_label",
-    "seed_ranking_line",
     "vut_safety_index",
 ]
 
@@ -151,27 +143,22 @@ class CaseAnalysis:
         indices: ``{vut: safety index}`` for VUTs with AYSS samples.
         ranking: VUTs safest first (point estimate).
         pairs: Verdicts of every pair, in ranking order (A ranked above B).
-        headline: The verdict sentence of the top-ranked pair, or why there is none.
-        headline_kind: ``"safer"``, ``"none"`` or ``"warning"``.
-        ranking_line: ``"pi2 > pi1"`` (``>`` significant under the rule, ``≈`` not).
-        problems: Missing or unreadable files, one sentence each.
+        verdict: The verdict of the mode asked for (``mode``), or of the mode it fell
+            back to (``verdict.mode``, :attr:`ranking_mode`); worded by ``mode``'s
+            :attr:`~sumo_ayss.modes.Mode.headline`.
+        paper_verdict: The paper mode's verdict (also when ``mode`` is another).
+        problems: Missing or unreadable files, one line each.
         mode: The analysis mode asked for (``report.mode``).
-        ranking_mode: The mode ``headline`` and ``ranking_line`` come from: ``mode``, or
-            ``"exposure"`` in cross-play mode without a cross-play table (the headline
-            says so first).
         exposure_rows: Exposure-mode ranking, safest first.
         exposure_pairs: Exposure-mode comparisons of every pair (A ranked above B).
         exposure_scores: ``{vut: {seed: E}}``, the per-seed exposures behind the ranking.
         premise: Whether the SPCPs reached the same overall outcome, or None.
-        paper_headline: The paper-mode headline (also when ``mode`` is exposure).
-        paper_ranking_line: The paper-mode ranking line.
-        crossplay: The case's cross-play matrix, or None (see ``crossplay_missing``).
+        crossplay: The case's cross-play matrix, or None (see ``crossplay_gap``).
         crossplay_rows: Cross-play ranking, safest first (empty without a table).
         crossplay_pairs: Cross-play comparisons of every pair (A ranked above B).
         crossplay_blocks: Block unit of the cross-play test (``"seed"`` or ``"opponent"``).
         crossplay_path: The ``crossplay.csv`` read, or None.
-        crossplay_missing: Why there is no cross-play ranking, one sentence; "" when there
-            is one.
+        crossplay_gap: Why there is no cross-play ranking; None when there is one.
         crossplay_diagonal: The table's diagonal check, ``(vut, seed, n, n_equal)`` per run
             (empty: the record predates the check).
         outcomes: ``{mode: {vut: VutOutcome}}`` for the modes that read outcomes
@@ -185,26 +172,28 @@ class CaseAnalysis:
     indices: dict[str, SafetyIndex] = field(default_factory=dict)
     ranking: list[RankedVut] = field(default_factory=list)
     pairs: list[PairVerdict] = field(default_factory=list)
-    headline: str = ""
-    headline_kind: Literal["safer", "none", "warning"] = "warning"
-    ranking_line: str = ""
+    verdict: CaseVerdict = field(default_factory=lambda: CaseVerdict(EXPOSURE.name, "warning"))
+    paper_verdict: CaseVerdict = field(default_factory=lambda: CaseVerdict(PAPER.name, "warning"))
     problems: list[str] = field(default_factory=list)
     mode: str = EXPOSURE.name
     exposure_rows: list[SeedRankRow] = field(default_factory=list)
     exposure_pairs: list[SeedComparison] = field(default_factory=list)
     exposure_scores: dict[str, dict[int, float]] = field(default_factory=dict)
     premise: Premise | None = None
-    paper_headline: str = ""
-    paper_ranking_line: str = ""
-    ranking_mode: str = EXPOSURE.name
     crossplay: CrossplayMatrix | None = None
     crossplay_rows: list[SeedRankRow] = field(default_factory=list)
     crossplay_pairs: list[SeedComparison] = field(default_factory=list)
     crossplay_blocks: str = "seed"
     crossplay_path: Path | None = None
-    crossplay_missing: str = ""
+    crossplay_gap: CrossplayGap | None = None
     crossplay_diagonal: tuple[tuple[str, int, int, int], ...] = ()
     outcomes: dict[str, dict[str, VutOutcome]] = field(default_factory=dict)
+
+    @property
+    def ranking_mode(self) -> str:
+        """The mode the verdict and its ranking come from: ``mode``, or ``"exposure"`` in
+        cross-play mode without a cross-play table (the headline says so first)."""
+        return self.verdict.mode
 
 
 def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
@@ -253,24 +242,22 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -
     there is none; a table not of exactly these VUTs and runs is not used."""
     out.crossplay_blocks = options.crossplay_blocks
     if len(out.runs) < 2:
-        only = next(iter(out.runs), "?")
-        out.crossplay_missing = (
-            f"no cross-play for this case: its runs here are of one VUT only ({only}), and "
-            "cross-play compares two or more"
-        )
+        out.crossplay_gap = CrossplayGap("one_vut", vut=next(iter(out.runs), "?"))
         return
     m = found.matrix
     if m is None:
-        out.crossplay_missing = found.missing or NO_CROSSPLAY_TABLE
+        out.crossplay_gap = CrossplayGap("not_found", loader=found.missing)
         if found.problem:
             out.problems.append(found.problem)
         return
     opponents = {(v, int(r.seed)) for v, rs in out.runs.items() for r in rs if r.seed is not None}
     if set(m.vuts) != set(out.runs) or set(m.opponents) != opponents:
-        out.crossplay_missing = (
-            f"the cross-play table {found.path} is not of these runs (VUTs {', '.join(m.vuts)}; "
-            f"{len(m.opponents)} opponents, this case has {len(opponents)} runs with a seed); "
-            f"run {CROSSPLAY_COMMAND} again once every job is done"
+        out.crossplay_gap = CrossplayGap(
+            "not_these_runs",
+            path=found.path,
+            vuts=tuple(m.vuts),
+            n_opponents=len(m.opponents),
+            n_runs=len(opponents),
         )
         return
     out.crossplay, out.crossplay_path = m, found.path
@@ -291,7 +278,7 @@ def analyse_case(
     crossplay: CrossplayInput | None = None,
     paper: bool = True,
 ) -> CaseAnalysis:
-    """Safety index per VUT, ranking, pairwise verdicts and the headline of one case.
+    """Safety index per VUT, ranking, pairwise verdicts and the verdict of one case.
 
     Args:
         case: Case name.
@@ -337,45 +324,10 @@ def analyse_case(
                 )
             except ConfigError as exc:
                 out.problems.append(f"{a} vs {b}: not comparable ({exc})")
-    _headline(out)
-    out.headline = "[paper mode] " + out.headline
     _exposure(out, options)
-    if out.premise is not None and out.premise.metrics and not out.premise.met:
-        out.headline += (
-            " Confounded: the SPCPs did not reach the same overall outcome (premise check), "
-            "so this aggressiveness comparison does not isolate the VUTs' safety."
-        )
-        if out.headline_kind == "safer":
-            out.headline_kind = "warning"
-    out.paper_headline, out.paper_ranking_line = out.headline, out.ranking_line
+    premise_met = out.premise is None or not out.premise.metrics or out.premise.met
+    out.paper_verdict = paper_verdict(PAPER.name, out.ranking, out.pairs, premise_met=premise_met)
     _crossplay(out, options, crossplay or CrossplayInput())
-    out.mode = out.ranking_mode = options.mode
-    get_mode(options.mode).headline(out)  # the paper mode's headline unless another mode's
+    out.mode = options.mode
+    out.verdict = get_mode(options.mode).verdict(out)
     return out
-
-
-def _headline(out: CaseAnalysis) -> None:
-    order = [r.name for r in out.ranking]
-    if not order:
-        out.headline = "No verdict yet: no VUT of this case has AYSS samples (ayss.csv)."
-        out.headline_kind = "warning"
-        return
-    if len(order) == 1:
-        out.headline = (
-            f"No verdict yet: only {order[0]} has AYSS samples; a verdict needs two VUTs."
-        )
-        out.headline_kind = "warning"
-        return
-    top = next((p for p in out.pairs if p.verdict.name_a == order[0]), None)
-    if top is None:
-        out.headline = "No verdict: the safety indices of the top two VUTs are not comparable."
-        out.headline_kind = "warning"
-        return
-    out.headline = top.sentence
-    out.headline_kind = "safer" if top.significant else "none"
-    by_pair = {(p.verdict.name_a, p.verdict.name_b): p for p in out.pairs}
-    significant = []
-    for a, b in itertools.pairwise(order):
-        pair = by_pair.get((a, b))
-        significant.append(pair is not None and pair.significant)
-    out.ranking_line = ranking_line(order, significant)

@@ -34,6 +34,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -44,8 +45,7 @@ from sumo_ayss.errors import ConfigError
 
 __all__ = [
     "BLOCKS",
-    "CROSSPLAY_COMMAND",
-    "NO_CROSSPLAY_TABLE",
+    "CrossplayGap",
     "CrossplayInput",
     "CrossplayMatrix",
     "crossplay_matrix",
@@ -54,12 +54,6 @@ __all__ = [
 
 #: Block units of the paired test: training seeds (default) or single opponents.
 BLOCKS = ("seed", "opponent")
-
-CROSSPLAY_COMMAND = "python -m sumo_ayss.crossplay <config>"
-"""The command that writes a case's cross-play table."""
-
-NO_CROSSPLAY_TABLE = f"no cross-play table for this case (run {CROSSPLAY_COMMAND})"
-"""Why a case has no cross-play ranking when its loader found no table."""
 
 
 @dataclass(frozen=True)
@@ -207,8 +201,8 @@ class CrossplayInput:
     Attributes:
         matrix: The table's :class:`CrossplayMatrix`, or None (the default: no table found).
         path: The table read (shown in the report), or None.
-        missing: Why there is no matrix, one sentence; "" with no matrix means that no
-            table was found (:data:`NO_CROSSPLAY_TABLE`).
+        missing: Why there is no matrix, one sentence from the loader; "" with no matrix
+            means that no table was found.
         problem: A line for the case's problem list (an unreadable table), or "".
         diagonal: The diagonal check of the table's record, one ``(vut, seed, n, n_equal)``
             per run: its SPCP against its own VUT reproduced ``n_equal`` of the ``n``
@@ -220,6 +214,32 @@ class CrossplayInput:
     missing: str = ""
     problem: str = ""
     diagonal: tuple[tuple[str, int, int, int], ...] = ()
+
+
+@dataclass(frozen=True)
+class CrossplayGap:
+    """Why a case has no cross-play ranking (the cross-play mode words it).
+
+    Attributes:
+        reason: ``"one_vut"`` (the case's runs are of one VUT), ``"not_found"`` (its loader
+            found no table, or none it could read) or ``"not_these_runs"`` (the table is of
+            other VUTs or runs).
+        vut: ``"one_vut"``: that VUT.
+        loader: ``"not_found"``: the loader's reason (:attr:`CrossplayInput.missing`); ""
+            when it found no table.
+        path: ``"not_these_runs"``: the table.
+        vuts: ``"not_these_runs"``: the table's VUTs.
+        n_opponents: ``"not_these_runs"``: the table's opponents.
+        n_runs: ``"not_these_runs"``: the case's runs with a seed.
+    """
+
+    reason: Literal["one_vut", "not_found", "not_these_runs"]
+    vut: str = ""
+    loader: str = ""
+    path: Path | None = None
+    vuts: tuple[str, ...] = ()
+    n_opponents: int = 0
+    n_runs: int = 0
 
 
 def rank_crossplay(

@@ -228,23 +228,6 @@ class PairDiscriminability:
     share_by_v_pov: FloatArray
     mean_abs_diff_by_h_mps2: FloatArray
 
-    @property
-    def label(self) -> str:
-        return f"{self.a} vs {self.b}"
-
-    def summary(self, threshold_mps2: float, h_step_m: float | None = None) -> str:
-        """One line a user reads in seconds, e.g. ``pi1 vs pi2 differ in 11.9 % of the AYSS
-        box; none below h ≈ 2.95 m``."""
-        if self.lowest_h_m is None:
-            return (
-                f"{self.label}: no difference anywhere in the AYSS box "
-                f"(|Δa| <= {threshold_mps2:g} m/s² at all {self.n_states:,} states)"
-            )
-        head = f"{self.label} differ in {100 * self.share:.1f} % of the AYSS box"
-        if h_step_m is not None and self.lowest_h_m <= h_step_m + 1e-9:
-            return f"{head}; down to the smallest headway (h = {self.lowest_h_m:g} m)"
-        return f"{head}; none below h ≈ {self.lowest_h_m:.2f} m"
-
     def to_dict(self) -> dict[str, Any]:
         def clean(arr: FloatArray) -> list[float | None]:
             return [None if not math.isfinite(v) else float(v) for v in arr]

@@ -6,7 +6,7 @@ spread *between seeds*. Two rules make those intervals read right:
 * **Too few seeds, no interval.** A Student t interval over two points uses
   ``t_{0.975, 1} = 12.7`` times the standard error and reads as nonsense ("crash rate
   28.5 % (−143.03 to 200.03)"). Below :data:`MIN_SEEDS_FOR_INTERVAL` seeds no interval is
-  given, and the text says why (:func:`seed_interval_text`).
+  given (the report says why: :func:`sumo_ayss.modes.formatting.seed_interval_text`).
 * **Inside what is possible.** A rate lies in [0, 1] and a harm per episode too: an
   interval is clipped to the quantity's possible range (``bounds``), and the caption says so.
 
@@ -23,7 +23,6 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sumo_ayss.analysis.formatting import fmt_interval
 from sumo_ayss.analysis.stats import BinnedStats, binned_mean_ci, mean_ci
 from sumo_ayss.errors import ConfigError
 
@@ -32,7 +31,6 @@ __all__ = [
     "SeedBands",
     "binned_seed_means",
     "clip_interval",
-    "seed_interval_text",
     "seed_mean_ci",
 ]
 
@@ -81,21 +79,6 @@ def seed_mean_ci(
     return mean, lo, hi
 
 
-def seed_interval_text(lo: float, hi: float, n_seeds: int, digits: int = 2) -> str:
-    """The interval for a table cell: ``"0.80–1.60"``, ``"2 seeds: no interval"``.
-
-    Args:
-        lo: Lower bound (NaN when there is none).
-        hi: Upper bound.
-        n_seeds: Seeds behind the interval.
-        digits: Decimals of each bound.
-    """
-    text = fmt_interval(lo, hi, digits)
-    if text:
-        return text
-    return f"{n_seeds} seed{'s' if n_seeds != 1 else ''}: no interval"
-
-
 class SeedBands:
     """Between-seed bands of a quantity against headway (:func:`binned_seed_means`).
 
@@ -122,14 +105,6 @@ class SeedBands:
     ) -> None:
         self.centers, self.means, self.lo, self.hi = centers, means, lo, hi
         self.n_seeds, self.per_seed = n_seeds, per_seed
-
-    @property
-    def band_kind(self) -> str:
-        """What the band is, for a legend: t-interval, range of two seeds, or none."""
-        most = int(self.n_seeds.max()) if self.n_seeds.size else 0
-        if most >= MIN_SEEDS_FOR_INTERVAL:
-            return "t-interval over seeds"
-        return "range of the 2 seeds" if most == 2 else "one seed: no band"
 
 
 def binned_seed_means(

@@ -39,8 +39,6 @@ __all__ = [
     "compare_seeds",
     "kendall_tau",
     "rank_seeds",
-    "ranking_line",
-    "seed_ranking_line",
 ]
 
 SeedTest = Literal["paired t", "Welch t", "none"]
@@ -291,29 +289,3 @@ def kendall_tau(order: Sequence[str], truth: Sequence[str]) -> float:
         else:
             discordant += 1
     return (concordant - discordant) / (concordant + discordant)
-
-
-def ranking_line(names: Sequence[str], significant_next: Sequence[bool]) -> str:
-    """``"a > b ≈ c"``: ``>`` where a VUT differs significantly from the next, ``≈`` where
-    not. VUTs joined by ``≈`` are listed by name, so that a tie reads the same in every
-    mode (the order inside it is not a finding).
-
-    Args:
-        names: VUTs safest first.
-        significant_next: Per VUT but the last, whether it differs significantly from the
-            next one.
-    """
-    if not names:
-        return ""
-    groups: list[list[str]] = [[names[0]]]
-    for sig, name in zip(significant_next, names[1:], strict=True):
-        if sig:
-            groups.append([name])
-        else:
-            groups[-1].append(name)
-    return " > ".join(" ≈ ".join(sorted(g)) for g in groups)
-
-
-def seed_ranking_line(rows: Sequence[SeedRankRow]) -> str:
-    """:func:`ranking_line` of a seed-level ranking."""
-    return ranking_line([r.name for r in rows], [bool(r.significant_vs_next) for r in rows[:-1]])

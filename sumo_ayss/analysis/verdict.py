@@ -1,7 +1,8 @@
 """Pairwise verdict between two VUTs from their safety indices (numpy, scipy and the stdlib).
 
 :func:`compare` pairs the bootstrap replicates of two :class:`~.safety_index.SafetyIndex`
-and states which VUT is safer, by how much and how sure that is, as one quotable sentence.
+and states which VUT is safer, by how much and how sure that is, as a :class:`Verdict`
+record (the paper mode words it: :func:`sumo_ayss.modes.paper.verdict_sentence`).
 """
 
 from __future__ import annotations
@@ -12,19 +13,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sumo_ayss.analysis.bootstrap import bootstrap_ci
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_p
 from sumo_ayss.analysis.safety_index import Indicator, SafetyIndex
 from sumo_ayss.analysis.stats import cohens_d, welch_t_test
 from sumo_ayss.analysis.validate import check_level
 from sumo_ayss.errors import ConfigError
 
 __all__ = ["Verdict", "compare"]
-
-
-def _fmt_h_range(h_range: tuple[float, float]) -> str:
-    """``"h ≤ 5 m"`` when the range starts at 0, ``"2 m ≤ h ≤ 5 m"`` otherwise."""
-    lo, hi = h_range
-    return f"h ≤ {hi:g} m" if lo == 0.0 else f"{lo:g} m ≤ h ≤ {hi:g} m"
 
 
 @dataclass(frozen=True)
@@ -55,7 +49,7 @@ class Verdict:
         n_seeds_b: Seeds behind B's index.
         h_range: Headway range in m of the two indices.
         same_bins: Whether both indices average over the same headway bins.
-        indicator: Naming of the indicator for :meth:`sentence`.
+        indicator: Naming of the indicator, for the wording of the verdict.
     """
 
     name_a: str
@@ -74,40 +68,6 @@ class Verdict:
     h_range: tuple[float, float]
     same_bins: bool
     indicator: Indicator = field(default_factory=Indicator)
-
-    def sentence(self) -> str:
-        """One quotable sentence stating the verdict and its statistics."""
-        pct = f"{100.0 * self.level:g} %"
-        where = f"adversarial-yet-safe states with {_fmt_h_range(self.h_range)}"
-        if self.safer is None:
-            text = (
-                f"No significant difference in safety between {self.name_a} and "
-                f"{self.name_b}: over {where}, the mean {self.indicator.name} of "
-                f"{self.name_b}'s SPCPs minus {self.name_a}'s is "
-                f"{self.indicator.amount(self.difference)} ({pct} CI "
-                f"{fmt_interval(self.diff_lo, self.diff_hi)}; "
-                f"P({self.name_a} safer) {fmt_p(self.p_a_safer, cap_high=True)}; "
-                f"{self.n_seeds_a} vs {self.n_seeds_b} seeds)."
-            )
-        else:
-            text = self._safer_sentence(pct, where)
-        if not self.same_bins:
-            text += " Caution: the two indices average over different headway bins."
-        return text
-
-    def _safer_sentence(self, pct: str, where: str) -> str:
-        """The sentence when one VUT is significantly safer."""
-        a_safer = self.safer == self.name_a
-        other = self.name_b if a_safer else self.name_a
-        diff = self.difference if a_safer else -self.difference
-        lo, hi = (self.diff_lo, self.diff_hi) if a_safer else (-self.diff_hi, -self.diff_lo)
-        p = self.p_a_safer if a_safer else 1.0 - self.p_a_safer
-        n_s, n_o = (self.n_seeds_a, self.n_seeds_b) if a_safer else (self.n_seeds_b, self.n_seeds_a)
-        return (
-            f"{self.safer} is safer than {other}: its SPCPs {self.indicator.phrase(diff)} on "
-            f"average over {where} ({pct} CI {fmt_interval(lo, hi)}; "
-            f"P({self.safer} safer) {fmt_p(p, cap_high=True)}; {n_s} vs {n_o} seeds)."
-        )
 
 
 def _check_comparable(a: SafetyIndex, b: SafetyIndex) -> None:
@@ -161,7 +121,7 @@ def compare(
         name_a: Name of VUT A in the verdict.
         name_b: Name of VUT B; must differ from ``name_a``.
         level: Confidence level of the interval of the difference, in (0, 1).
-        indicator: Naming for :meth:`Verdict.sentence`; a generic one if None.
+        indicator: Naming of the indicator in the verdict; a generic one if None.
 
     Returns:
         The :class:`Verdict`.

@@ -5,14 +5,18 @@ A mode decides how a case's VUTs are scored, ranked and compared, and how its ve
 read: ``crossplay`` (default; every SPCP against every VUT), ``exposure`` (each VUT's own
 SPCPs) and ``paper`` (the paper's AYSS safety index). The rest of the package asks the
 registry (``get_mode(options.mode).standings(analysis)``) instead of branching on mode
-names: the configuration validates ``report.mode`` against it, the analysis sets the
-headline through :attr:`Mode.headline`, ``rank`` writes ``ranking.csv`` from
+names: the configuration validates ``report.mode`` against it, the analysis asks
+:attr:`Mode.verdict` for the case's verdict record and the report words it with
+:attr:`Mode.headline` (:func:`headline_text`), ``rank`` writes ``ranking.csv`` from
 :attr:`Mode.standings`, the report's leaderboard and verdict callout read the mode's hooks,
 and the pipeline runs the cross-play stage when :attr:`Mode.runs_crossplay`.
 
 Layering: like the case records, this package imports only the standard library, the
 error tree and the range checks at module level (the configuration reads it without numpy);
 its hooks import :mod:`sumo_ayss.analysis` when called, and nothing above it.
+
+How numbers, intervals and rankings read, in the modes' sentences and the report's tables
+alike: :mod:`.formatting` (standard library only).
 
 Adding a mode: one module here that calls :func:`register_mode` with its record, imported
 below (rows of the modes follow in registry order).
@@ -28,6 +32,7 @@ from sumo_ayss.modes.registry import (
     Mode,
     Standing,
     get_mode,
+    headline_text,
     mode_names,
     register_mode,
     registered_modes,
@@ -45,6 +50,7 @@ __all__ = [
     "Mode",
     "Standing",
     "get_mode",
+    "headline_text",
     "mode_names",
     "register_mode",
     "registered_modes",

@@ -10,7 +10,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from sumo_ayss.modes.registry import Mode, Standing, register_mode
+from sumo_ayss.modes.formatting import ranking_line
+from sumo_ayss.modes.registry import Mode, Standing, get_mode, register_mode
 from sumo_ayss.modes.seed_level import (
     INTERVAL_NAME,
     paper_verdict_lines,
@@ -22,9 +23,27 @@ from sumo_ayss.modes.seed_level import (
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
+    from sumo_ayss.analysis.case_verdict import CaseVerdict
+    from sumo_ayss.analysis.crossplay import CrossplayGap
     from sumo_ayss.analysis.seeds import SeedComparison
 
-__all__ = ["CROSSPLAY", "crossplay_headline", "crossplay_sentence"]
+__all__ = [
+    "CROSSPLAY",
+    "CROSSPLAY_COMMAND",
+    "NO_CROSSPLAY_TABLE",
+    "crossplay_gap_text",
+    "crossplay_headline",
+    "crossplay_sentence",
+    "crossplay_verdict",
+]
+
+NAME = "crossplay"
+
+CROSSPLAY_COMMAND = "python -m sumo_ayss.crossplay <config>"
+"""The command that writes a case's cross-play table."""
+
+NO_CROSSPLAY_TABLE = f"no cross-play table for this case (run {CROSSPLAY_COMMAND})"
+"""Why a case has no cross-play ranking when its loader found no table."""
 
 
 def _fmt(x: float) -> str:
@@ -59,24 +78,50 @@ def crossplay_sentence(c: SeedComparison, blocks: str = "seed") -> str:
     )
 
 
-def crossplay_headline(out: CaseAnalysis) -> None:
-    """Headline and ranking line of the cross-play mode; without a table, the exposure
-    mode's, after a sentence that says so."""
-    from sumo_ayss.analysis.seeds import seed_ranking_line
-    from sumo_ayss.modes.exposure import EXPOSURE, exposure_headline
+def crossplay_gap_text(gap: CrossplayGap) -> str:
+    """Why a case has no cross-play ranking, one sentence."""
+    if gap.reason == "one_vut":
+        return (
+            f"no cross-play for this case: its runs here are of one VUT only ({gap.vut}), and "
+            "cross-play compares two or more"
+        )
+    if gap.reason == "not_these_runs":
+        return (
+            f"the cross-play table {gap.path} is not of these runs (VUTs {', '.join(gap.vuts)}; "
+            f"{gap.n_opponents} opponents, this case has {gap.n_runs} runs with a seed); "
+            f"run {CROSSPLAY_COMMAND} again once every job is done"
+        )
+    return gap.loader or NO_CROSSPLAY_TABLE
 
-    rows = out.crossplay_rows
-    if len(rows) < 2 or rows[0].vs_next is None:
-        exposure_headline(out)
-        out.ranking_mode = EXPOSURE.name
-        reason = out.crossplay_missing or "the cross-play table ranks fewer than two VUTs"
-        out.headline = f"[crossplay mode] {reason}. Shown instead, labelled: {out.headline}"
-        out.headline_kind = "warning"
-        return
-    top = rows[0].vs_next
-    out.headline = crossplay_sentence(top, out.crossplay_blocks)
-    out.headline_kind = "safer" if top.significant else "none"
-    out.ranking_line = seed_ranking_line(rows)
+
+def crossplay_verdict(a: CaseAnalysis) -> CaseVerdict:
+    """The cross-play mode's verdict; without a ranking of two VUTs, the exposure mode's
+    in its place, as a warning."""
+    import dataclasses
+
+    from sumo_ayss.analysis.case_verdict import seed_verdict
+    from sumo_ayss.modes.exposure import EXPOSURE, exposure_verdict
+
+    v = seed_verdict(NAME, a.crossplay_rows, a.crossplay_pairs)
+    if not v.missing:
+        return v
+    return dataclasses.replace(exposure_verdict(a, EXPOSURE.name), kind="warning")
+
+
+def crossplay_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
+    """The cross-play mode's verdict in words; one that fell back to the exposure mode's
+    says why first."""
+    from sumo_ayss.analysis.seeds import SeedComparison
+
+    if v.mode != NAME:
+        if a.crossplay_gap is not None:
+            reason = crossplay_gap_text(a.crossplay_gap)
+        else:
+            reason = "the cross-play table ranks fewer than two VUTs"
+        shown = get_mode(v.mode).headline(a, v)
+        return f"[{NAME} mode] {reason}. Shown instead, labelled: {shown}"
+    assert isinstance(v.top, SeedComparison)
+    return crossplay_sentence(v.top, a.crossplay_blocks)
 
 
 def _standings(a: CaseAnalysis) -> list[Standing]:
@@ -85,16 +130,16 @@ def _standings(a: CaseAnalysis) -> list[Standing]:
 
 def _companion_lines(a: CaseAnalysis) -> list[str]:
     """The exposure ranking beside the cross-play one."""
-    from sumo_ayss.analysis.seeds import seed_ranking_line
-
-    if not a.exposure_rows:
+    rows = a.exposure_rows
+    if not rows:
         return []
-    return [f"Ranking (exposure mode), safest first: {seed_ranking_line(a.exposure_rows)}"]
+    line = ranking_line([r.name for r in rows], [bool(r.significant_vs_next) for r in rows[:-1]])
+    return [f"Ranking (exposure mode), safest first: {line}"]
 
 
 CROSSPLAY = register_mode(
     Mode(
-        name="crossplay",
+        name=NAME,
         description=(
             "Cross-play mode (default): every SPCP of a case drives against every VUT of the "
             "case on the same outcome scenarios; a VUT's score H is the mean harm per episode "
@@ -113,6 +158,7 @@ CROSSPLAY = register_mode(
         digits=3,
         available=lambda a: bool(a.crossplay_rows),
         standings=_standings,
+        verdict=crossplay_verdict,
         headline=crossplay_headline,
         unit=lambda a: "harm/episode, pooled SPCPs (lower = safer)",
         ends=lambda a, safest, least: seed_ends(a.crossplay_pairs, safest, least),

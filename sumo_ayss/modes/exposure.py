@@ -21,9 +21,16 @@ from sumo_ayss.modes.seed_level import (
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
+    from sumo_ayss.analysis.case_verdict import CaseVerdict
     from sumo_ayss.analysis.seeds import SeedComparison
 
-__all__ = ["EXPOSURE", "EXPOSURE_SCORE", "exposure_headline", "exposure_sentence"]
+__all__ = [
+    "EXPOSURE",
+    "EXPOSURE_SCORE",
+    "exposure_headline",
+    "exposure_sentence",
+    "exposure_verdict",
+]
 
 NAME = "exposure"
 
@@ -38,24 +45,25 @@ def exposure_sentence(c: SeedComparison) -> str:
     )
 
 
-def exposure_headline(out: CaseAnalysis) -> None:
-    """Headline and ranking line of the exposure mode."""
-    from sumo_ayss.analysis.seeds import seed_ranking_line
+def exposure_verdict(a: CaseAnalysis, name: str = NAME) -> CaseVerdict:
+    """The exposure mode's verdict, ranked under ``name`` (a plug-in built from this
+    record ranks under its own name)."""
+    from sumo_ayss.analysis.case_verdict import seed_verdict
 
-    rows = out.exposure_rows
-    if len(rows) < 2:
-        out.headline = "[exposure mode] No verdict yet: a verdict needs outcomes of two VUTs."
-        out.headline_kind = "warning"
-        out.ranking_line = rows[0].name if rows else ""
-        return
-    top = rows[0].vs_next
-    assert top is not None
-    out.headline = exposure_sentence(top)
-    out.headline_kind = "safer" if top.significant else "none"
-    if out.info.exposure_caution:
-        out.headline += " " + out.info.exposure_caution
-        out.headline_kind = "warning"
-    out.ranking_line = seed_ranking_line(rows)
+    caution = bool(a.info.exposure_caution)
+    return seed_verdict(name, a.exposure_rows, a.exposure_pairs, caution=caution)
+
+
+def exposure_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
+    """The exposure mode's verdict in words."""
+    from sumo_ayss.analysis.seeds import SeedComparison
+
+    if not isinstance(v.top, SeedComparison):
+        return f"[{NAME} mode] No verdict yet: a verdict needs outcomes of two VUTs."
+    text = exposure_sentence(v.top)
+    if v.caveat == "case_caution":
+        text += " " + a.info.exposure_caution
+    return text
 
 
 def _standings(a: CaseAnalysis) -> list[Standing]:
@@ -79,6 +87,7 @@ EXPOSURE = register_mode(
         digits=3,
         available=lambda a: bool(a.exposure_rows),
         standings=_standings,
+        verdict=lambda a: exposure_verdict(a, a.mode),
         headline=exposure_headline,
         unit=lambda a: "harm/episode, own SPCPs (lower = safer)",
         ends=lambda a, safest, least: seed_ends(a.exposure_pairs, safest, least),

@@ -2,24 +2,136 @@
 adversarial-yet-safe states, condensed into a safety index over headway bins
 (:mod:`sumo_ayss.analysis.safety_index`; hierarchical bootstrap, the slow part).
 
-Its headline is computed for every report (``CaseAnalysis.paper_headline``); a ranking
-in this mode lists it only when it was asked for.
+Its verdict is computed for every report (``CaseAnalysis.paper_verdict``); a ranking
+in this mode lists it only when it was asked for. The mode words its verdicts here: a
+pairwise verdict (:func:`verdict_sentence`), one under the report's significance rule
+(:func:`pair_sentence`, the rule itself: :func:`significance_rule`) and the headline.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import TYPE_CHECKING
 
+from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p
 from sumo_ayss.modes.registry import Mode, Standing, register_mode
 from sumo_ayss.modes.seed_level import no_lines
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
+    from sumo_ayss.analysis.case_verdict import CaseVerdict
+    from sumo_ayss.analysis.significance import PairVerdict, SignificanceOptions
+    from sumo_ayss.analysis.verdict import Verdict
 
-__all__ = ["PAPER"]
+__all__ = ["PAPER", "pair_sentence", "paper_headline", "significance_rule", "verdict_sentence"]
 
 NAME = "paper"
+
+#: Why a paper verdict is missing (:data:`sumo_ayss.analysis.case_verdict.NoVerdict`).
+_NO_VERDICT = {
+    "no_samples": "No verdict yet: no VUT of this case has AYSS samples (ayss.csv).",
+    "not_comparable": "No verdict: the safety indices of the top two VUTs are not comparable.",
+}
+
+_CONFOUNDED = (
+    " Confounded: the SPCPs did not reach the same overall outcome (premise check), "
+    "so this aggressiveness comparison does not isolate the VUTs' safety."
+)
+
+
+def _fmt_h_range(h_range: tuple[float, float]) -> str:
+    """``"h ≤ 5 m"`` when the range starts at 0, ``"2 m ≤ h ≤ 5 m"`` otherwise."""
+    lo, hi = h_range
+    return f"h ≤ {hi:g} m" if lo == 0.0 else f"{lo:g} m ≤ h ≤ {hi:g} m"
+
+
+def verdict_sentence(v: Verdict) -> str:
+    """One quotable sentence stating a pairwise verdict and its statistics."""
+    pct = f"{100.0 * v.level:g} %"
+    where = f"adversarial-yet-safe states with {_fmt_h_range(v.h_range)}"
+    if v.safer is None:
+        text = (
+            f"No significant difference in safety between {v.name_a} and "
+            f"{v.name_b}: over {where}, the mean {v.indicator.name} of "
+            f"{v.name_b}'s SPCPs minus {v.name_a}'s is "
+            f"{v.indicator.amount(v.difference)} ({pct} CI "
+            f"{fmt_interval(v.diff_lo, v.diff_hi)}; "
+            f"P({v.name_a} safer) {fmt_p(v.p_a_safer, cap_high=True)}; "
+            f"{v.n_seeds_a} vs {v.n_seeds_b} seeds)."
+        )
+    else:
+        text = _safer_sentence(v, pct, where)
+    if not v.same_bins:
+        text += " Caution: the two indices average over different headway bins."
+    return text
+
+
+def _safer_sentence(v: Verdict, pct: str, where: str) -> str:
+    """The sentence when one VUT is significantly safer."""
+    a_safer = v.safer == v.name_a
+    other = v.name_b if a_safer else v.name_a
+    diff = v.difference if a_safer else -v.difference
+    lo, hi = (v.diff_lo, v.diff_hi) if a_safer else (-v.diff_hi, -v.diff_lo)
+    p = v.p_a_safer if a_safer else 1.0 - v.p_a_safer
+    n_s, n_o = (v.n_seeds_a, v.n_seeds_b) if a_safer else (v.n_seeds_b, v.n_seeds_a)
+    return (
+        f"{v.safer} is safer than {other}: its SPCPs {v.indicator.phrase(diff)} on "
+        f"average over {where} ({pct} CI {fmt_interval(lo, hi)}; "
+        f"P({v.safer} safer) {fmt_p(p, cap_high=True)}; {n_s} vs {n_o} seeds)."
+    )
+
+
+def pair_sentence(pair: PairVerdict) -> str:
+    """One quotable sentence stating a verdict under the report's significance rule."""
+    v = pair.verdict
+    if v.significant and not pair.significant:
+        neutral = verdict_sentence(dataclasses.replace(v, safer=None, significant=False))
+        why = (
+            f"the seed-level Welch test gives p {fmt_p(v.p_seed_welch)} "
+            f"(needs < {pair.welch_alpha:g})"
+            if math.isfinite(v.p_seed_welch)
+            else "the seed-level Welch test is undefined (it needs two seeds per VUT with spread)"
+        )
+        return (
+            f"{neutral} The bootstrap interval alone excludes 0, but {why}, so the difference "
+            "is not called significant."
+        )
+    welch = (
+        f"p {fmt_p(v.p_seed_welch)}"
+        if math.isfinite(v.p_seed_welch)
+        else "undefined (it needs two seeds per VUT with spread)"
+    )
+    return f"{verdict_sentence(v)} Seed-level Welch test: {welch}."
+
+
+def significance_rule(options: SignificanceOptions) -> str:
+    """The rule of the paper mode (:mod:`sumo_ayss.analysis.significance`), in words."""
+    pct = f"{100 * options.level:g} %"
+    return (
+        "Paper-mode significance rule: a difference between two VUTs is called significant "
+        "only when "
+        f"BOTH the {pct} hierarchical-bootstrap interval of the difference of their safety "
+        "indices excludes 0 AND the seed-level Welch t-test on the per-seed indices gives "
+        f"p < {options.welch_alpha:g}. With only a few seeds per VUT the bootstrap alone is "
+        "anti-conservative (resampling a few seeds understates the seed-to-seed spread), so the "
+        "Welch test, which treats each seed's SPCP as one observation, must agree."
+    )
+
+
+def paper_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
+    """The paper mode's verdict in words."""
+    from sumo_ayss.analysis.significance import PairVerdict
+
+    if isinstance(v.top, PairVerdict):
+        text = pair_sentence(v.top)
+    elif v.missing == "one_vut":
+        only = a.ranking[0].name if a.ranking else "?"
+        text = f"No verdict yet: only {only} has AYSS samples; a verdict needs two VUTs."
+    else:
+        text = _NO_VERDICT.get(v.missing, _NO_VERDICT["not_comparable"])
+    text = f"[{NAME} mode] {text}"
+    return text + _CONFOUNDED if v.caveat == "premise_not_met" else text
 
 
 def _standings(a: CaseAnalysis) -> list[Standing]:
@@ -43,7 +155,7 @@ def _standings(a: CaseAnalysis) -> list[Standing]:
                 p=pair.verdict.p_seed_welch if pair else None,
                 test="Welch t" if pair else "",
                 # Tagged like the seed-level modes' sentences ("[exposure mode] ...").
-                vs_next=f"[paper mode] {pair.sentence}" if pair else "",
+                vs_next=f"[{NAME} mode] {pair_sentence(pair)}" if pair else "",
             )
         )
     return out
@@ -58,20 +170,12 @@ def _ends(a: CaseAnalysis, safest: str, least: str) -> tuple[bool, float]:
 
 
 def _score_text(a: CaseAnalysis, s: Standing) -> str:
-    from sumo_ayss.analysis.formatting import fmt_interval, fmt_num
-
     ci = fmt_interval(s.lo, s.hi)
     return f"{fmt_num(s.score)} {a.info.indicator.unit}" + (f" ({ci})" if ci else "")
 
 
 def _interval_text(lo: float, hi: float, n_seeds: int, digits: int) -> str:
-    from sumo_ayss.analysis.formatting import fmt_interval
-
     return fmt_interval(lo, hi, digits)
-
-
-def _headline(a: CaseAnalysis) -> None:
-    """The headline is already the paper mode's (computed first, for every report)."""
 
 
 PAPER = register_mode(
@@ -89,7 +193,8 @@ PAPER = register_mode(
         # Ranked in paper mode only: the bootstrap is skipped in the other modes.
         available=lambda a: bool(a.ranking) and a.mode == NAME,
         standings=_standings,
-        headline=_headline,
+        verdict=lambda a: a.paper_verdict,  # computed first, for every report
+        headline=paper_headline,
         unit=lambda a: f"{a.info.indicator.unit} (higher = safer)",
         ends=_ends,
         score_text=_score_text,

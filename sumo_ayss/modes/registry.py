@@ -17,11 +17,13 @@ from sumo_ayss.validation import require, suggest
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
+    from sumo_ayss.analysis.case_verdict import CaseVerdict
 
 __all__ = [
     "Mode",
     "Standing",
     "get_mode",
+    "headline_text",
     "mode_names",
     "register_mode",
     "registered_modes",
@@ -88,9 +90,11 @@ class Mode:
             bootstrap); a ranking in another mode skips them.
         available: Whether the mode has a ranking of this case.
         standings: The case's ranking in this mode, safest first.
-        headline: Sets the analysis's ``headline``, ``headline_kind``, ``ranking_line`` and
-            ``ranking_mode`` when this mode was asked for (called after every mode's data is
-            computed and ``headline`` holds the paper mode's).
+        verdict: The case's verdict when this mode was asked for, as a record (called by
+            the analysis after every mode's data is computed); its ``mode`` is another
+            mode's when this one has no ranking and falls back to it.
+        headline: The verdict record in words: ``(analysis, verdict) -> sentence``, for a
+            verdict this mode gave (or fell back from).
         unit: The score's unit text in ``ranking.csv`` and ``ranking.md``.
         ends: ``(found, p)`` for a known safest and least safe VUT: whether this mode
             finds the first significantly safer than the second, and the p-value (NaN when
@@ -111,7 +115,8 @@ class Mode:
     digits: int
     available: Callable[[CaseAnalysis], bool]
     standings: Callable[[CaseAnalysis], list[Standing]]
-    headline: Callable[[CaseAnalysis], None]
+    verdict: Callable[[CaseAnalysis], CaseVerdict]
+    headline: Callable[[CaseAnalysis, CaseVerdict], str]
     unit: Callable[[CaseAnalysis], str]
     ends: Callable[[CaseAnalysis, str, str], tuple[bool, float]]
     score_text: Callable[[CaseAnalysis, Standing], str]
@@ -167,6 +172,11 @@ def get_mode(name: str) -> Mode:
         hint = suggest(name, names) if isinstance(name, str) else ""
         raise ConfigError(f"unknown mode {name!r}{hint}; allowed: {list(names)}")
     return mode
+
+
+def headline_text(a: CaseAnalysis) -> str:
+    """The case's headline: its verdict (``a.verdict``) worded by the mode asked for."""
+    return get_mode(a.mode).headline(a, a.verdict)
 
 
 def mode_names() -> tuple[str, ...]:

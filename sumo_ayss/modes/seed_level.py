@@ -11,7 +11,14 @@ import math
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
-from sumo_ayss.modes.registry import Standing
+from sumo_ayss.modes.formatting import (
+    fmt_interval,
+    fmt_num,
+    fmt_p,
+    ranking_line,
+    seed_interval_text,
+)
+from sumo_ayss.modes.registry import Standing, get_mode
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
@@ -53,8 +60,6 @@ def verdict_sentence(
         mode: Analysis mode named at the start of the sentence.
         digits: Decimals of the amount and its interval.
     """
-    from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p
-
     pct = f"{100 * c.level:g} %"
     if c.test == "paired t":
         how = f"paired t-test over {c.n_a} shared seeds"
@@ -124,23 +129,20 @@ def seed_ends(comparisons: Sequence[SeedComparison], safest: str, least: str) ->
 
 def seed_interval(lo: float, hi: float, n_seeds: int, digits: int) -> str:
     """A seed-level interval as ``ranking.md`` writes it."""
-    from sumo_ayss.analysis.seed_intervals import seed_interval_text
-
     return seed_interval_text(lo, hi, n_seeds, digits)
 
 
 def seed_score_text(a: CaseAnalysis, s: Standing) -> str:
     """A seed-level score with its interval, three decimals, as the leaderboard writes it."""
-    from sumo_ayss.analysis.formatting import fmt_num
-
     return f"{fmt_num(s.score, 3)} ({seed_interval(s.lo, s.hi, s.n_seeds, 3)})"
 
 
 def paper_verdict_lines(a: CaseAnalysis) -> list[str]:
     """The paper mode's verdict, closing the callout of a mode that is not the paper's."""
-    line = a.paper_headline
-    if a.paper_ranking_line:
-        line += f" Ranking (paper mode): {a.paper_ranking_line}."
+    v = a.paper_verdict
+    line = get_mode(v.mode).headline(a, v)
+    if v.order:
+        line += f" Ranking ({v.mode} mode): {ranking_line(v.order, v.apart)}."
     return [line]
 
 

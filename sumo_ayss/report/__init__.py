@@ -29,7 +29,7 @@ _LAZY = {
     "pair_verdict": "sumo_ayss.analysis.significance",
     "render_html": "sumo_ayss.report.render",
     "render_markdown": "sumo_ayss.report.render",
-    "significance_rule": "sumo_ayss.analysis.significance",
+    "significance_rule": "sumo_ayss.modes.paper",
     "vut_safety_index": "sumo_ayss.analysis.case",
     "write_report": "sumo_ayss.report.document",
     "write_report_for": "sumo_ayss.report.document",

@@ -13,7 +13,9 @@ analyses in (the pipeline, which passes them on to rank), composes the sections
 * the PNG figures themselves (:mod:`.figures`).
 
 Nothing here computes a number that a verdict rests on: the statistics and the significance
-rule (:mod:`sumo_ayss.analysis.significance`) live in :mod:`sumo_ayss.analysis`.
+rule (:mod:`sumo_ayss.analysis.significance`) live in :mod:`sumo_ayss.analysis`, which
+returns numbers and verdict records; the ranking modes (:mod:`sumo_ayss.modes`) word the
+verdicts, and the sections here the rest.
 """
 
 from __future__ import annotations
@@ -24,10 +26,11 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis, analyse_case, vut_safety_index
-from sumo_ayss.analysis.significance import PairVerdict, pair_verdict, significance_rule
+from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.modes import get_mode
+from sumo_ayss.modes.paper import significance_rule
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -141,7 +144,7 @@ def build_report(
     if not analyses:
         blocks.append(Callout("No runs", ("No run folder was found.",), "warning"))
     for a in analyses:
-        blocks.append(Callout(a.info.title, verdict_lines(a, options), a.headline_kind))
+        blocks.append(Callout(a.info.title, verdict_lines(a, options), a.verdict.kind))
     blocks.append(Paragraph(modes_paragraph(analyses, options.mode)))
     blocks.append(Paragraph(significance_rule(options)))
     blocks.append(

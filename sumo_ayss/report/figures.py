@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from sumo_ayss.analysis import binned_mean_ci
 from sumo_ayss.analysis.ranking import SafetyIndex
-from sumo_ayss.analysis.seed_intervals import binned_seed_means
+from sumo_ayss.analysis.seed_intervals import MIN_SEEDS_FOR_INTERVAL, SeedBands, binned_seed_means
 from sumo_ayss.cases import case_info
 from sumo_ayss.config import RewardConfig
 from sumo_ayss.envs.rewards import adversarial_reward_array
@@ -42,6 +42,7 @@ from sumo_ayss.report.load import Run
 
 __all__ = [
     "DPI",
+    "band_kind",
     "indicator_figure",
     "learning_curves_figure",
     "reward_shapes_figure",
@@ -230,6 +231,14 @@ def _seed_arrays(run: Run) -> tuple[NDArray[np.float64], NDArray[np.float64]] | 
     return run.ayss.h, run.ayss.indicator
 
 
+def band_kind(bands: SeedBands) -> str:
+    """What a between-seed band is, for a legend: t-interval, range of two seeds, or none."""
+    most = int(bands.n_seeds.max()) if bands.n_seeds.size else 0
+    if most >= MIN_SEEDS_FOR_INTERVAL:
+        return "t-interval over seeds"
+    return "range of the 2 seeds" if most == 2 else "one seed: no band"
+
+
 def _band(
     ax: Axes,
     centers: NDArray[np.float64],
@@ -296,7 +305,7 @@ def indicator_figure(
                 continue
             arrays = [a for _, a in with_data]
             bands = binned_seed_means(arrays, edges, level=level, min_count=2)
-            kinds.add(bands.band_kind)
+            kinds.add(band_kind(bands))
             _band(
                 ax_seeds,
                 centers,

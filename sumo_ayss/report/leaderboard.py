@@ -12,8 +12,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from sumo_ayss.analysis.case import CaseAnalysis
-from sumo_ayss.analysis.formatting import fmt_p
-from sumo_ayss.modes import EXPOSURE, get_mode
+from sumo_ayss.modes import EXPOSURE, get_mode, headline_text
+from sumo_ayss.modes.formatting import fmt_p
 from sumo_ayss.report.blocks import Table
 from sumo_ayss.report.sections.common import crash_cell
 
@@ -100,7 +100,7 @@ def leaderboard_text(analyses: Sequence[CaseAnalysis]) -> str:
         lines.append(f"{a.case}: leaderboard ({a.ranking_mode} mode), safest first")
         lines.append(f"  score: {get_mode(a.ranking_mode).score_name}")
         if not rows:
-            lines.append(f"  no ranking: {a.headline}")
+            lines.append(f"  no ranking: {headline_text(a)}")
         width = max((len(r.vut) for r in rows), default=0)
         for r in rows:
             lines.append(f"  {r.rank:>2}. {r.vut:<{width}}  {r.score}   crashes {r.crash_rate}")

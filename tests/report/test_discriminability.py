@@ -7,11 +7,15 @@ from pathlib import Path
 
 import numpy as np
 
-from sumo_ayss.analysis.discriminability import BoxGrid, compare_responses
+from sumo_ayss.analysis.discriminability import BoxGrid, BoxStates, compare_responses
 from sumo_ayss.discriminability import JSON_NAME, write_outputs
 from sumo_ayss.report import write_report
 from sumo_ayss.report.blocks import FigureBlock, Table
-from sumo_ayss.report.sections.discriminability import discriminability_blocks, read_record
+from sumo_ayss.report.sections.discriminability import (
+    discriminability_blocks,
+    pair_summary,
+    read_record,
+)
 from tests.report.test_report import FAST, make_run
 
 
@@ -26,9 +30,28 @@ def _record(vuts: tuple[str, ...] = ("pi1", "pi2")) -> dict:
         "vuts": list(vuts),
         "settings": {"grid": BoxGrid(speed_step_mps=5.0, headway_step_m=0.5).to_dict()},
         "collisions": {v: 0 for v in vuts},
-        "summary": [p.summary(0.1) for p in result.pairs],
+        "summary": [pair_summary(p, 0.1) for p in result.pairs],
         **result.to_dict(),
     }
+
+
+def test_pair_summary_golden() -> None:
+    """The record's summary lines, on the analysis's hand-computed case."""
+    h = np.array([0.5, 1.5, 2.5, 3.5, 4.5, 4.5])
+    v = np.array([5.0, 5.0, 15.0, 15.0, 25.0, 25.0])
+    a = np.array([-6.0, -6.0, -6.0, -5.0, -4.0, -4.0])
+    b = np.array([-6.0, -6.0, -6.0, -6.0, -6.0, -4.05])
+    res = compare_responses(
+        {"a": a, "b": b, "a2": a.copy()},
+        BoxStates(v_pov_mps=v.copy(), v_vut_mps=v, h_m=h),
+        threshold_mps2=0.1,
+        h_edges_m=[0, 1, 2, 3, 4, 5],
+        v_edges_mps=[0, 10, 20, 30],
+    )
+    ab, aa, _ = res.pairs
+    assert pair_summary(ab, 0.1) == "a vs b differ in 33.3 % of the AYSS box; none below h ≈ 3.50 m"
+    assert pair_summary(ab, 0.1, h_step_m=3.5).endswith("down to the smallest headway (h = 3.5 m)")
+    assert pair_summary(aa, 0.1).startswith("a vs a2: no difference anywhere")
 
 
 def test_blocks_from_a_record(tmp_path: Path) -> None:

@@ -13,10 +13,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from sumo_ayss.analysis.crossplay import CrossplayGap
 from sumo_ayss.analysis.ranking import POV_ACCELERATION, SafetyIndex
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.catalog import BUILTIN_VUTS
 from sumo_ayss.config import RewardConfig, to_dict
+from sumo_ayss.modes import headline_text
+from sumo_ayss.modes.crossplay import crossplay_gap_text
+from sumo_ayss.modes.paper import pair_sentence
 from sumo_ayss.report import (
     RUN_FILES,
     ReportOptions,
@@ -305,7 +309,7 @@ def test_same_vut_under_two_seed_sets_is_no_difference(tmp_path: Path) -> None:
         a, b, name_a="pi1 (seeds 0-2)", name_b="pi1 (seeds 3-5)", indicator=POV_ACCELERATION
     )
     assert not pair.significant and pair.safer is None
-    assert pair.sentence.startswith("No significant difference")
+    assert pair_sentence(pair).startswith("No significant difference")
     text = write_report([tmp_path], tmp_path / "out", options=FAST).read_text(encoding="utf-8")
     assert re.search(
         r"No significant difference in safety between (pi1 and pi1_again|pi1_again and pi1)", text
@@ -335,14 +339,15 @@ def test_bootstrap_alone_is_not_significant() -> None:
     pair = pair_verdict(a, b, name_a="A", name_b="B", indicator=POV_ACCELERATION)
     assert pair.verdict.significant and pair.verdict.p_seed_welch > 0.05
     assert not pair.significant and pair.safer is None
-    assert pair.sentence.startswith("No significant difference")
-    assert "bootstrap interval alone excludes 0" in pair.sentence
+    assert pair_sentence(pair).startswith("No significant difference")
+    assert "bootstrap interval alone excludes 0" in pair_sentence(pair)
     # With tight seeds both tests agree and A is called safer.
     c = _index(2.5, (2.45, 2.5, 2.55), 2.5 + rng.normal(0, 0.05, 400))
     d = _index(2.0, (1.95, 2.0, 2.05), 2.0 + rng.normal(0, 0.05, 400))
     pair = pair_verdict(c, d, name_a="A", name_b="B", indicator=POV_ACCELERATION)
     assert pair.significant and pair.safer == "A"
-    assert pair.sentence.startswith("A is safer than B") and "Welch test: p" in pair.sentence
+    text = pair_sentence(pair)
+    assert text.startswith("A is safer than B") and "Welch test: p" in text
 
 
 def test_outcome_reader_refuses_shapes_no_writer_produces(tmp_path: Path) -> None:
@@ -469,16 +474,20 @@ def test_crossplay_needs_two_vuts_and_a_table_of_these_runs(tmp_path: Path) -> N
     root = tmp_path / "runs"
     dirs = [make_run(root, "cut_in", "pi1", s) for s in range(2)]
     one = analyse_case("cut_in", group_runs([load_run(d) for d in dirs])["cut_in"], FAST)
-    assert "one VUT only (pi1)" in one.crossplay_missing and not one.crossplay_rows
-    assert one.headline.startswith("[crossplay mode] no cross-play for this case")
-    assert one.ranking_mode == "exposure" and one.headline_kind == "warning"
+    assert one.crossplay_gap == CrossplayGap("one_vut", vut="pi1") and not one.crossplay_rows
+    assert "one VUT only (pi1)" in crossplay_gap_text(one.crossplay_gap)
+    assert headline_text(one).startswith("[crossplay mode] no cross-play for this case")
+    assert one.ranking_mode == "exposure" and one.verdict.kind == "warning"
     dirs += [make_run(root, "cut_in", "pi2", s) for s in range(2)]
     make_crossplay(root / "cut_in", ["pi1", "pi2"], range(3))  # a seed these runs lack
     runs = group_runs([load_run(d) for d in dirs])["cut_in"]
     stale = analyse_case("cut_in", runs, FAST, crossplay=load_crossplay(runs))
-    assert "is not of these runs" in stale.crossplay_missing and stale.ranking_mode == "exposure"
+    assert stale.crossplay_gap is not None and stale.ranking_mode == "exposure"
+    assert (stale.crossplay_gap.reason, stale.crossplay_gap.n_runs) == ("not_these_runs", 4)
+    assert "is not of these runs" in crossplay_gap_text(stale.crossplay_gap)
     without = analyse_case("cut_in", runs, FAST)  # no table handed in
-    assert "no cross-play table for this case" in without.crossplay_missing
+    assert without.crossplay_gap == CrossplayGap("not_found")
+    assert "no cross-play table for this case" in crossplay_gap_text(without.crossplay_gap)
 
 
 def test_the_loader_hands_analysis_the_crossplay_table_or_why_there_is_none(tmp_path: Path) -> None:
@@ -500,7 +509,8 @@ def test_the_loader_hands_analysis_the_crossplay_table_or_why_there_is_none(tmp_
     broken = load_crossplay(runs)
     assert broken.matrix is None and "unreadable" in broken.missing
     a = analyse_case("cut_in", runs, FAST, crossplay=broken)
-    assert a.crossplay_missing == broken.missing and broken.problem in a.problems
+    assert a.crossplay_gap == CrossplayGap("not_found", loader=broken.missing)
+    assert crossplay_gap_text(a.crossplay_gap) == broken.missing and broken.problem in a.problems
     other = make_run(tmp_path / "elsewhere", "cut_in", "pi2", 5)
     mixed = group_runs([load_run(d) for d in [*dirs, other]])["cut_in"]
     assert "several case folders" in load_crossplay(mixed).missing

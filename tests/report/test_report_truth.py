@@ -11,8 +11,8 @@ import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from sumo_ayss.analysis.case import analyse_case, ranking_line
-from sumo_ayss.analysis.formatting import fmt_num
+from sumo_ayss.analysis.case import analyse_case
+from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.report import write_report
 from sumo_ayss.report.crossplay_figure import crossplay_lines
 from sumo_ayss.report.episodes import load_crossplay
@@ -119,12 +119,6 @@ def test_single_vut_report_claims_no_verdict_mode(tmp_path: Path) -> None:
     assert "Verdicts above are in" not in html
     assert "No verdict: every case of this report has fewer than two VUTs" in html
     assert "from 1 run folder (" in html
-
-
-def test_ties_read_the_same_in_every_mode() -> None:
-    assert ranking_line(["pi2", "pi1"], [False]) == ranking_line(["pi1", "pi2"], [False])
-    assert ranking_line(["c", "b", "a"], [True, False]) == "c > a ≈ b"
-    assert ranking_line(["c", "b", "a"], [False, True]) == "b ≈ c > a"
 
 
 @pytest.mark.parametrize("width_in", [4.0, 5.4, 8.0])

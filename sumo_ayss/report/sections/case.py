@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 
 from sumo_ayss.analysis.case import CaseAnalysis
-from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.config.report import ReportOptions
-from sumo_ayss.modes import get_mode
+from sumo_ayss.modes import get_mode, headline_text
+from sumo_ayss.modes.formatting import fmt_num, ranking_line
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragraph, Table
 from sumo_ayss.report.sections.common import display_path
@@ -39,7 +39,7 @@ def case_blocks(
     info, case = a.info, a.case
     anchor = f"case-{case}"
     blocks: list[Block] = [Heading(f"{info.title} ({case})", 2, anchor)]
-    blocks.append(Callout(f"Verdict — {info.title}", verdict_lines(a, options), a.headline_kind))
+    blocks.append(Callout(f"Verdict — {info.title}", verdict_lines(a, options), a.verdict.kind))
     if a.problems:
         blocks.append(
             Callout("Missing or incomplete data in this case", tuple(a.problems), "warning")
@@ -60,9 +60,10 @@ def case_blocks(
 
 def verdict_lines(a: CaseAnalysis, options: ReportOptions) -> tuple[str, ...]:
     """The verdict callout: the mode's headline and ranking, the premise, the other modes."""
-    lines = [a.headline]
-    if a.ranking_line:
-        lines.append(f"Ranking ({a.ranking_mode} mode), safest first: {a.ranking_line}")
+    v = a.verdict
+    lines = [headline_text(a)]
+    if v.order:
+        lines.append(f"Ranking ({v.mode} mode), safest first: {ranking_line(v.order, v.apart)}")
     lines += get_mode(a.ranking_mode).companion_lines(a)
     lines.append(premise_sentence(a.premise, options))
     lines += get_mode(a.mode).closing_lines(a)

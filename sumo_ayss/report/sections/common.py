@@ -7,10 +7,10 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_prob
 from sumo_ayss.analysis.harm import VutOutcome
 from sumo_ayss.analysis.ranking import SafetyIndex
 from sumo_ayss.analysis.seeds import SeedComparison
+from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_prob
 from sumo_ayss.report.blocks import Table
 from sumo_ayss.report.load import Estimate, Run
 

@@ -6,11 +6,10 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis
-from sumo_ayss.analysis.formatting import fmt_num, fmt_p
-from sumo_ayss.analysis.seed_intervals import seed_interval_text
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import CROSSPLAY
-from sumo_ayss.modes.crossplay import crossplay_sentence
+from sumo_ayss.modes.crossplay import crossplay_gap_text, crossplay_sentence
+from sumo_ayss.modes.formatting import fmt_num, fmt_p, seed_interval_text
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -58,7 +57,8 @@ def crossplay_blocks(
     blocks.append(_diagonal_block(a))
     m = a.crossplay
     if m is None or not a.crossplay_rows:
-        reason = a.crossplay_missing or "no cross-play ranking"
+        gap = a.crossplay_gap
+        reason = crossplay_gap_text(gap) if gap is not None else "no cross-play ranking"
         return [
             *blocks,
             Callout(

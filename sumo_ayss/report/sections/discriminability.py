@@ -23,19 +23,50 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from sumo_ayss.analysis.formatting import fmt_num
+from sumo_ayss.analysis.discriminability import PairDiscriminability
 from sumo_ayss.cases import case_info
+from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.report import figstyle
 from sumo_ayss.report.blocks import Block, FigureBlock, Heading, Paragraph, Table
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["RECORD_NAME", "discriminability_blocks", "discriminability_figure", "read_record"]
+__all__ = [
+    "RECORD_NAME",
+    "discriminability_blocks",
+    "discriminability_figure",
+    "pair_summary",
+    "read_record",
+]
 
 _MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
 
 #: File name of the record, in ``<out>/<case>/`` (the same name the CLI writes).
 RECORD_NAME = "discriminability.json"
+
+
+def pair_summary(
+    pair: PairDiscriminability, threshold_mps2: float, h_step_m: float | None = None
+) -> str:
+    """One line a user reads in seconds, e.g. ``pi1 vs pi2 differ in 11.9 % of the AYSS
+    box; none below h ≈ 2.95 m`` (the record's ``summary`` lines).
+
+    Args:
+        pair: How the two VUTs' responses differ.
+        threshold_mps2: The difference that counts [m/s²].
+        h_step_m: The smallest headway of the grid [m]; a pair that differs there differs
+            "down to the smallest headway".
+    """
+    label = f"{pair.a} vs {pair.b}"
+    if pair.lowest_h_m is None:
+        return (
+            f"{label}: no difference anywhere in the AYSS box "
+            f"(|Δa| <= {threshold_mps2:g} m/s² at all {pair.n_states:,} states)"
+        )
+    head = f"{label} differ in {100 * pair.share:.1f} % of the AYSS box"
+    if h_step_m is not None and pair.lowest_h_m <= h_step_m + 1e-9:
+        return f"{head}; down to the smallest headway (h = {pair.lowest_h_m:g} m)"
+    return f"{head}; none below h ≈ {pair.lowest_h_m:.2f} m"
 
 
 def read_record(path: Path) -> dict[str, Any] | None:

@@ -11,10 +11,10 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from sumo_ayss.analysis.case import CaseAnalysis
-from sumo_ayss.analysis.formatting import fmt_num
 from sumo_ayss.analysis.measure_ranking import MeasureRanking
 from sumo_ayss.analysis.r157 import R157_DECEL_MPS2, R157_INTRUSION_DEPTH_M, R157_TIME_S
 from sumo_ayss.config.report import ReportOptions
+from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.report.blocks import Block, FigureBlock, Heading, Paragraph, Table
 from sumo_ayss.report.figstyle import save, style
 from sumo_ayss.report.measures import CaseMeasures, case_measures

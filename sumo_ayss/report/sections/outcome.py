@@ -6,13 +6,12 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis
-from sumo_ayss.analysis.formatting import fmt_num, fmt_p
 from sumo_ayss.analysis.premise import Premise
-from sumo_ayss.analysis.seed_intervals import seed_interval_text
 from sumo_ayss.cases import OUTCOME_COLUMNS
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import EXPOSURE
 from sumo_ayss.modes.exposure import exposure_sentence
+from sumo_ayss.modes.formatting import fmt_num, fmt_p, seed_interval_text
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,

@@ -6,10 +6,10 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_prob
-from sumo_ayss.analysis.significance import significance_rule
 from sumo_ayss.analysis.verdict import Verdict
 from sumo_ayss.config.report import ReportOptions
+from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_prob
+from sumo_ayss.modes.paper import pair_sentence, significance_rule
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, BulletList, FigureBlock, Heading, Paragraph, Table
 from sumo_ayss.report.sections.common import seed_points_text
@@ -121,5 +121,5 @@ def paper_blocks(
                 significance_rule(options),
             )
         )
-        blocks.append(BulletList(tuple(p.sentence for p in a.pairs)))
+        blocks.append(BulletList(tuple(pair_sentence(p) for p in a.pairs)))
     return blocks

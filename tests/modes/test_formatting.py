@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import math
 
-from sumo_ayss.analysis.formatting import fmt_interval, fmt_num, fmt_p, fmt_prob
+from sumo_ayss.modes.formatting import (
+    fmt_interval,
+    fmt_num,
+    fmt_p,
+    fmt_prob,
+    ranking_line,
+    seed_interval_text,
+)
 
 
 def test_fmt_num() -> None:
@@ -35,3 +42,17 @@ def test_fmt_p_and_prob() -> None:
     assert fmt_prob(0.0001) == "< 0.001"
     assert fmt_prob(0.9999) == "> 0.999"
     assert fmt_prob(math.nan) == "—"
+
+
+def test_seed_interval_text_says_why_there_is_none() -> None:
+    assert seed_interval_text(math.nan, math.nan, 2) == "2 seeds: no interval"
+    assert seed_interval_text(math.nan, math.nan, 1) == "1 seed: no interval"
+    assert seed_interval_text(0.0, 1.0, 3) == "0.00–1.00"
+    assert seed_interval_text(0.1234, 0.5, 3, 3) == "0.123–0.500"
+
+
+def test_ties_read_the_same_in_every_mode() -> None:
+    assert ranking_line(["pi2", "pi1"], [False]) == ranking_line(["pi1", "pi2"], [False])
+    assert ranking_line(["c", "b", "a"], [True, False]) == "c > a ≈ b"
+    assert ranking_line(["c", "b", "a"], [False, True]) == "b ≈ c > a"
+    assert ranking_line(["a"], []) == "a" and ranking_line([], []) == ""

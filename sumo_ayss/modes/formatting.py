@@ -1,14 +1,24 @@
-"""How numbers, intervals and p-values read in verdict sentences and report tables.
+"""How numbers, intervals, p-values and rankings read in verdict sentences and tables.
 
-One formatter for every sentence and table cell, so a number reads the same in the
-analysis's verdicts and in the report.
+One formatter for every sentence and table cell, so a number reads the same in the modes'
+verdicts, the report and ``rank``'s tables. Here (standard library only) rather than in
+the report because the modes word their own verdicts and may not import the report.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
-__all__ = ["MINUS", "fmt_interval", "fmt_num", "fmt_p", "fmt_prob"]
+__all__ = [
+    "MINUS",
+    "fmt_interval",
+    "fmt_num",
+    "fmt_p",
+    "fmt_prob",
+    "ranking_line",
+    "seed_interval_text",
+]
 
 MINUS = "−"
 """The typographic minus sign (U+2212) of the report's numbers."""
@@ -73,3 +83,40 @@ def fmt_p(p: float | None, *, cap_high: bool = False, undefined: str = "n/a") ->
 def fmt_prob(p: float | None) -> str:
     """A probability for a table cell: ``"0.953"``, ``"< 0.001"``, ``"> 0.999"``, ``"—"``."""
     return fmt_p(p, cap_high=True, undefined="—").removeprefix("= ")
+
+
+def seed_interval_text(lo: float, hi: float, n_seeds: int, digits: int = 2) -> str:
+    """A seed-level interval for a table cell: ``"0.80–1.60"``, ``"2 seeds: no interval"``
+    (:func:`sumo_ayss.analysis.seed_intervals.seed_mean_ci` gives none under three seeds).
+
+    Args:
+        lo: Lower bound (NaN when there is none).
+        hi: Upper bound.
+        n_seeds: Seeds behind the interval.
+        digits: Decimals of each bound.
+    """
+    text = fmt_interval(lo, hi, digits)
+    if text:
+        return text
+    return f"{n_seeds} seed{'s' if n_seeds != 1 else ''}: no interval"
+
+
+def ranking_line(names: Sequence[str], significant_next: Sequence[bool]) -> str:
+    """``"a > b ≈ c"``: ``>`` where a VUT differs significantly from the next, ``≈`` where
+    not. VUTs joined by ``≈`` are listed by name, so that a tie reads the same in every
+    mode (the order inside it is not a finding).
+
+    Args:
+        names: VUTs safest first.
+        significant_next: Per VUT but the last, whether it differs significantly from the
+            next one.
+    """
+    if not names:
+        return ""
+    groups: list[list[str]] = [[names[0]]]
+    for sig, name in zip(significant_next, names[1:], strict=True):
+        if sig:
+            groups.append([name])
+        else:
+            groups[-1].append(name)
+    return " > ".join(" ≈ ".join(sorted(g)) for g in groups)
