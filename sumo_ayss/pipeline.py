@@ -62,12 +62,11 @@ from sumo_ayss.grid_local import run_grid_local
 from sumo_ayss.jobs import JobSpec
 from sumo_ayss.modes import get_mode
 from sumo_ayss.progress import JobStatus
-from sumo_ayss.run_folder import RunFolder
+from sumo_ayss.run_folder import RunRecord, StudyFolder, write_pipeline_json
 from sumo_ayss.validation import suggest
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
-    from sumo_ayss.report.load import Run
 
 logger = logging.getLogger("sumo_ayss.pipeline")  # also when run as __main__
 
@@ -90,15 +89,15 @@ class PipelineResult(NamedTuple):
     Attributes:
         statuses: One per job, in grid order.
         report: The report's ``report.html``, or None when no job finished.
-        runs: The finished jobs' run folders, loaded once
-            (:func:`sumo_ayss.report.load.load_run`), in the order of ``statuses``.
+        runs: The finished jobs' run folders, read once
+            (:func:`sumo_ayss.run_folder.read_run`), in the order of ``statuses``.
         analyses: Every case's analysis (:func:`sumo_ayss.report.load.analyse_runs`, paper
             mode included), computed once; the report's verdicts, and rank's rows.
     """
 
     statuses: list[JobStatus]
     report: Path | None
-    runs: list[Run]
+    runs: list[RunRecord]
     analyses: list[CaseAnalysis]
 
 
@@ -179,7 +178,7 @@ def final_messages(result: PipelineResult) -> list[str]:
     """What the CLI prints at the end: failures, the report and its trust warnings (from
     the runs the pipeline loaded)."""
     lines = [
-        f"FAILED {s.spec.name}: {s.error}  (log: {RunFolder(s.spec.run_dir).job_log})"
+        f"FAILED {s.spec.name}: {s.error}  (log: {s.spec.folder.job_log})"
         for s in result.statuses
         if s.state == "failed"
     ]
@@ -235,9 +234,8 @@ def _run_locked(
     console: Any,
 ) -> PipelineResult:
     """:func:`run_pipeline` once the output folder's lock is held."""
-    from sumo_ayss.atomic import atomic_write_json
-
-    atomic_write_json(cfg.out / "pipeline.json", _relative_paths(to_dict(cfg), cfg.out))
+    study = StudyFolder(cfg.out)
+    write_pipeline_json(study.pipeline_json, _relative_paths(to_dict(cfg), cfg.out))
     after = ", ".join(stages_after_grid(cfg))
     if backend == "ray":
         from sumo_ayss.ray_backend import run_grid_ray
@@ -258,16 +256,16 @@ def _run_locked(
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
     if not finished:
         return PipelineResult(statuses, None, [], [])
-    if get_mode(cfg.report.mode).runs_crossplay:
-        run_crossplay_stage(cfg, statuses)
-    write_discriminability(cfg)
     from sumo_ayss.report.document import load_runs, write_report_for
     from sumo_ayss.report.load import analyse_runs
 
+    runs = load_runs(finished)  # read once: cross-play, the report and rank use them
+    if get_mode(cfg.report.mode).runs_crossplay:
+        run_crossplay_stage(cfg, statuses, runs)
+    write_discriminability(cfg)
     logger.info("report: analysing %d run folders and drawing the figures", len(finished))
-    runs = load_runs(finished)
     analyses = analyse_runs(runs, cfg.report)  # once per case: the report's and rank's
-    report = write_report_for(runs, cfg.out / "report", analyses=analyses, options=cfg.report)
+    report = write_report_for(runs, study.report_dir, analyses=analyses, options=cfg.report)
     return PipelineResult(statuses, report, runs, analyses)
 
 
@@ -280,7 +278,9 @@ def stages_after_grid(cfg: PipelineConfig) -> list[str]:
     return [*stages, "the report"]
 
 
-def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> list[Path]:
+def run_crossplay_stage(
+    cfg: PipelineConfig, statuses: Sequence[JobStatus], runs: Sequence[RunRecord]
+) -> list[Path]:
     """Cross-play of every case of the grid with two or more VUTs; the tables written.
 
     Every SPCP of the case drives against every VUT on the outcome scenarios
@@ -288,15 +288,16 @@ def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> l
     case already cross-played with the same SPCPs and settings is skipped. A case with one
     VUT has no cross-play; a case with a failed job is skipped with a warning (its report
     then says that the cross-play table is missing); a failure of the stage itself is
-    logged, never fatal.
+    logged, never fatal. ``runs``: the finished jobs' records (:func:`~sumo_ayss.run_folder.
+    read_run`).
     """
     from sumo_ayss.crossplay import run_case
-    from sumo_ayss.run_folder import case_dir_for
     from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
 
     if len(cfg.grid.vuts) < 2:
         logger.info("cross-play skipped: the grid has one VUT (cross-play compares two or more)")
         return []
+    by_path = {r.path: r for r in runs}
     written = []
     for case in cfg.grid.cases:
         jobs = [s for s in statuses if s.spec.case == case]
@@ -312,8 +313,8 @@ def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> l
             continue
         try:
             csv_path = run_case(
-                [s.spec.run_dir for s in jobs],
-                case_dir_for(cfg.out, case),
+                [by_path[s.spec.run_dir.resolve()] for s in jobs],
+                StudyFolder(cfg.out).case(case).path,
                 n=cfg.evaluate.n_outcome,
                 seed=DEFAULT_OUTCOME_SEED,
                 trust_controller=True,  # the pipeline's own runs, from the user's configs
@@ -351,7 +352,7 @@ def write_discriminability(cfg: PipelineConfig) -> None:
         )
         try:
             env = discriminability.pipeline_env(cfg, case)
-            discriminability.ensure(env, cfg.grid.vuts, cfg.out / case)
+            discriminability.ensure(env, cfg.grid.vuts, StudyFolder(cfg.out).case(case).path)
         except (AyssError, ImportError, OSError) as e:  # never fatal: the report says so
             logger.warning("discriminability of %s not computed: %s", case, e)
 

@@ -18,6 +18,7 @@ from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import get_mode
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragraph, Table
+from sumo_ayss.report.checks import training_status
 from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.crossplay import crossplay_blocks
 from sumo_ayss.report.sections.discriminability import discriminability_blocks
@@ -108,7 +109,7 @@ def learning_blocks(a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path) -
                     step,
                     score,
                     crit,
-                    run.training.status,
+                    training_status(run.training),
                     display_path(run.path, out_dir),
                 )
             )
