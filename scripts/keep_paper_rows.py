@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from sumo_ayss.rank import write_ranking
-from sumo_ayss.run_folder import RANKING_COLUMNS, StudyFolder, read_order_check, read_ranking_csv
+from sumo_ayss.run_folder import StudyFolder, read_order_check, read_ranking_csv
 
 
 def main(study: Path, previous: Path) -> None:
@@ -26,15 +26,15 @@ def main(study: Path, previous: Path) -> None:
     if not paper:
         return
     merged = []
-    for r in rows + paper:
-        row = {k: r.get(k, "") for k in RANKING_COLUMNS}
+    for r in rows + paper:  # every column: the reader fills a missing one with ""
+        row: dict[str, object] = dict(r)
         for key in ("score", "lo", "hi", "crash_rate", "crash_lo", "crash_hi", "mobility_mps"):
-            if row[key] not in ("", None):
-                row[key] = float(row[key])
+            if r[key] != "":
+                row[key] = float(r[key])
         for key in ("rank", "n_seeds", "crashes", "episodes"):
-            if row[key] not in ("", None):
-                row[key] = int(row[key])
-        row["timid"] = row["timid"] == "True" if row["timid"] != "" else ""
+            if r[key] != "":
+                row[key] = int(r[key])
+        row["timid"] = r["timid"] == "True" if r["timid"] != "" else ""
         merged.append(row)
     found = read_order_check(folder.order_check_json) if folder.order_check_json.is_file() else None
     checks = found.cases if found is not None else ()

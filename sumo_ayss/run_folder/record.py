@@ -340,10 +340,9 @@ def _vut_description(env: Mapping[str, Any], vut: str) -> str:
 
 
 class _Reader:
-    """Collects a run's fields and the sentences of what could not be read."""
+    """Reads a run's files, collecting a sentence for each that could not be read."""
 
-    def __init__(self, folder: RunFolder) -> None:
-        self.folder = folder
+    def __init__(self) -> None:
         self.problems: list[str] = []
 
     def attempt(
@@ -374,7 +373,7 @@ def read_run(path: str | Path) -> RunRecord:
     """
     folder = RunFolder(Path(path).resolve())
     run_dir = folder.path
-    r = _Reader(folder)
+    r = _Reader()
     case, vut, seed = (
         run_dir.parent.parent.name or "unknown",
         run_dir.parent.name or "unknown",
