@@ -37,6 +37,7 @@ import yaml
 from sumo_ayss.atomic import atomic_write_text
 from sumo_ayss.config.budget import BUDGETS
 from sumo_ayss.paths import PROJECT_ROOT
+from sumo_ayss.run_folder import OrderCheck, StudyFolder, read_adaptive, read_order_check
 
 
 def _children_cpu_s() -> float:
@@ -84,19 +85,23 @@ def measure(config: Path, run_out: Path, force: bool) -> dict:
     return result
 
 
-def verdict(run_out: Path, case: str) -> dict:
+def verdict(run_out: Path, case: str) -> OrderCheck:
     """The case's cross-play order check (``order_check.json``)."""
-    checks = json.loads((run_out / "order_check.json").read_text())["cases"]
-    c = next(x for x in checks if x["case"] == case and x["mode"] == "crossplay")
-    c["correct"] = c["tau"] == 1.0 and bool(c["ends_significant"])
-    adaptive = run_out / case / "adaptive.json"  # adaptive seeding's last look
-    ranking = json.loads((run_out / "pipeline.json").read_text())["grid"]["seeds"]
-    c["seeds"] = (
-        json.loads(adaptive.read_text())["looks"][-1]["n_seeds"]
-        if adaptive.is_file()
-        else len(ranking)
-    )
-    return c
+    checks = read_order_check(StudyFolder(run_out).order_check_json).cases
+    return next(x for x in checks if x.case == case and x.mode == "crossplay")
+
+
+def is_correct(check: OrderCheck) -> bool:
+    """The ranking is the known order and its ends differ significantly."""
+    return check.tau == 1.0 and check.ends_significant
+
+
+def seeds_of(run_out: Path, case: str) -> int:
+    """Seeds per VUT the case ended with: adaptive seeding's last look, else the grid's."""
+    adaptive = StudyFolder(run_out).case(case).adaptive_json
+    if adaptive.is_file():
+        return read_adaptive(adaptive).looks[-1].n_seeds
+    return len(json.loads(StudyFolder(run_out).pipeline_json.read_text())["grid"]["seeds"])
 
 
 def main() -> None:
@@ -113,7 +118,7 @@ def main() -> None:
     lines = []
     per_budget: dict[str, tuple[float, int, bool]] = {}
     for budget in a.budgets:
-        total, correct, complete = 0.0, 0, True
+        total, n_correct, complete = 0.0, 0, True
         for case in cases:
             config = write_config(a.ladder, budget, case, a.out)
             m = measure(config, a.out / budget / case, a.force)
@@ -121,15 +126,16 @@ def main() -> None:
                 sys.exit(f"rank failed on {config} (exit {m['returncode']})")
             v = verdict(a.out / budget / case, case)
             total += m["cpu_s"]
-            correct += v["correct"]
+            n_correct += is_correct(v)
             complete &= m["complete"]
+            seeds = seeds_of(a.out / budget / case, case)
             lines.append(
-                f"| {budget} | {case} | {v['seeds']} | {v['tau']:.2f} | {v['ends_p']:.3g} | "
-                f"{v['significant_adjacent']} of {v['adjacent']} | "
-                f"{'yes' if v['correct'] else 'no'} | {m['cpu_s']:.0f} | {m['wall_s']:.0f} |"
+                f"| {budget} | {case} | {seeds} | {v.tau:.2f} | {v.ends_p:.3g} | "
+                f"{v.significant_adjacent} of {v.adjacent} | "
+                f"{'yes' if is_correct(v) else 'no'} | {m['cpu_s']:.0f} | {m['wall_s']:.0f} |"
                 + ("" if m["complete"] else " resumed: CPU-s partial |")
             )
-        per_budget[budget] = (total, correct, complete)
+        per_budget[budget] = (total, n_correct, complete)
     b = BUDGETS
     print(f"ladder {a.ladder.name}, cases {', '.join(cases)}")
     for name in a.budgets:

@@ -65,8 +65,9 @@ def synthetic_nulls(reps: int, rng: np.random.Generator) -> list[dict]:
     rows = []
     shapes = {
         "normal": lambda k, n: rng.normal(size=(k, n)),
-        "block scale sd 0.7": lambda k, n: rng.normal(size=(k, n))
-        * np.exp(rng.normal(0.0, 0.7, n)),
+        "block scale sd 0.7": lambda k, n: (
+            rng.normal(size=(k, n)) * np.exp(rng.normal(0.0, 0.7, n))
+        ),
         "t, 3 df": lambda k, n: rng.standard_t(3, size=(k, n)),
     }
     for shape, draw in shapes.items():
@@ -147,7 +148,10 @@ def _cells_blocks() -> dict[str, tuple[list[str], np.ndarray]]:
                 for i, v in enumerate(vuts):
                     steps = [runs[f"{o}/{s}"]["spcp_by_budget"]["20000"] for o in vuts]
                     x[i, j] = np.mean(
-                        [data[(v, o, s, st)][0][:200].mean() for o, st in zip(vuts, steps, strict=True)]
+                        [
+                            data[(v, o, s, st)][0][:200].mean()
+                            for o, st in zip(vuts, steps, strict=True)
+                        ]
                     )
             out[f"{study} {case} (seeds {seeds[0]}-{seeds[-1]}, cells at 20k)"] = (vuts, x)
     return out

@@ -22,14 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from sumo_ayss.envs import make_env
-from sumo_ayss.evaluate import load_run, load_spcp
-from sumo_ayss.run_folder import (
-    OUTCOME_SCHEMA,
-    RunFolder,
-    read_outcome_json,
-    read_table,
-    write_table,
-)
+from sumo_ayss.evaluate import load_spcp
+from sumo_ayss.run_folder import OUTCOME_SCHEMA, RunRecord, read_run, write_table
 from sumo_ayss.scenarios import rollout
 from sumo_ayss.scenarios.outcome import run_outcome
 
@@ -37,10 +31,11 @@ from sumo_ayss.scenarios.outcome import run_outcome
 OLD_COLUMNS = [c.name for c in OUTCOME_SCHEMA.columns if c.name not in rollout.MEASURE_NAMES]
 
 
-def _timed(run_dir: Path, measures: bool) -> tuple[object, float]:
-    run = load_run(run_dir)
-    settings = read_outcome_json(RunFolder(run_dir).outcome_json).settings
-    env = make_env(run.config.env, sumo_seed=run.seed)
+def _timed(run: RunRecord, measures: bool) -> tuple[object, float]:
+    if run.outcome_record is None:
+        raise SystemExit(f"{run.folder.outcome_json}: missing or unreadable")
+    settings = run.outcome_record.settings
+    env = make_env(run.experiment.env, sumo_seed=run.config_seed)
     original = rollout.measures_of
     if not measures:
         rollout.measures_of = lambda *a: None  # type: ignore[assignment,return-value]
@@ -62,18 +57,20 @@ def main() -> None:
     runs = sorted(p.parent for p in args.study.rglob("outcome.json"))
     with_s, without_s = [], []
     for run_dir in runs:
-        folder = RunFolder(run_dir)
-        old = read_table(folder.outcome_csv, OUTCOME_SCHEMA)
+        run = read_run(run_dir)
+        old = run.outcome_table
+        if old is None:
+            raise SystemExit(f"{run.folder.outcome_csv}: missing or unreadable")
         if args.overhead:
-            _, t_off = _timed(run_dir, measures=False)
+            _, t_off = _timed(run, measures=False)
             without_s.append(t_off)
-        result, t_on = _timed(run_dir, measures=True)
+        result, t_on = _timed(run, measures=True)
         with_s.append(t_on)
         new = result.table  # type: ignore[attr-defined]
         for col in OLD_COLUMNS:
             if not np.array_equal(old[col], new[col], equal_nan=old[col].dtype.kind == "f"):
                 raise SystemExit(f"{run_dir}: column {col} not reproduced; nothing written")
-        write_table(folder.outcome_csv, new)
+        write_table(run.folder.outcome_csv, new)
         line = f"{run_dir}: {len(new)} episodes, {t_on:.2f} s with recording"
         print(line + (f", {without_s[-1]:.2f} s without" if args.overhead else ""))
     if args.overhead and with_s:

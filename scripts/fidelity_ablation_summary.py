@@ -13,11 +13,11 @@ and whether the study called it significant. Writes the Markdown table to
 
 from __future__ import annotations
 
-import csv
 import sys
 from pathlib import Path
 
 from sumo_ayss.atomic import atomic_write_text
+from sumo_ayss.run_folder import StudyFolder, read_ranking_csv
 
 MODES = ("crossplay", "exposure", "paper")
 UNITS = {
@@ -33,9 +33,8 @@ UNITS = {
 def _rows(study: Path) -> dict[tuple[str, str], dict[str, dict[str, str]]]:
     """``{(case, mode): {"pi1": row, "pi2": row}}`` from ``study/ranking.csv``."""
     out: dict[tuple[str, str], dict[str, dict[str, str]]] = {}
-    with (study / "ranking.csv").open() as f:
-        for row in csv.DictReader(f):
-            out.setdefault((row["case"], row["mode"]), {})[row["vut"].split("_")[-1]] = row
+    for row in read_ranking_csv(StudyFolder(study).ranking_csv):
+        out.setdefault((row["case"], row["mode"]), {})[row["vut"].split("_")[-1]] = row
     return out
 
 

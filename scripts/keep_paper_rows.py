@@ -10,37 +10,35 @@ after the rows ``rank`` wrote, unless paper rows are there already.
 
 from __future__ import annotations
 
-import csv
-import json
 import sys
 from pathlib import Path
 
-from sumo_ayss.rank import RANKING_COLUMNS, write_ranking
+from sumo_ayss.rank import write_ranking
+from sumo_ayss.run_folder import StudyFolder, read_order_check, read_ranking_csv
 
 
 def main(study: Path, previous: Path) -> None:
-    with (study / "ranking.csv").open() as f:
-        rows = list(csv.DictReader(f))
+    folder = StudyFolder(study)
+    rows = read_ranking_csv(folder.ranking_csv)
     if any(r["mode"] == "paper" for r in rows):
         return
-    with previous.open() as f:
-        paper = [r for r in csv.DictReader(f) if r["mode"] == "paper"]
+    paper = [r for r in read_ranking_csv(previous) if r["mode"] == "paper"]
     if not paper:
         return
     merged = []
-    for r in rows + paper:
-        row = {k: r.get(k, "") for k in RANKING_COLUMNS}
+    for r in rows + paper:  # every column: the reader fills a missing one with ""
+        row: dict[str, object] = dict(r)
         for key in ("score", "lo", "hi", "crash_rate", "crash_lo", "crash_hi", "mobility_mps"):
-            if row[key] not in ("", None):
-                row[key] = float(row[key])
+            if r[key] != "":
+                row[key] = float(r[key])
         for key in ("rank", "n_seeds", "crashes", "episodes"):
-            if row[key] not in ("", None):
-                row[key] = int(row[key])
-        row["timid"] = row["timid"] == "True" if row["timid"] != "" else ""
+            if r[key] != "":
+                row[key] = int(r[key])
+        row["timid"] = r["timid"] == "True" if r["timid"] != "" else ""
         merged.append(row)
-    check = study / "order_check.json"
-    checks = json.loads(check.read_text())["cases"] if check.is_file() else []
-    expected = json.loads(check.read_text())["expected"] if check.is_file() else []
+    found = read_order_check(folder.order_check_json) if folder.order_check_json.is_file() else None
+    checks = found.cases if found is not None else ()
+    expected = found.expected if found is not None else ()
     write_ranking(merged, study, checks, expected)
     print(f"{study}: {len(paper)} paper-mode rows carried over from {previous}")
 

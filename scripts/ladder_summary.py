@@ -21,8 +21,6 @@ episode can pay; lower = safer).
 
 from __future__ import annotations
 
-import csv
-import json
 import sys
 from pathlib import Path
 
@@ -32,20 +30,26 @@ mpl.use("Agg")
 from matplotlib.figure import Figure
 
 from sumo_ayss.atomic import atomic_write_text
-from sumo_ayss.report.episodes import load_crossplay
-from sumo_ayss.report.load import group_runs, load_run
+from sumo_ayss.report.load import group_runs
+from sumo_ayss.run_folder import (
+    StudyFolder,
+    load_crossplay,
+    read_order_check,
+    read_ranking_csv,
+    read_run,
+)
 
 
 def _runs(study: Path, case: str) -> dict[str, list]:
     """The study's loaded runs of one case, by VUT."""
     dirs = sorted((study / case).glob("*/seed_*"))
-    return group_runs([load_run(d) for d in dirs]).get(case, {})
+    return group_runs([read_run(d) for d in dirs]).get(case, {})
 
 
 def _crash_cells(study: Path, case: str, mode: str, expected: list[str]) -> tuple[str, str]:
     """``"19.8 / 11.6 / 5.7 %"`` in the known order, and the TIMID VUTs, from ranking.csv."""
-    with (study / "ranking.csv").open() as f:
-        rows = {r["vut"]: r for r in csv.DictReader(f) if r["case"] == case and r["mode"] == mode}
+    ranking = read_ranking_csv(StudyFolder(study).ranking_csv)
+    rows = {r["vut"]: r for r in ranking if r["case"] == case and r["mode"] == mode}
     if not all(rows.get(v, {}).get("crash_rate") for v in expected):
         return "—", "—"
     rates = " / ".join(f"{100 * float(rows[v]['crash_rate']):.1f}" for v in expected) + " %"
@@ -64,23 +68,24 @@ def main(root: Path) -> None:
     ]
     panels: dict[tuple[str, str], list[tuple[str, Path, list[str]]]] = {}
     for study in studies:
-        check = json.loads((study / "order_check.json").read_text())
+        check = read_order_check(StudyFolder(study).order_check_json)
+        expected = list(check.expected)
         ladder, _, run = study.name.rpartition("_")
-        for c in check["cases"]:
-            runs = _runs(study, c["case"])
+        for c in check.cases:
+            runs = _runs(study, c.case)
             seeds = sorted({r.seed for rs in runs.values() for r in rs if r.seed is not None})
             per_vut = max((len(rs) for rs in runs.values()), default=0)
-            rates, timid = _crash_cells(study, c["case"], c["mode"], check["expected"])
+            rates, timid = _crash_cells(study, c.case, c.mode, expected)
             lines.append(
-                f"| {ladder} | {c['case']} | {run} ({', '.join(map(str, seeds))}; "
-                f"{per_vut} per VUT) | {c['mode']} | {c['tau']:.2f} | "
-                f"{'yes' if c['ends_significant'] else 'no'} ({c['ends_p']:.3g}) | "
-                f"{c['significant_adjacent']} of {c['adjacent']} | {' > '.join(c['order'])} | "
+                f"| {ladder} | {c.case} | {run} ({', '.join(map(str, seeds))}; "
+                f"{per_vut} per VUT) | {c.mode} | {c.tau:.2f} | "
+                f"{'yes' if c.ends_significant else 'no'} ({c.ends_p:.3g}) | "
+                f"{c.significant_adjacent} of {c.adjacent} | {' > '.join(c.order)} | "
                 f"{rates} | {timid} |"
             )
-            entries = panels.setdefault((ladder, c["case"]), [])
+            entries = panels.setdefault((ladder, c.case), [])
             if all(e[1] != study for e in entries):  # one entry per run, whatever the modes
-                entries.append((run, study, check["expected"]))
+                entries.append((run, study, expected))
     table = "\n".join(lines) + "\n"
     print(table)
     atomic_write_text(root / "summary.md", table)

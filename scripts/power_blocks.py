@@ -14,7 +14,6 @@ Prints a Markdown table.
 from __future__ import annotations
 
 import itertools
-import json
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -22,8 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from sumo_ayss.analysis.stats import student_t_sf
-from sumo_ayss.report.episodes import load_crossplay
-from sumo_ayss.report.load import group_runs, load_run
+from sumo_ayss.report.load import group_runs
+from sumo_ayss.run_folder import StudyFolder, load_crossplay, read_order_check, read_run
 
 NS = (3, 4, 5, 6, 8, 10)
 REPS = 4000
@@ -40,9 +39,9 @@ def power(d: float, sd: float, n: int, rng: np.random.Generator) -> float:
 
 def block_diffs(study: Path) -> dict[tuple[str, str, str], list[float]]:
     """(case, safer VUT, less safe VUT) -> per-block harm differences (less safe - safer)."""
-    expected = json.loads((study / "order_check.json").read_text())["expected"]
+    expected = list(read_order_check(StudyFolder(study).order_check_json).expected)
     out: dict[tuple[str, str, str], list[float]] = {}
-    runs = group_runs([load_run(d) for d in sorted(study.glob("*/*/seed_*"))])
+    runs = group_runs([read_run(d) for d in sorted(study.glob("*/*/seed_*"))])
     for case, by_vut in runs.items():
         m = load_crossplay(by_vut).matrix
         if m is None:

@@ -56,7 +56,15 @@ from sumo_ayss.analysis.harm import episode_harm
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.atomic import atomic_write_text
 from sumo_ayss.paths import PROJECT_ROOT, portable_path
-from sumo_ayss.report.episodes import harm_scale_of
+from sumo_ayss.run_folder import (
+    MODEL_ZIP,
+    RunFolder,
+    RunRecord,
+    StudyFolder,
+    read_eval_rows,
+    read_order_check,
+    read_run,
+)
 
 CELL_COLUMNS = (
     "vut",
@@ -78,16 +86,12 @@ BUDGET_STEP = 10_000
 # ----------------------------------------------------------------------------- cells
 
 
-def _eval_rows(run_dir: Path) -> list[dict[str, float]]:
-    with (run_dir / "eval.csv").open() as f:
-        return [{k: float(v) for k, v in r.items() if k != "checkpoint"} for r in csv.DictReader(f)]
-
-
-def spcp_steps(run_dir: Path, criterion: str) -> dict[int, int]:
+def spcp_steps(run: RunRecord) -> dict[int, int]:
     """Budget B -> step of the candidate the run selects among those at steps <= B."""
     from sumo_ayss.selection import select_spcp
 
-    rows = _eval_rows(run_dir)
+    criterion = run.experiment.train.selection
+    rows = read_eval_rows(run.folder.eval_table)[0]
     last = int(max(r["step"] for r in rows))
     out = {}
     for budget in range(BUDGET_STEP, last + 1, BUDGET_STEP):
@@ -115,18 +119,18 @@ def cells(out: Path, studies: Sequence[Path]) -> None:
     from sumo_ayss.agents.weights import load_greedy_policy
     from sumo_ayss.envs import make_env
     from sumo_ayss.envs.odd import sample_initial_conditions
-    from sumo_ayss.evaluate import load_run
-    from sumo_ayss.run_folder import read_outcome_json
     from sumo_ayss.scenarios.rollout import run_episodes
 
     cases = sorted({p.name for s in studies for p in s.iterdir() if list(p.glob("*/seed_*"))})
     for case in cases:
-        runs = [load_run(d) for d in _run_dirs(studies, case)]
-        settings = read_outcome_json(runs[0].run_dir / "outcome.json").settings
-        n, seed = int(settings["n"]), int(settings["seed"])
+        runs = [read_run(d) for d in _run_dirs(studies, case)]
+        outcome = runs[0].outcome_record
+        if outcome is None:
+            sys.exit(f"{runs[0].folder.outcome_json}: missing or unreadable")
+        n, seed = int(outcome.settings["n"]), int(outcome.settings["seed"])
         envs = {}
         for r in runs:
-            envs.setdefault(r.config.env.vut, r.config.env)
+            envs.setdefault(r.experiment.env.vut, r.experiment.env)
         folder = out / case
         folder.mkdir(parents=True, exist_ok=True)
         path = folder / "cells.csv"
@@ -139,15 +143,17 @@ def cells(out: Path, studies: Sequence[Path]) -> None:
         }
         todo = []
         for r in runs:
-            steps = spcp_steps(r.run_dir, r.config.train.selection)
-            meta["runs"][f"{r.config.env.vut}/{r.seed}"] = {
-                "run_dir": portable_path(r.run_dir),
+            steps = spcp_steps(r)
+            meta["runs"][f"{r.experiment.env.vut}/{r.config_seed}"] = {
+                "run_dir": portable_path(r.path),
                 "spcp_by_budget": {str(b): s for b, s in steps.items()},
-                "sec_per_10k": _sec_per_10k(r.run_dir),
+                "sec_per_10k": _sec_per_10k(r.folder),
             }
             for step in sorted(set(steps.values())):
                 todo += [
-                    (v, r, step) for v in envs if (v, r.config.env.vut, r.seed, step) not in done
+                    (v, r, step)
+                    for v in envs
+                    if (v, r.experiment.env.vut, r.config_seed, step) not in done
                 ]
         atomic_write_text(folder / "cells.json", json.dumps(meta, indent=2) + "\n")
         print(f"{case}: {len(done)} cells done, {len(todo)} to run", flush=True)
@@ -159,15 +165,15 @@ def cells(out: Path, studies: Sequence[Path]) -> None:
                 writer.writeheader()
             for k, (vut, run, step) in enumerate(todo):
                 c0, t0 = time.process_time(), time.perf_counter()
-                env = make_env(envs[vut], sumo_seed=run.seed)
+                env = make_env(envs[vut], sumo_seed=run.config_seed)
                 try:
-                    key = (run.config.env.vut, run.seed, step)
+                    key = (run.experiment.env.vut, run.config_seed, step)
                     if key not in policies:
-                        ckpt = run.run_dir / "checkpoints" / f"step_{step:09d}" / "model.zip"
+                        ckpt = run.folder.step_dir(step) / MODEL_ZIP
                         policies = {
                             key: load_greedy_policy(
                                 ckpt,
-                                run.config.agent,
+                                run.experiment.agent,
                                 env.observation_space,  # type: ignore[arg-type]
                                 env.action_space,  # type: ignore[arg-type]
                             )
@@ -181,8 +187,8 @@ def cells(out: Path, studies: Sequence[Path]) -> None:
                     writer.writerow(
                         {
                             "vut": vut,
-                            "opponent_vut": run.config.env.vut,
-                            "opponent_seed": run.seed,
+                            "opponent_vut": run.experiment.env.vut,
+                            "opponent_seed": run.config_seed,
                             "opponent_step": step,
                             "scenario": j,
                             "collided": int(e.collided),
@@ -195,36 +201,38 @@ def cells(out: Path, studies: Sequence[Path]) -> None:
                         }
                     )
                 f.flush()
-                if vut == run.config.env.vut and step == run.spcp_step:
-                    _check_diagonal(run.run_dir, episodes)
-                    print(f"{run.run_dir}: own SPCP reproduces outcome.csv", flush=True)
+                spcp_step = run.spcp.step if run.spcp is not None else None
+                if vut == run.experiment.env.vut and step == spcp_step:
+                    _check_diagonal(run, episodes)
+                    print(f"{run.path}: own SPCP reproduces outcome.csv", flush=True)
                 print(
-                    f"{case} [{k + 1}/{len(todo)}] {vut} vs {run.config.env.vut}/{run.seed}"
+                    f"{case} [{k + 1}/{len(todo)}] {vut} vs {run.experiment.env.vut}/"
+                    f"{run.config_seed}"
                     f"@{step}: {sum(e.collided for e in episodes)}/{n} crashes "
                     f"({time.perf_counter() - t0:.2f} s)",
                     flush=True,
                 )
 
 
-def _check_diagonal(run_dir: Path, episodes: Sequence[object]) -> None:
+def _check_diagonal(run: RunRecord, episodes: Sequence[object]) -> None:
     """The run's own SPCP against its own VUT must reproduce ``outcome.csv`` exactly."""
-    with (run_dir / "outcome.csv").open() as f:
-        rows = list(csv.DictReader(f))
-    for row, e in zip(rows, episodes, strict=True):
-        same = float(row["episode_return"]) == e.episode_return and int(  # type: ignore[attr-defined]
-            row["collided"] in ("1", "True", "true")
-        ) == int(e.collided)  # type: ignore[attr-defined]
+    table = run.outcome_table
+    if table is None:
+        sys.exit(f"{run.folder.outcome_csv}: missing or unreadable")
+    rows = zip(table["episode_return"].tolist(), table["collided"].tolist(), strict=True)
+    for (episode_return, collided), e in zip(rows, episodes, strict=True):
+        same = episode_return == e.episode_return and bool(collided) == bool(e.collided)  # type: ignore[attr-defined]
         if not same:
-            sys.exit(f"{run_dir}: a rollout differs from outcome.csv: not the product's vehicle")
+            sys.exit(f"{run.path}: a rollout differs from outcome.csv: not the product's vehicle")
 
 
 _STAMP = re.compile(r"^(\S+ \S+) \S+ INFO: candidate (\d+):")
 
 
-def _sec_per_10k(run_dir: Path) -> float:
+def _sec_per_10k(folder: RunFolder) -> float:
     """Median seconds between consecutive candidates in ``job.log`` (per 10k transitions)."""
     stamps = []
-    for line in (run_dir / "job.log").read_text().splitlines():
+    for line in folder.job_log.read_text().splitlines():
         m = _STAMP.match(line)
         if m:
             t = datetime.strptime(m.group(1), "%Y-%m-%d %H:%M:%S,%f").timestamp()
@@ -242,15 +250,11 @@ def _sec_per_10k(run_dir: Path) -> float:
 
 def _load_cells(folder: Path) -> tuple[dict, dict, float]:
     """(vut, opp_vut, opp_seed, step) -> (harm, collided) arrays; meta; CPU-s per episode."""
-    from sumo_ayss.evaluate import load_run
-
     meta = json.loads((folder / "cells.json").read_text())
-    first = PROJECT_ROOT / next(iter(meta["runs"].values()))["run_dir"]
-    cfg = load_run(first).config
-    scale = harm_scale_of(
-        cfg.env.reward,
-        {"episode_s": cfg.env.episode_s, "decision_period_s": cfg.env.decision_period_s},
-    )
+    first = read_run(PROJECT_ROOT / next(iter(meta["runs"].values()))["run_dir"])
+    scale = first.harm_scale
+    if scale is None:
+        sys.exit(f"{first.path}: no harm scale ({'; '.join(first.problems)})")
     data: dict = defaultdict(list)
     cpu: dict = {}
     with (folder / "cells.csv").open() as f:
@@ -337,8 +341,8 @@ def curve(out: Path, expected: Sequence[str] | None, max_subsets: int) -> None:
 
 
 def _expected(meta: dict) -> list[str]:
-    study = PROJECT_ROOT / meta["studies"][0]
-    return list(json.loads((study / "order_check.json").read_text())["expected"])
+    study = StudyFolder(PROJECT_ROOT / meta["studies"][0])
+    return list(read_order_check(study.order_check_json).expected)
 
 
 def _protocol_cpu(v: int, s: int, budget: int, n: int, sec10k: float, cpu_episode: float) -> float:

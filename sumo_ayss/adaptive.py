@@ -30,7 +30,9 @@ from sumo_ayss.run_folder import (
     AdaptiveLook,
     AdaptiveRecord,
     CaseFolder,
+    RunRecord,
     case_dir_for,
+    find_run_dirs,
     read_adaptive,
     write_adaptive,
 )
@@ -42,8 +44,11 @@ __all__ = ["case_seeds", "is_adaptive", "read_record", "run_adaptive", "summary_
 RunJobs = Callable[[list[JobSpec]], list[JobStatus]]
 """Runs a list of jobs on the pipeline's backend and returns their statuses."""
 
-CrossplayStage = Callable[[PipelineConfig, Sequence[JobStatus]], list[Path]]
+CrossplayStage = Callable[[PipelineConfig, Sequence[JobStatus], Sequence[RunRecord]], list[Path]]
 """The pipeline's cross-play stage (:func:`sumo_ayss.pipeline.run_crossplay_stage`)."""
+
+LoadRuns = Callable[[Sequence[Path]], list[RunRecord]]
+"""Reads finished run folders (:func:`sumo_ayss.report.document.load_runs`)."""
 
 
 def is_adaptive(cfg: PipelineConfig) -> bool:
@@ -85,13 +90,13 @@ def case_seeds(cfg: PipelineConfig, case: str) -> tuple[int, ...]:
     return cfg.seeds if record is None else record.seeds
 
 
-def _look(cfg: PipelineConfig, case: str, run_dirs: Sequence[Path]) -> AdaptiveLook:
+def _look(cfg: PipelineConfig, case: str, runs: Sequence[RunRecord]) -> AdaptiveLook:
     """One look at a case from its cross-play table."""
     from sumo_ayss.analysis.sequential import looks_of, settle_check
     from sumo_ayss.crossplay import read_matrix
 
     assert cfg.max_seeds is not None
-    matrix = read_matrix(run_dirs)
+    matrix = read_matrix(runs)
     check = settle_check(
         matrix.scores("seed"),  # seed blocks: the independent replications
         looks_of(len(cfg.seeds), cfg.max_seeds),
@@ -112,18 +117,22 @@ def _describe(case: str, look: AdaptiveLook) -> str:
 def run_adaptive(
     cfg: PipelineConfig,
     statuses: list[JobStatus],
+    runs: list[RunRecord],
     run_jobs: RunJobs,
     crossplay_stage: CrossplayStage,
     plan: Callable[[PipelineConfig, str, int], list[JobSpec]],
-) -> list[JobStatus]:
+    load_runs: LoadRuns,
+) -> tuple[list[JobStatus], list[RunRecord]]:
     """Look at every case, add seeds to those not settled, until each settles or reaches
-    ``max_seeds``; return ``statuses`` with the added jobs' statuses appended.
+    ``max_seeds``; return the statuses and the runs with the added jobs' appended (the runs
+    in :func:`~sumo_ayss.run_folder.find_run_dirs` order, as a resumed pipeline reads them).
 
     ``plan(cfg, case, seed)`` gives one seed's jobs of a case. A case with a failed job or
     without a cross-play table is left as it is (logged).
     """
     assert cfg.max_seeds is not None
     statuses = list(statuses)
+    by_path = {r.path.resolve(): r for r in runs}
     active = list(cfg.grid.cases)
     while active:
         grow = []
@@ -133,7 +142,7 @@ def run_adaptive(
                 logger.warning("adaptive seeding of %s stopped: a job is not done", case)
                 continue
             try:
-                look = _look(cfg, case, [s.spec.run_dir for s in jobs])
+                look = _look(cfg, case, [by_path[s.spec.run_dir.resolve()] for s in jobs])
             except AyssError as exc:
                 logger.warning("adaptive seeding of %s stopped: %s", case, exc)
                 continue
@@ -153,11 +162,18 @@ def run_adaptive(
             new_jobs += plan(cfg, case, seed)
         if not new_jobs:
             break
-        statuses += run_jobs(new_jobs)
+        added = run_jobs(new_jobs)
+        statuses += added
+        done = [s.spec.run_dir for s in added if s.state == "done"]
+        if done:
+            by_path.update((r.path.resolve(), r) for r in load_runs(done))
         active = [case for case, _ in grow]
         only = dataclasses.replace(cfg, grid=dataclasses.replace(cfg.grid, cases=tuple(active)))
-        crossplay_stage(only, [s for s in statuses if s.spec.case in active])
-    return statuses
+        crossplay_stage(
+            only, [s for s in statuses if s.spec.case in active], list(by_path.values())
+        )
+    order = find_run_dirs([s.spec.run_dir for s in statuses if s.state == "done"])
+    return statuses, [by_path[Path(p).resolve()] for p in order]
 
 
 def _record_look(cfg: PipelineConfig, case: str, look: AdaptiveLook) -> AdaptiveRecord:

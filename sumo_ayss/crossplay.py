@@ -10,7 +10,8 @@ outcome scenarios (``evaluate.n_outcome`` of the outcome seed) and writes, per c
   (:data:`~sumo_ayss.run_folder.CROSSPLAY_SCHEMA`);
 * ``<out>/<case>/crossplay.json``: the settings, the opponents with the SHA-256 of their
   ``spcp.zip``, and the wall time (:class:`~sumo_ayss.run_folder.CrossplayRecord`). A rerun
-  with the same settings and SPCPs skips the case.
+  with the same settings and SPCPs skips the case (the stage contract,
+  :class:`~sumo_ayss.run_folder.CrossplayStage`).
 
 (file names, writers and readers: :mod:`sumo_ayss.run_folder`).
 
@@ -37,12 +38,20 @@ from sumo_ayss.cli import prog
 from sumo_ayss.errors import AyssError, CheckpointError, TableError
 from sumo_ayss.run_folder import (
     CROSSPLAY_SCHEMA,
+    OUTCOME_SCHEMA,
     CaseFolder,
     CrossplayOpponent,
     CrossplayRecord,
+    CrossplayStage,
     RunFolder,
+    RunRecord,
+    Table,
     case_dir_for,
+    is_done,
+    load_crossplay,
     read_crossplay_json,
+    read_outcome_json,
+    read_run,
     read_table,
     run_dir_for,
     write_crossplay_json,
@@ -56,24 +65,25 @@ def _sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-def case_runs(out: Path, case: str, vuts: Sequence[str], seeds: Sequence[int]) -> list[Path]:
-    """The run folders of one case of a grid, VUTs then seeds in grid order.
+def case_runs(out: Path, case: str, vuts: Sequence[str], seeds: Sequence[int]) -> list[RunRecord]:
+    """The runs of one case of a grid, read (:func:`~sumo_ayss.run_folder.read_run`), VUTs
+    then seeds in grid order.
 
     Raises:
         CheckpointError: If a run folder has no ``spcp.zip`` (its job did not finish).
     """
-    dirs = [run_dir_for(out, case, v, s) for v in vuts for s in seeds]
-    missing = [str(d) for d in dirs if not RunFolder(d).spcp_zip.is_file()]
+    folders = [RunFolder(run_dir_for(out, case, v, s)) for v in vuts for s in seeds]
+    missing = [str(f.path) for f in folders if not f.spcp_zip.is_file()]
     if missing:
         raise CheckpointError(
             f"cross-play needs every SPCP of the grid; no spcp.zip in {', '.join(missing)} "
             "(run the grid first: python -m sumo_ayss.rank <config>)"
         )
-    return dirs
+    return [read_run(f.path) for f in folders]
 
 
 def run_case(
-    run_dirs: Sequence[Path],
+    runs: Sequence[RunRecord],
     case_dir: Path,
     *,
     n: int,
@@ -84,16 +94,19 @@ def run_case(
 ) -> Path:
     """Cross-play of one case's runs; writes and returns the case folder's ``crossplay.csv``.
 
-    After the rollouts, every SPCP's episodes against its own VUT are compared with its
-    run's ``outcome.csv`` (:func:`~sumo_ayss.scenarios.crossplay.diagonal_check`); the
-    result goes into ``crossplay.json``.
+    Skipped when the stage is done with these settings and SPCPs
+    (:class:`~sumo_ayss.run_folder.CrossplayStage`), unless ``force``. After the rollouts,
+    every SPCP's episodes against its own VUT are compared with its run's ``outcome.csv``
+    (:func:`~sumo_ayss.scenarios.crossplay.diagonal_check`); the result goes into
+    ``crossplay.json``.
 
     Raises:
         DiagonalMismatchError: If an SPCP did not reproduce its outcome table (the table
             and the record are written first, for inspection; loaders refuse to rank it).
         TableError: If a run's outcome table is missing or was run on other scenarios.
+        CheckpointError: If a run's configuration or SPCP cannot be read.
     """
-    from sumo_ayss.evaluate import load_run, load_spcp
+    from sumo_ayss.evaluate import load_spcp
     from sumo_ayss.scenarios.crossplay import (
         Opponent,
         check_diagonal,
@@ -101,47 +114,36 @@ def run_case(
         run_crossplay,
     )
 
-    runs = [load_run(d) for d in run_dirs]
     pool = tuple(
-        CrossplayOpponent(r.config.env.vut, r.seed, _sha256(RunFolder(r.run_dir).spcp_zip))
+        CrossplayOpponent(r.experiment.env.vut, r.config_seed, _sha256(r.folder.spcp_zip))
         for r in runs
     )
     folder = CaseFolder(case_dir)
-    csv_path, json_path = folder.crossplay_csv, folder.crossplay_json
-    case = runs[0].config.env.case
+    case = runs[0].experiment.env.case
     requested = CrossplayRecord(case, n, seed, pool, (), 0.0)
     envs: dict[str, Any] = {}
     for r in runs:
-        envs.setdefault(r.config.env.vut, r.config.env)
-    earlier = None  # a table of a smaller pool that this one extends (new seeds added)
-    if not force and csv_path.is_file() and json_path.is_file():
-        try:
-            done = read_crossplay_json(json_path)
-        except TableError as exc:
-            logger.warning("%s; cross-play of %s runs again", exc, case_dir)
-        else:
-            if done.same_inputs(requested) and done.diagonal:
-                logger.info("%s: cross-play done with these settings and SPCPs; skipped", case_dir)
-                check_diagonal(done.diagonal, case)
-                return csv_path
-            if done.extended_by(requested) and done.diagonal and done.vuts == tuple(envs):
-                earlier = done
+        envs.setdefault(r.experiment.env.vut, r.experiment.env)
+    if not force and _done(CrossplayStage(folder, requested)):
+        logger.info("%s: cross-play done with these settings and SPCPs; skipped", case_dir)
+        check_diagonal(read_crossplay_json(folder.crossplay_json).diagonal, case)
+        return folder.crossplay_csv
+    earlier = None if force else _extended(folder, requested, tuple(envs))
     if earlier is not None:
         old = set(earlier.opponents)
-        runs_to_play = [r for r, o in zip(runs, pool, strict=True) if o not in old]
+        to_play = [r for r, o in zip(runs, pool, strict=True) if o not in old]
         logger.info(
             "%s: cross-play of %d new SPCPs (the table of the other %d is kept)",
             case_dir,
-            len(runs_to_play),
+            len(to_play),
             len(old),
         )
     else:
-        runs_to_play = runs
-    outcomes = {
-        (r.config.env.vut, r.seed): _outcome_table(r.run_dir, n, seed) for r in runs_to_play
-    }
+        to_play = list(runs)
+    outcomes = {(r.experiment.env.vut, r.config_seed): _outcome_table(r, n, seed) for r in to_play}
     opponents = [
-        Opponent(r.config.env.vut, r.seed, functools.partial(load_spcp, r)) for r in runs_to_play
+        Opponent(r.experiment.env.vut, r.config_seed, functools.partial(load_spcp, r))
+        for r in to_play
     ]
     t0 = time.perf_counter()
     with controller_imports(trust_controller):
@@ -149,15 +151,42 @@ def run_case(
     wall_s = time.perf_counter() - t0
     checks = tuple(diagonal_check(table, v, s, out) for (v, s), out in outcomes.items())
     if earlier is not None:
-        table = _merged(read_table(csv_path, CROSSPLAY_SCHEMA), table, tuple(envs), pool)
+        table = _merged(
+            read_table(folder.crossplay_csv, CROSSPLAY_SCHEMA), table, tuple(envs), pool
+        )
         checks = _merged_checks(earlier.diagonal, checks, pool)
         wall_s += earlier.wall_s
     folder.path.mkdir(parents=True, exist_ok=True)
-    write_table(csv_path, table)
+    write_table(folder.crossplay_csv, table)
     record = dataclasses.replace(requested, vuts=tuple(envs), wall_s=wall_s, diagonal=checks)
-    write_crossplay_json(json_path, record)
+    write_crossplay_json(folder.crossplay_json, record)
     check_diagonal(checks, case)
-    return csv_path
+    return folder.crossplay_csv
+
+
+def _done(stage: CrossplayStage) -> bool:
+    """Whether the stage is done; an unreadable record is logged and the case runs again."""
+    try:
+        return is_done(stage)
+    except TableError as exc:
+        logger.warning("%s; cross-play of %s runs again", exc, stage.folder.path)
+        return False
+
+
+def _extended(
+    folder: CaseFolder, requested: CrossplayRecord, vuts: tuple[str, ...]
+) -> CrossplayRecord | None:
+    """The case's recorded cross-play when ``requested`` only adds opponents to it (the same
+    scenarios, rollout and VUTs; adaptive seeding's new seeds), else None."""
+    if not (folder.crossplay_csv.is_file() and folder.crossplay_json.is_file()):
+        return None
+    try:
+        done = read_crossplay_json(folder.crossplay_json)
+    except TableError:
+        return None
+    if done.extended_by(requested) and done.diagonal and done.vuts == vuts:
+        return done
+    return None
 
 
 def _merged(old: Any, new: Any, vuts: tuple[str, ...], pool: tuple[Any, ...]) -> Any:
@@ -184,36 +213,43 @@ def _merged_checks(old: Sequence[Any], new: Sequence[Any], pool: tuple[Any, ...]
     return tuple(by_run[(o.vut, o.seed)] for o in pool if (o.vut, o.seed) in by_run)
 
 
-def _outcome_table(run_dir: Path, n: int, seed: int) -> Any:
-    """A run's outcome table, checked to hold the scenarios cross-play drives."""
-    from sumo_ayss.run_folder import OUTCOME_SCHEMA, read_outcome_json, read_table
+def _outcome_table(run: RunRecord, n: int, seed: int) -> Table:
+    """A run's outcome table, checked to hold the scenarios cross-play drives.
 
-    folder = RunFolder(run_dir)
-    settings = read_outcome_json(folder.outcome_json).settings
+    Raises:
+        TableError: If ``outcome.json`` or ``outcome.csv`` is missing or unreadable (the
+            reader's own message, naming the file), or the outcome stage ran other
+            scenarios.
+    """
+    folder = run.folder
+    # What the record could not read is read again here, for the reader's own error.
+    outcome = run.outcome_record or read_outcome_json(folder.outcome_json)
+    settings = outcome.settings
     if (settings.get("n"), settings.get("seed")) != (n, seed):
         raise TableError(
             f"{folder.outcome_json}: the outcome stage ran n={settings.get('n')}, "
             f"seed={settings.get('seed')}; cross-play drives n={n}, seed={seed}, so its diagonal "
             "cannot be checked against it (re-run: python -m sumo_ayss.evaluate <run> --force)"
         )
+    if run.outcome_table is not None:
+        return run.outcome_table
     return read_table(folder.outcome_csv, OUTCOME_SCHEMA)
 
 
-def read_matrix(run_dirs: Sequence[Path]) -> Any:
+def read_matrix(runs: Sequence[RunRecord]) -> Any:
     """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of one case's runs, scored
-    on their harm scale, with its diagonal check (:func:`sumo_ayss.report.load.
+    on their harm scale, with its diagonal check (:func:`sumo_ayss.run_folder.
     load_crossplay`).
 
     Raises:
         TableError: If there is no usable table (the message says why).
     """
-    from sumo_ayss.report.episodes import load_crossplay
-    from sumo_ayss.report.load import group_runs, load_run
+    from sumo_ayss.report.load import group_runs
 
-    groups = group_runs([load_run(d) for d in run_dirs])
+    groups = group_runs(runs)
     found = load_crossplay(next(iter(groups.values())))
     if found.matrix is None:
-        raise TableError(found.missing or f"no cross-play table for {run_dirs[0]}")
+        raise TableError(found.missing or f"no cross-play table for {runs[0].path}")
     return found.matrix
 
 
@@ -258,9 +294,9 @@ def main(argv: Sequence[str] | None = None) -> None:
         cfg = load_pipeline(args.config, out=out, seeds=args.seeds)
         seeds = cfg.seeds
         for case in cfg.grid.cases:
-            dirs = case_runs(Path(cfg.out), case, cfg.grid.vuts, seeds)
+            runs = case_runs(Path(cfg.out), case, cfg.grid.vuts, seeds)
             run_case(
-                dirs,
+                runs,
                 case_dir_for(cfg.out, case),
                 n=cfg.evaluate.n_outcome,
                 seed=DEFAULT_OUTCOME_SEED,
@@ -268,7 +304,7 @@ def main(argv: Sequence[str] | None = None) -> None:
                 trust_controller=args.trust_controller,
                 progress=functools.partial(print, f"{case}:", flush=True),
             )
-            matrix = read_matrix(dirs)
+            matrix = read_matrix(runs)
             rows, _pairs = rank_crossplay(matrix, blocks=args.blocks)
             print(f"\n{case}: cross-play ranking, safest first (lower harm = safer)")
             for r in rows:

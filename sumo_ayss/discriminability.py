@@ -23,11 +23,7 @@ pipeline YAML (``grid: ...``; its ``vuts`` section adds VUTs to every case, and
 from __future__ import annotations
 
 import argparse
-import csv
 import dataclasses
-import hashlib
-import io
-import json
 import logging
 import sys
 import time
@@ -42,7 +38,6 @@ from sumo_ayss.analysis.discriminability import (
     Discriminability,
     compare_responses,
 )
-from sumo_ayss.atomic import atomic_write_json, atomic_write_text
 from sumo_ayss.cases import case_names
 from sumo_ayss.cli import prog
 from sumo_ayss.config import (
@@ -53,15 +48,17 @@ from sumo_ayss.config import (
     load_experiment,
     load_pipeline,
     read_yaml,
-    to_dict,
 )
 from sumo_ayss.errors import AyssError, ConfigError
+from sumo_ayss.run_folder import (
+    CaseFolder,
+    DiscriminabilityStage,
+    is_done,
+    read_discriminability_json,
+    write_discriminability,
+)
 
 logger = logging.getLogger(__name__)
-
-JSON_NAME = "discriminability.json"
-CSV_NAME = "discriminability.csv"
-PNG_NAME = "discriminability.png"
 
 #: Keys that mark a pipeline YAML (any other top-level mapping is read as an experiment).
 #: Keys a run folder's config.yaml adds to an experiment.
@@ -144,20 +141,6 @@ def pipeline_env(pipe: PipelineConfig, case: Case) -> EnvConfig:
     return dataclasses.replace(exp.env, vuts={**exp.env.vuts, **pipe.vuts})
 
 
-def fingerprint(env: EnvConfig, vuts: Sequence[str], settings: dict[str, Any]) -> str:
-    """Hash of everything a result depends on (vehicle types, case, SUMO options, grid)."""
-    parts = {
-        "case": env.case,
-        "vuts": {v: to_dict(env.vuts[v]) for v in vuts},
-        "pov": to_dict(env.pov),
-        "sim": to_dict(env.sim),
-        "decision_period_s": env.decision_period_s,
-        "settings": settings,
-    }
-    text = json.dumps(parts, sort_keys=True, default=str)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
 def compute(
     env: EnvConfig,
     vuts: Sequence[str],
@@ -198,11 +181,7 @@ def compute(
         if progress:
             print(f"  {vut}: {len(states):,} states in {seconds[vut]:.1f} s", file=sys.stderr)
     result = compare_responses(responses, states, threshold_mps2=threshold_mps2)
-    settings = {
-        "grid": grid.to_dict(),
-        "threshold_mps2": threshold_mps2,
-        "decisions": decisions,
-    }
+    settings = _settings(grid, threshold_mps2, decisions)
     meta = {
         "case": env.case,
         "vuts": list(vuts),
@@ -215,7 +194,7 @@ def compute(
         "step_length_s": env.sim.step_length_s,
         "collisions": collisions,
         "seconds": seconds,
-        "fingerprint": fingerprint(env, vuts, settings),
+        "fingerprint": _stage(env, vuts, settings, Path()).key(),
         "summary": summary_lines(result, grid),
         **result.to_dict(),
     }
@@ -232,70 +211,45 @@ def summary_lines(result: Discriminability, grid: BoxGrid | None = None) -> list
 
 
 def write_outputs(meta: dict[str, Any], out_dir: str | Path, *, figure: bool = True) -> list[Path]:
-    """Write ``discriminability.json``, ``.csv`` (long table) and ``.png`` into ``out_dir``."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    atomic_write_json(out / JSON_NAME, meta)
-    rows = csv_rows(meta)
-    buf = io.StringIO()
-    writer = csv.DictWriter(
-        buf, fieldnames=["pair", "dimension", "bin_low", "bin_high", "share"], lineterminator="\n"
-    )
-    writer.writeheader()
-    writer.writerows(rows)
-    atomic_write_text(out / CSV_NAME, buf.getvalue())
-    paths = [out / JSON_NAME, out / CSV_NAME]
+    """Write ``discriminability.json`` and ``.csv`` (:func:`~sumo_ayss.run_folder.
+    write_discriminability`) and the figure ``.png`` into ``out_dir``."""
+    folder = CaseFolder(Path(out_dir))
+    paths = write_discriminability(folder, meta)
     if figure:
         from sumo_ayss.report.sections.discriminability import discriminability_figure
 
-        png = discriminability_figure(meta, out / PNG_NAME)
+        png = discriminability_figure(meta, folder.discriminability_png)
         if png is not None:
             paths.append(png)
     return paths
 
 
-def csv_rows(meta: dict[str, Any]) -> list[dict[str, Any]]:
-    """The long table of a JSON record (one row per pair, dimension and bin)."""
-    rows: list[dict[str, Any]] = []
-    dims = (
-        ("h_m", meta["h_edges_m"], "share_by_h"),
-        ("v_vut_mps", meta["v_edges_mps"], "share_by_v_vut"),
-        ("v_pov_mps", meta["v_edges_mps"], "share_by_v_pov"),
-    )
-    for p in meta["pairs"]:
-        label = f"{p['a']} vs {p['b']}"
-        rows.append({"pair": label, "dimension": "all", "bin_low": "", "bin_high": "",
-                     "share": p["share"]})  # fmt: skip
-        for dim, edges, key in dims:
-            for lo, hi, s in zip(edges[:-1], edges[1:], p[key], strict=True):
-                rows.append({"pair": label, "dimension": dim, "bin_low": lo, "bin_high": hi,
-                             "share": "" if s is None else s})  # fmt: skip
-    return rows
+def _settings(grid: BoxGrid, threshold_mps2: float, decisions: int) -> dict[str, Any]:
+    return {"grid": grid.to_dict(), "threshold_mps2": threshold_mps2, "decisions": decisions}
+
+
+def _stage(
+    env: EnvConfig, vuts: Sequence[str], settings: dict[str, Any], out_dir: Path
+) -> DiscriminabilityStage:
+    return DiscriminabilityStage(CaseFolder(out_dir), env, tuple(vuts), settings)
 
 
 def ensure(
     env: EnvConfig, vuts: Sequence[str], out_dir: str | Path, **kwargs: Any
 ) -> dict[str, Any]:
-    """:func:`compute` + :func:`write_outputs`, unless ``out_dir`` holds a JSON made from the
-    same inputs (same fingerprint): then that record is returned as is."""
-    out = Path(out_dir)
-    grid = kwargs.get("grid") or BoxGrid()
-    settings = {
-        "grid": grid.to_dict(),
-        "threshold_mps2": kwargs.get("threshold_mps2", DEFAULT_THRESHOLD_MPS2),
-        "decisions": kwargs.get("decisions", 1),
-    }
-    fp = fingerprint(env, vuts, settings)
-    existing = out / JSON_NAME
-    if existing.is_file():
-        try:
-            old = json.loads(existing.read_text(encoding="utf-8"))
-            if old.get("fingerprint") == fp:
-                return dict(old)
-        except (OSError, ValueError, AttributeError):  # unreadable, not JSON, not an object
-            pass
+    """:func:`compute` + :func:`write_outputs`, unless ``out_dir`` holds a record made from
+    the same inputs (:class:`~sumo_ayss.run_folder.DiscriminabilityStage` is done): then
+    that record is returned as is."""
+    settings = _settings(
+        kwargs.get("grid") or BoxGrid(),
+        kwargs.get("threshold_mps2", DEFAULT_THRESHOLD_MPS2),
+        kwargs.get("decisions", 1),
+    )
+    stage = _stage(env, vuts, settings, Path(out_dir))
+    if is_done(stage):
+        return read_discriminability_json(stage.folder.discriminability_json)
     _, meta = compute(env, vuts, **kwargs)
-    write_outputs(meta, out)
+    write_outputs(meta, out_dir)
     return meta
 
 

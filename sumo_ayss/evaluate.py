@@ -15,43 +15,38 @@ selected policy ``<run>/spcp.zip``, and writes into the run folder:
 
 Both stages run in one env, so in one SUMO simulation (libsumo allows one per process). A
 stage whose CSV and JSON both exist is skipped unless ``--force``; a skipped stage whose
-stored settings differ from the requested ones is reported in the log. ``--seed`` fixes the
-outcome scenario set and the AYSS draws; keep it the same for every run that is compared.
+stored settings differ from the requested ones is reported in the log (the stage contract,
+:class:`~sumo_ayss.run_folder.OutcomeStage` and :class:`~sumo_ayss.run_folder.AyssStage`).
+``--seed`` fixes the outcome scenario set and the AYSS draws; keep it the same for every run
+that is compared.
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import logging
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from sumo_ayss.catalog import controller_imports
 from sumo_ayss.cli import prog
-from sumo_ayss.config import (
-    DEFAULT_AYSS_SEED,
-    AyssConfig,
-    ExperimentConfig,
-    experiment_from_dict,
-    to_dict,
-)
+from sumo_ayss.config import DEFAULT_AYSS_SEED, AyssConfig, to_dict
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
+from sumo_ayss.errors import AyssError, CheckpointError
 from sumo_ayss.paths import portable_path
 from sumo_ayss.run_folder import (
-    RunFolder,
+    AyssStage,
+    OutcomeStage,
+    RunRecord,
     StageHeader,
-    read_ayss_json,
-    read_outcome_json,
-    read_run_config,
-    read_spcp,
+    is_done,
+    read_run,
     write_ayss_json,
     write_outcome_json,
     write_table,
@@ -61,26 +56,9 @@ from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_N, DEFAULT_OUTCOME_SEED,
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.threads import set_torch_threads
 
-__all__ = ["EvaluationResult", "evaluate_run", "load_run", "main"]
+__all__ = ["EvaluationResult", "evaluate_run", "load_spcp", "main"]
 
 logger = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class RunInfo:
-    """What a run folder says about itself.
-
-    Attributes:
-        run_dir: The folder.
-        config: The resolved experiment configuration (``env.vut`` is the run's VUT).
-        seed: The training seed (also the run's SUMO seed).
-        spcp_step: Training step of the selected candidate (``spcp.json``), if recorded.
-    """
-
-    run_dir: Path
-    config: ExperimentConfig
-    seed: int
-    spcp_step: int | None
 
 
 @dataclass(frozen=True)
@@ -96,100 +74,65 @@ class EvaluationResult:
     ran_ayss: bool
 
 
-def load_run(run_dir: str | Path, *, known: tuple[ExperimentConfig, int] | None = None) -> RunInfo:
-    """Read ``config.yaml`` (and ``spcp.json`` if present) of a run folder.
-
-    Reading never imports the user controller a config names: that happens when an env is
-    built, inside ``controller_imports(trust)`` (see :func:`evaluate_run`).
-
-    Args:
-        run_dir: The run folder.
-        known: The run's configuration and seed as the caller already holds them (the
-            pipeline, which just trained or checked the folder): ``config.yaml`` is then
-            not parsed again.
+def load_spcp(run: RunRecord, env: PairEnv) -> Policy:
+    """The run's SPCP as a greedy policy, its weights read without unpickling (trust model).
 
     Raises:
-        CheckpointError: If the folder or its config is missing or unreadable.
+        CheckpointError: If the run has no ``spcp.zip`` or no readable ``config.yaml``.
     """
-    folder = RunFolder(Path(run_dir))
-    path = folder.config
-    if not path.is_file():
-        raise CheckpointError(f"{folder.path}: not a run folder (no {path.name})")
-    cfg, seed = known if known is not None else _read_run_config(path)
-    spcp_step = read_spcp(folder.spcp_json).step if folder.spcp_json.is_file() else None
-    return RunInfo(folder.path, cfg, seed, spcp_step)
-
-
-def _read_run_config(path: Path) -> tuple[ExperimentConfig, int]:
-    """A run folder's ``config.yaml`` (:func:`~sumo_ayss.run_folder.read_run_config`): the
-    experiment, its VUT set, and the seed."""
-    stored = read_run_config(path)
-    try:
-        return experiment_from_dict(stored.experiment, path.parent), stored.seed
-    except ConfigError as exc:
-        raise CheckpointError(f"{path}: invalid run configuration: {exc}") from exc
-
-
-def load_spcp(run: RunInfo, env: PairEnv) -> Policy:
-    """The run's SPCP as a greedy policy, its weights read without unpickling (trust model)."""
     from sumo_ayss.agents.weights import load_greedy_policy
 
-    path = RunFolder(run.run_dir).spcp_zip
+    path = run.folder.spcp_zip
     if not path.is_file():
-        raise CheckpointError(f"{run.run_dir}: no {path.name} (was the SPCP selected?)")
+        raise CheckpointError(f"{run.path}: no {path.name} (was the SPCP selected?)")
     return load_greedy_policy(
         path,
-        run.config.agent,
+        run.experiment.agent,
         env.observation_space,  # type: ignore[arg-type]
         env.action_space,  # type: ignore[arg-type]
     )
 
 
-def _header(run: RunInfo) -> StageHeader:
-    env = run.config.env
-    return StageHeader(portable_path(run.run_dir), env.case, env.vut, run.seed, run.spcp_step)
+def _header(run: RunRecord) -> StageHeader:
+    env = run.experiment.env
+    step = run.spcp.step if run.spcp is not None else None
+    return StageHeader(portable_path(run.path), env.case, env.vut, run.config_seed, step)
 
 
-def _should_run(
-    csv_path: Path,
-    json_path: Path,
-    read_settings: Callable[[Path], dict[str, Any]],
-    requested: dict[str, Any],
-    force: bool,
-) -> bool:
-    """Whether a stage runs; logs a skip, and a warning if its stored settings differ."""
-    if force or not (csv_path.is_file() and json_path.is_file()):
+def _should_run(stage: OutcomeStage | AyssStage, force: bool) -> bool:
+    """Whether a stage of the CLI runs: when forced or its outputs are missing. A stage
+    whose outputs exist is skipped, with a warning when they were made with other settings
+    (:func:`~sumo_ayss.run_folder.is_done`)."""
+    if force or not all(p.is_file() for p in stage.outputs):
         return True
-    stored = read_settings(json_path)
-    logger.info("skipping %s: outputs exist (pass --force to recompute)", csv_path.name)
-    requested = json.loads(json.dumps(requested))  # tuples -> lists, as stored
-    if stored != requested:
+    logger.info("skipping %s: outputs exist (pass --force to recompute)", stage.outputs[0].name)
+    if not is_done(stage):
         logger.warning(
             "%s was computed with %s, not the requested %s; pass --force to recompute",
-            json_path.name,
-            stored,
-            requested,
+            stage.outputs[1].name,
+            stage.stored(),
+            stage.settings(),
         )
     return False
 
 
 def _outcome_stage(
-    env: PairEnv, policy: Policy, run: RunInfo, n: int, seed: int, progress: bool
+    env: PairEnv, policy: Policy, run: RunRecord, n: int, seed: int, progress: bool
 ) -> None:
-    if seed == run.config.train.eval_seed:
+    if seed == run.experiment.train.eval_seed:
         logger.warning(
             "outcome seed %d equals train.eval_seed: the SPCP is scored on the scenarios it "
             "was selected on",
             seed,
         )
     result = run_outcome(env, policy, n=n, seed=seed, progress=progress)
-    folder = RunFolder(run.run_dir)
+    folder = run.folder
     write_table(folder.outcome_csv, result.table)
     write_outcome_json(
         folder.outcome_json,
         _header(run),
         {"n": n, "seed": seed},
-        to_dict(run.config.env.odd),
+        to_dict(run.experiment.env.odd),
         result.summary.as_dict(),
         result.wall_s,
     )
@@ -204,10 +147,10 @@ def _outcome_stage(
 
 
 def _ayss_stage(
-    env: PairEnv, policy: Policy, run: RunInfo, cfg: AyssConfig, progress: bool
+    env: PairEnv, policy: Policy, run: RunRecord, cfg: AyssConfig, progress: bool
 ) -> None:
     result = run_ayss(env, policy, cfg, progress=progress)
-    folder = RunFolder(run.run_dir)
+    folder = run.folder
     write_table(folder.ayss_csv, result.table)
     summary = result.summary()
     settings = summary.pop("config")  # the AyssConfig used, compared on a later skip
@@ -218,7 +161,7 @@ def _ayss_stage(
 
 
 def evaluate_run(
-    run_dir: str | Path,
+    run: str | Path | RunRecord,
     *,
     n_outcome: int = DEFAULT_OUTCOME_N,
     outcome_seed: int = DEFAULT_OUTCOME_SEED,
@@ -227,12 +170,12 @@ def evaluate_run(
     progress: bool = True,
     policy: Policy | None = None,
     trust_controller: bool = False,
-    run: tuple[ExperimentConfig, int] | None = None,
 ) -> EvaluationResult:
     """Run the outcome and AYSS stages on a run folder (see the module docstring).
 
     Args:
-        run_dir: Folder written by :func:`sumo_ayss.train.train`.
+        run: The run, as read by :func:`~sumo_ayss.run_folder.read_run` (or its folder,
+            written by :func:`sumo_ayss.train.train`, read here).
         n_outcome: Outcome episodes (paper: 200).
         outcome_seed: Seed of the outcome scenario set (same for every compared run).
         ayss: Monte Carlo settings; default :class:`AyssConfig()` (its seed included).
@@ -241,8 +184,6 @@ def evaluate_run(
         policy: Use this policy instead of ``<run>/spcp.zip`` (e.g. a scripted one).
         trust_controller: Allow importing the run's user-controller VUT (runs its code); a
             run whose VUT is a controller cannot be evaluated without it.
-        run: The run's configuration and seed, when the caller holds them (see
-            :func:`load_run`'s ``known``).
 
     Returns:
         The output paths and which stages ran.
@@ -250,35 +191,27 @@ def evaluate_run(
     Raises:
         CheckpointError: If the run folder, its config or its SPCP cannot be read.
     """
+    record = run if isinstance(run, RunRecord) else read_run(run)
     with controller_imports(trust_controller):
-        return _evaluate_run(run_dir, n_outcome, outcome_seed, ayss, force, progress, policy, run)
+        return _evaluate_run(record, n_outcome, outcome_seed, ayss, force, progress, policy)
 
 
 def _evaluate_run(
-    run_dir: str | Path,
+    run: RunRecord,
     n_outcome: int,
     outcome_seed: int,
     ayss: AyssConfig | None,
     force: bool,
     progress: bool,
     policy: Policy | None,
-    known: tuple[ExperimentConfig, int] | None = None,
 ) -> EvaluationResult:
-    run = load_run(run_dir, known=known)
+    cfg = run.experiment  # raises if config.yaml is missing or invalid
     ayss_cfg = ayss if ayss is not None else AyssConfig()
-    f = RunFolder(run.run_dir)
-    do_outcome = _should_run(
-        f.outcome_csv,
-        f.outcome_json,
-        lambda p: read_outcome_json(p).settings,
-        {"n": n_outcome, "seed": outcome_seed},
-        force,
-    )
-    do_ayss = _should_run(
-        f.ayss_csv, f.ayss_json, lambda p: read_ayss_json(p).settings, ayss_cfg.to_dict(), force
-    )
+    f = run.folder
+    do_outcome = _should_run(OutcomeStage(f, n_outcome, outcome_seed), force)
+    do_ayss = _should_run(AyssStage(f, ayss_cfg), force)
     if do_outcome or do_ayss:
-        env = make_env(run.config.env, sumo_seed=run.seed)
+        env = make_env(cfg.env, sumo_seed=run.config_seed)
         try:
             pol = policy if policy is not None else load_spcp(run, env)
             if do_outcome:
@@ -336,24 +269,24 @@ def main(argv: Sequence[str] | None = None) -> None:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
     t0 = time.perf_counter()
     try:
-        run = load_run(args.run_dir)  # parsed once, then passed on
-        set_torch_threads(run.config.train.torch_threads)
+        run = read_run(args.run_dir)  # read once, then handed on
+        cfg = run.experiment
+        set_torch_threads(cfg.train.torch_threads)
         overrides: dict[str, Any] = {"n_samples": args.n_ayss}
         if args.seed is not None:
             overrides["seed"] = args.seed
         if args.ayss_speeds_from_odd:
-            ayss = AyssConfig.from_odd(run.config.env.odd, **overrides)
+            ayss = AyssConfig.from_odd(cfg.env.odd, **overrides)
         else:
             ayss = dataclasses.replace(AyssConfig(), **overrides)
         result = evaluate_run(
-            args.run_dir,
+            run,
             n_outcome=args.n_outcome,
             outcome_seed=args.seed if args.seed is not None else DEFAULT_OUTCOME_SEED,
             ayss=ayss,
             force=args.force,
             progress=not args.no_progress,
             trust_controller=args.trust_controller,
-            run=(run.config, run.seed),
         )
     except AyssError as e:
         sys.exit(f"error: {e}")

@@ -20,7 +20,6 @@ from typing import Any
 
 from sumo_ayss.jobs import NOT_RETRIED, JobSpec, run_job
 from sumo_ayss.progress import GridProgress, JobStatus
-from sumo_ayss.run_folder import RunFolder
 
 logger = logging.getLogger("sumo_ayss.pipeline")
 
@@ -133,7 +132,7 @@ def run_grid_local(
                         logger.warning(progress.line(s, f"failed ({s.error}); will retry"))
                     else:
                         s.state = "failed"
-                        log = RunFolder(s.spec.run_dir).job_log
+                        log = s.spec.folder.job_log
                         why = " (not retried: it fails again)" if s.attempts <= retries else ""
                         logger.error(progress.line(s, f"FAILED{why}: {s.error} (log: {log})"))
                     continue

@@ -8,8 +8,6 @@ import this module; it imports none of them.
 
 from __future__ import annotations
 
-import hashlib
-import json
 import logging
 import time
 from dataclasses import dataclass
@@ -19,10 +17,12 @@ from typing import Any
 from sumo_ayss.config import AyssConfig, ExperimentConfig
 from sumo_ayss.errors import ControllerError
 from sumo_ayss.run_folder import (
+    EvaluateStage,
     RunFolder,
-    read_evaluate_done,
+    TrainStage,
+    is_done,
+    read_run,
     run_dir_for,
-    write_evaluate_done,
     write_progress,
 )
 
@@ -69,24 +69,10 @@ class JobSpec:
     def run_dir(self) -> Path:
         return run_dir_for(self.out, self.case, self.vut, self.seed)
 
-
-def _fingerprint(*parts: Any) -> str:
-    h = hashlib.sha256()
-    for part in parts:
-        if isinstance(part, Path):
-            h.update(part.read_bytes())
-        else:
-            h.update(json.dumps(part, sort_keys=True, default=str).encode())
-    return h.hexdigest()[:16]
-
-
-def _ayss_key(ayss: AyssConfig) -> list[Any]:
-    """What of ``ayss`` the evaluation marker records: the draws, plus every other setting
-    when one differs from its default (so markers written before ``evaluate.ayss`` existed
-    stay valid)."""
-    if ayss == AyssConfig(n_samples=ayss.n_samples):
-        return [ayss.n_samples]
-    return [ayss.n_samples, ayss.to_dict()]
+    @property
+    def folder(self) -> RunFolder:
+        """The job's run folder."""
+        return RunFolder(self.run_dir)
 
 
 def run_job(spec: JobSpec) -> dict[str, Any]:
@@ -95,8 +81,8 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
     from sumo_ayss.threads import set_torch_threads
     from sumo_ayss.train import train
 
-    run_dir = spec.run_dir
-    folder = RunFolder(run_dir)
+    folder = spec.folder
+    run_dir = folder.path
     run_dir.mkdir(parents=True, exist_ok=True)
     handler = logging.FileHandler(folder.job_log)
     handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s: %(message)s"))
@@ -109,12 +95,10 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
     try:
         cfg = spec.experiment
         set_torch_threads(cfg.train.torch_threads)  # for evaluate too, when training is skipped
-        if folder.spcp_json.is_file() and folder.config.is_file():
-            from sumo_ayss.training.config_check import check_same_config
-
-            check_same_config(run_dir, cfg, spec.seed)  # raises if the inputs changed
+        if is_done(TrainStage(folder, cfg, spec.seed)):
             stages["train"] = "skipped"
         else:
+            # A run folder with another configuration is refused here, naming the fields.
             resume = folder.config.is_file()
             train(cfg, spec.seed, Path(spec.out), resume=resume, argv=["--pipeline", spec.name])
             stages["train"] = "resumed" if resume else "done"
@@ -122,20 +106,19 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
 
         write_progress(run_dir, "evaluate")
         t1 = time.perf_counter()
-        key = _fingerprint(folder.spcp_zip, spec.n_outcome, *_ayss_key(spec.ayss))
-        if read_evaluate_done(folder.evaluate_done) == key:
+        evaluation = EvaluateStage(folder, spec.n_outcome, spec.ayss)
+        if is_done(evaluation):
             stages["evaluate"] = "skipped"
         else:
             evaluate_run(
-                run_dir,
+                read_run(run_dir),  # read once, after training, and handed on
                 n_outcome=spec.n_outcome,
                 ayss=spec.ayss,
                 force=True,
                 progress=False,
                 trust_controller=True,  # the pipeline's own runs, from the user's configs
-                run=(cfg, spec.seed),  # the config in hand: config.yaml is not parsed again
             )
-            write_evaluate_done(folder.evaluate_done, key)
+            evaluation.mark_done()
             stages["evaluate"] = "done"
         times["evaluate_s"] = time.perf_counter() - t1
         write_progress(run_dir, "done")

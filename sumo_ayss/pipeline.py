@@ -44,7 +44,6 @@ Pipeline YAML (every key optional)::
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import functools
 import logging
 import os
@@ -55,26 +54,23 @@ from typing import TYPE_CHECKING, Any, Literal, NamedTuple
 
 from sumo_ayss.cli import prog
 from sumo_ayss.config import (
-    ExperimentConfig,
     PipelineConfig,
     check_out_dir,
-    load_experiment,
     load_pipeline,
     to_dict,
 )
 from sumo_ayss.config.budget import BUDGET_CHOICES, BUDGET_HELP
-from sumo_ayss.errors import AyssError, ConfigError
+from sumo_ayss.errors import AyssError
 from sumo_ayss.folder_lock import output_lock
 from sumo_ayss.grid_local import run_grid_local
 from sumo_ayss.jobs import JobSpec
 from sumo_ayss.modes import get_mode
+from sumo_ayss.plan import plan_jobs, plan_seed
 from sumo_ayss.progress import JobStatus
-from sumo_ayss.run_folder import RunFolder
-from sumo_ayss.validation import suggest
+from sumo_ayss.run_folder import RunRecord, StudyFolder, write_pipeline_json
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
-    from sumo_ayss.report.load import Run
 
 logger = logging.getLogger("sumo_ayss.pipeline")  # also when run as __main__
 
@@ -97,79 +93,17 @@ class PipelineResult(NamedTuple):
     Attributes:
         statuses: One per job, in grid order.
         report: The report's ``report.html``, or None when no job finished.
-        runs: The finished jobs' run folders, loaded once
-            (:func:`sumo_ayss.report.load.load_run`), in the order of ``statuses``.
+        runs: The finished jobs' run folders, read once
+            (:func:`sumo_ayss.run_folder.read_run`), in the order of ``statuses``.
         analyses: Every case's analysis (:func:`sumo_ayss.report.load.analyse_runs`, paper
             mode included), computed once; the report's verdicts, and rank's rows.
     """
 
     statuses: list[JobStatus]
     report: Path | None
-    runs: list[Run]
+    runs: list[RunRecord]
     analyses: list[CaseAnalysis]
     cfg: PipelineConfig | None = None
-
-
-def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
-    """Resolve every job's experiment; bad grids are refused here, before any job runs.
-
-    Each case's experiment file is parsed once; a job receives that frozen record with its
-    VUT set (workers never parse it again). A case's seeds are ``grid.seeds`` plus those
-    adaptive seeding already added (:func:`sumo_ayss.adaptive.case_seeds`).
-    """
-    from sumo_ayss.adaptive import case_seeds
-
-    jobs = []
-    for case in cfg.grid.cases:
-        exp = _case_experiment(cfg, case)
-        for vut in cfg.grid.vuts:
-            for seed in case_seeds(cfg, case):
-                jobs.append(_job(cfg, exp, case, vut, seed))
-    return jobs
-
-
-def plan_seed(cfg: PipelineConfig, case: str, seed: int) -> list[JobSpec]:
-    """One seed's jobs of one case, every VUT (adaptive seeding adds them)."""
-    exp = _case_experiment(cfg, case)
-    return [_job(cfg, exp, case, vut, seed) for vut in cfg.grid.vuts]
-
-
-def _job(cfg: PipelineConfig, exp: ExperimentConfig, case: str, vut: str, seed: int) -> JobSpec:
-    return JobSpec(
-        case=case,
-        vut=vut,
-        seed=int(seed),
-        experiment=exp.with_vut(vut),
-        out=str(cfg.out),
-        n_outcome=cfg.evaluate.n_outcome,
-        ayss=cfg.evaluate.ayss,
-    )
-
-
-def _case_experiment(cfg: PipelineConfig, case: str) -> ExperimentConfig:
-    """The case's experiment with the pipeline's overrides; its VUTs checked."""
-    exp = load_experiment(cfg.experiments[case])
-    if exp.env.case != case:
-        raise ConfigError(
-            f"experiments.{case}: {cfg.experiments[case]} is a {exp.env.case!r} experiment"
-        )
-    overrides: dict[str, Any] = {"progress_bar": False}
-    if cfg.total_timesteps is not None:
-        overrides["total_timesteps"] = cfg.total_timesteps
-    if cfg.eval_every is not None:
-        overrides["eval_every"] = cfg.eval_every
-    exp = dataclasses.replace(exp, train=dataclasses.replace(exp.train, **overrides))
-    if cfg.vuts:
-        exp = dataclasses.replace(
-            exp, env=dataclasses.replace(exp.env, vuts={**exp.env.vuts, **cfg.vuts})
-        )
-    for vut in cfg.grid.vuts:
-        if vut not in exp.env.vuts:
-            raise ConfigError(
-                f"grid.vuts: {vut!r} is not a VUT of the {case} experiment"
-                f"{suggest(vut, exp.env.vuts)}; allowed: {sorted(exp.env.vuts)}"
-            )
-    return exp
 
 
 def _relative_paths(data: Any, base: Path) -> Any:
@@ -205,7 +139,7 @@ def final_messages(result: PipelineResult) -> list[str]:
     """What the CLI prints at the end: failures, the report and its trust warnings (from
     the runs the pipeline loaded)."""
     lines = [
-        f"FAILED {s.spec.name}: {s.error}  (log: {RunFolder(s.spec.run_dir).job_log})"
+        f"FAILED {s.spec.name}: {s.error}  (log: {s.spec.folder.job_log})"
         for s in result.statuses
         if s.state == "failed"
     ]
@@ -265,9 +199,8 @@ def _run_locked(
     console: Any,
 ) -> PipelineResult:
     """:func:`run_pipeline` once the output folder's lock is held."""
-    from sumo_ayss.atomic import atomic_write_json
-
-    atomic_write_json(cfg.out / "pipeline.json", _relative_paths(to_dict(cfg), cfg.out))
+    study = StudyFolder(cfg.out)
+    write_pipeline_json(study.pipeline_json, _relative_paths(to_dict(cfg), cfg.out))
     after = ", ".join(stages_after_grid(cfg))
     if backend == "local" and live and console is None and sys.stdout.isatty():
         from rich.console import Console
@@ -288,24 +221,24 @@ def _run_locked(
         )
 
     statuses = run_jobs(jobs)
-    mode = get_mode(cfg.report.mode)
-    if mode.runs_crossplay and any(s.state == "done" for s in statuses):
-        run_crossplay_stage(cfg, statuses)
-    from sumo_ayss.adaptive import is_adaptive, run_adaptive
-
-    if is_adaptive(cfg):
-        statuses = run_adaptive(cfg, statuses, run_jobs, run_crossplay_stage, plan_seed)
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
     if not finished:
         return PipelineResult(statuses, None, [], [], cfg)
-    write_discriminability(cfg)
+    from sumo_ayss.adaptive import is_adaptive, run_adaptive
     from sumo_ayss.report.document import load_runs, write_report_for
     from sumo_ayss.report.load import analyse_runs
 
-    logger.info("report: analysing %d run folders and drawing the figures", len(finished))
-    runs = load_runs(finished)
+    runs = load_runs(finished)  # read once: cross-play, the report and rank use them
+    if get_mode(cfg.report.mode).runs_crossplay:
+        run_crossplay_stage(cfg, statuses, runs)
+    if is_adaptive(cfg):
+        statuses, runs = run_adaptive(
+            cfg, statuses, runs, run_jobs, run_crossplay_stage, plan_seed, load_runs
+        )
+    write_discriminability(cfg)
+    logger.info("report: analysing %d run folders and drawing the figures", len(runs))
     analyses = analyse_runs(runs, cfg.report)  # once per case: the report's and rank's
-    report = write_report_for(runs, cfg.out / "report", analyses=analyses, options=cfg.report)
+    report = write_report_for(runs, study.report_dir, analyses=analyses, options=cfg.report)
     return PipelineResult(statuses, report, runs, analyses, cfg)
 
 
@@ -322,7 +255,9 @@ def stages_after_grid(cfg: PipelineConfig) -> list[str]:
     return [*stages, "the report"]
 
 
-def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> list[Path]:
+def run_crossplay_stage(
+    cfg: PipelineConfig, statuses: Sequence[JobStatus], runs: Sequence[RunRecord]
+) -> list[Path]:
     """Cross-play of every case of the grid with two or more VUTs; the tables written.
 
     Every SPCP of the case drives against every VUT on the outcome scenarios
@@ -330,10 +265,10 @@ def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> l
     case already cross-played with the same SPCPs and settings is skipped. A case with one
     VUT has no cross-play; a case with a failed job is skipped with a warning (its report
     then says that the cross-play table is missing); a failure of the stage itself is
-    logged, never fatal.
+    logged, never fatal. ``runs``: the finished jobs' records (:func:`~sumo_ayss.run_folder.
+    read_run`).
     """
     from sumo_ayss.crossplay import run_case
-    from sumo_ayss.run_folder import case_dir_for
     from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
 
     if len(cfg.grid.vuts) < 2:
@@ -341,6 +276,7 @@ def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> l
         return []
     from sumo_ayss.adaptive import case_seeds
 
+    by_path = {r.path: r for r in runs}
     written = []
     for case in cfg.grid.cases:
         seeds = case_seeds(cfg, case)
@@ -360,8 +296,8 @@ def run_crossplay_stage(cfg: PipelineConfig, statuses: Sequence[JobStatus]) -> l
             continue
         try:
             csv_path = run_case(
-                [s.spec.run_dir for s in jobs],
-                case_dir_for(cfg.out, case),
+                [by_path[s.spec.run_dir.resolve()] for s in jobs],
+                StudyFolder(cfg.out).case(case).path,
                 n=cfg.evaluate.n_outcome,
                 seed=DEFAULT_OUTCOME_SEED,
                 trust_controller=True,  # the pipeline's own runs, from the user's configs
@@ -399,7 +335,7 @@ def write_discriminability(cfg: PipelineConfig) -> None:
         )
         try:
             env = discriminability.pipeline_env(cfg, case)
-            discriminability.ensure(env, cfg.grid.vuts, cfg.out / case)
+            discriminability.ensure(env, cfg.grid.vuts, StudyFolder(cfg.out).case(case).path)
         except (AyssError, ImportError, OSError) as e:  # never fatal: the report says so
             logger.warning("discriminability of %s not computed: %s", case, e)
 

@@ -24,7 +24,6 @@ import statistics
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, Protocol
 
 from sumo_ayss.errors import CheckpointError
@@ -38,7 +37,7 @@ class _Spec(Protocol):
     def name(self) -> str: ...
 
     @property
-    def run_dir(self) -> Path: ...
+    def folder(self) -> RunFolder: ...
 
     experiment: dict[str, Any]
 
@@ -84,20 +83,19 @@ class JobStatus:
 
     def __post_init__(self) -> None:
         self.total = int(self.spec.experiment.train.total_timesteps)
-        self.step = _finished_steps(self.spec.run_dir, self.total)
+        self.step = _finished_steps(self.spec.folder, self.total)
 
     def start(self) -> None:
         """A worker takes the job: a new try begins (candidates found now are not events)."""
         self.attempts += 1
         self.state, self.stage, self.started_at = "running", "", time.time()
-        self.step_at_start = self.step = _finished_steps(self.spec.run_dir, self.total)
-        found = _candidates(self.spec.run_dir)
+        self.step_at_start = self.step = _finished_steps(self.spec.folder, self.total)
+        found = _candidates(self.spec.folder)
         self.candidate_step = found[-1][0] if found else None
 
 
-def _finished_steps(run_dir: Path, total: int) -> int:
-    """Training transitions already in ``run_dir`` from an earlier invocation."""
-    folder = RunFolder(run_dir)
+def _finished_steps(folder: RunFolder, total: int) -> int:
+    """Training transitions already in the run folder from an earlier invocation."""
     if folder.spcp_json.is_file():
         return total
     try:
@@ -106,10 +104,10 @@ def _finished_steps(run_dir: Path, total: int) -> int:
         return 0
 
 
-def _candidates(run_dir: Path) -> list[tuple[int, str]]:
+def _candidates(folder: RunFolder) -> list[tuple[int, str]]:
     """(step, mean evaluation reward to 2 decimals) of each SPCP candidate in ``eval.csv``."""
     try:
-        rows = read_eval_rows(RunFolder(run_dir).eval_table, skip_bad_rows=True)[0]
+        rows = read_eval_rows(folder.eval_table, skip_bad_rows=True)[0]
     except CheckpointError:
         return []
     return [(int(row["step"]), f"{row['mean_return']:.2f}") for row in rows]
@@ -169,13 +167,13 @@ class GridProgress:
         for s in self.statuses:
             if s.state != "running":
                 continue
-            run_dir = s.spec.run_dir
-            progress = read_progress(run_dir)
+            folder = s.spec.folder
+            progress = read_progress(folder.path)
             if progress and float(progress.get("time", 0)) < (s.started_at or 0) - 1:
                 progress = None  # left by an earlier invocation
             rate = progress.get("rate_steps_per_s") if progress else None
             at = f" ({rate:.0f} steps/s)" if isinstance(rate, int | float) and rate > 0 else ""
-            for step, reward in _candidates(run_dir):
+            for step, reward in _candidates(folder):
                 if s.candidate_step is None or step > s.candidate_step:
                     text = f"SPCP candidate at step {step:,}/{s.total:,}{at}"
                     events.append(self.line(s, f"{text}: mean evaluation reward {reward}"))
@@ -189,7 +187,7 @@ class GridProgress:
                         s.rate_steps_per_s = float(rate)
                 if stage and stage != s.stage:
                     if stage == "evaluate":
-                        s.step = s.total if RunFolder(run_dir).spcp_json.is_file() else s.step
+                        s.step = s.total if folder.spcp_json.is_file() else s.step
                         events.append(self.line(s, "training finished; evaluating"))
                     s.stage = stage
         return events

@@ -33,8 +33,6 @@ the bootstrap only in paper mode) and never runs cross-play.
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -45,53 +43,45 @@ from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.modes import Mode, get_mode, mode_names, registered_modes
 from sumo_ayss.modes.formatting import fmt_num
-from sumo_ayss.run_folder import OUTCOME_JSON, RunFolder
+from sumo_ayss.run_folder import (
+    OUTCOME_JSON,
+    OrderCheck,
+    OrderChecks,
+    RunRecord,
+    StudyFolder,
+    read_run,
+    write_order_check,
+    write_ranking_csv,
+)
 
 if TYPE_CHECKING:
     from sumo_ayss.config.report import ReportOptions
-    from sumo_ayss.report.load import Run
 
-RANKING_COLUMNS = [
-    "case",
-    "mode",
-    "rank",
-    "vut",
-    "score",
-    "lo",
-    "hi",
-    "n_seeds",
-    "unit",
-    "p_vs_next",
-    "significant_vs_next",
-    "vs_next",
-    "crash_rate",
-    "crash_lo",
-    "crash_hi",
-    "crashes",
-    "episodes",
-    "mobility_mps",
-    "timid",
+__all__ = [
+    "analyse",
+    "analyse_loaded",
+    "available_modes",
+    "main",
+    "order_check",
+    "order_checks",
+    "ranking_rows",
+    "write_ranking",
 ]
-"""``ranking.csv``'s columns. ``score``: harm per episode in cross-play and exposure mode
-(:mod:`sumo_ayss.analysis.harm`, lower = safer), the AYSS safety index in paper mode (higher
-= safer). ``crash_rate`` with its Wilson interval ``crash_lo``/``crash_hi`` (fractions),
-``crashes`` of ``episodes``, ``mobility_mps`` (mean VUT speed) and ``timid`` (mobility below
-80 % of the median VUT's) describe the same episodes as the score; empty in paper mode."""
 
 
 def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> list[CaseAnalysis]:
     """The analysis of every case among ``run_dirs``, for ranking without the pipeline.
 
-    Each run folder is read once (:func:`sumo_ayss.report.load.load_run`) and each case
+    Each run folder is read once (:func:`sumo_ayss.run_folder.read_run`) and each case
     analysed once (:func:`sumo_ayss.report.load.analyse_runs`); the AYSS bootstrap runs in
     paper mode only.
     """
-    from sumo_ayss.report.load import load_run
-
-    return analyse_loaded([load_run(d) for d in run_dirs], options)
+    return analyse_loaded([read_run(d) for d in run_dirs], options)
 
 
-def analyse_loaded(runs: Sequence[Run], options: ReportOptions | None = None) -> list[CaseAnalysis]:
+def analyse_loaded(
+    runs: Sequence[RunRecord], options: ReportOptions | None = None
+) -> list[CaseAnalysis]:
     """:func:`analyse` of runs already loaded."""
     from sumo_ayss.config.report import ReportOptions
     from sumo_ayss.report.load import analyse_runs
@@ -160,7 +150,7 @@ def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
 
 def order_check(
     a: CaseAnalysis, expected: Sequence[str], mode: str | None = None
-) -> dict[str, Any] | None:
+) -> OrderCheck | None:
     """How one case's ranking in one mode compares with a known order (safest first).
 
     Args:
@@ -169,11 +159,11 @@ def order_check(
         mode: The mode whose ranking is checked; default the analysis's mode.
 
     Returns:
-        ``{"case", "mode", "order", "expected", "tau", "ends_significant", "ends_p",
-        "significant_adjacent", "adjacent"}`` (Kendall τ of the ranking against the known
-        order; whether the expected safest and least safe VUT differ significantly, in the
-        right direction; significant adjacent pairs of the ranking), or None when the mode
-        has no ranking for this case or the case's VUTs are not exactly the expected ones.
+        The :class:`~sumo_ayss.run_folder.OrderCheck` (Kendall τ of the ranking against
+        the known order; whether the expected safest and least safe VUT differ
+        significantly, in the right direction; significant adjacent pairs of the ranking),
+        or None when the mode has no ranking for this case or the case's VUTs are not
+        exactly the expected ones.
     """
     mode = mode or a.mode
     if mode not in available_modes(a):
@@ -184,20 +174,20 @@ def order_check(
     if sorted(order) != sorted(expected) or len(order) < 2:
         return None
     ends_ok, ends_p = get_mode(mode).ends(a, expected[0], expected[-1])
-    return {
-        "case": a.case,
-        "mode": mode,
-        "order": order,
-        "expected": list(expected),
-        "tau": kendall_tau(order, list(expected)),
-        "ends_significant": ends_ok,
-        "ends_p": ends_p,
-        "significant_adjacent": sum(sig),
-        "adjacent": len(sig),
-    }
+    return OrderCheck(
+        case=a.case,
+        mode=mode,
+        order=tuple(order),
+        expected=tuple(expected),
+        tau=kendall_tau(order, list(expected)),
+        ends_significant=ends_ok,
+        ends_p=ends_p,
+        significant_adjacent=sum(sig),
+        adjacent=len(sig),
+    )
 
 
-def order_checks(analyses: Sequence[CaseAnalysis], expected: Sequence[str]) -> list[dict[str, Any]]:
+def order_checks(analyses: Sequence[CaseAnalysis], expected: Sequence[str]) -> list[OrderCheck]:
     """:func:`order_check` of every (case, mode) available, the analysis's mode first."""
     return [
         c
@@ -210,18 +200,16 @@ def order_checks(analyses: Sequence[CaseAnalysis], expected: Sequence[str]) -> l
 def write_ranking(
     rows: Sequence[dict[str, Any]],
     out: Path,
-    checks: Sequence[dict[str, Any]] = (),
+    checks: Sequence[OrderCheck] = (),
     expected: Sequence[str] = (),
 ) -> tuple[Path, Path]:
-    """``ranking.csv`` and ``ranking.md`` in ``out`` (written atomically), and with a known
-    order, ``order_check.json`` (see :func:`order_check`)."""
+    """``ranking.csv`` and ``ranking.md`` in the study folder ``out`` (written atomically),
+    and with a known order, ``order_check.json`` (see :func:`order_check`;
+    :mod:`sumo_ayss.run_folder.study`)."""
     from sumo_ayss.atomic import atomic_write_text
 
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=RANKING_COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    atomic_write_text(out / "ranking.csv", buf.getvalue())
+    study = StudyFolder(out)
+    write_ranking_csv(study.ranking_csv, rows)
     lines = [
         "| case | mode | rank | VUT | score (95 % CI) | seeds | crash rate (95 % CI) | "
         "mean speed | vs next |",
@@ -240,18 +228,16 @@ def write_ranking(
     for c in checks:
         lines += [
             "",
-            f"Known order ({c['case']}, {c['mode']} mode), safest first: "
-            f"{' > '.join(expected)}. Ranking: {' > '.join(c['order'])}. "
-            f"Kendall tau = {c['tau']:.2f}; ends significantly different: "
-            f"{'yes' if c['ends_significant'] else 'no'} (p = {c['ends_p']:.3g}); "
-            f"significant adjacent pairs: {c['significant_adjacent']} of {c['adjacent']}.",
+            f"Known order ({c.case}, {c.mode} mode), safest first: "
+            f"{' > '.join(expected)}. Ranking: {' > '.join(c.order)}. "
+            f"Kendall tau = {c.tau:.2f}; ends significantly different: "
+            f"{'yes' if c.ends_significant else 'no'} (p = {c.ends_p:.3g}); "
+            f"significant adjacent pairs: {c.significant_adjacent} of {c.adjacent}.",
         ]
-    atomic_write_text(out / "ranking.md", "\n".join(lines) + "\n")
+    atomic_write_text(study.ranking_md, "\n".join(lines) + "\n")
     if checks:
-        from sumo_ayss.atomic import atomic_write_json
-
-        atomic_write_json(out / "order_check.json", {"expected": list(expected), "cases": checks})
-    return out / "ranking.csv", out / "ranking.md"
+        write_order_check(study.order_check_json, OrderChecks(tuple(expected), tuple(checks)))
+    return study.ranking_csv, study.ranking_md
 
 
 def _crash_cell(row: dict[str, Any]) -> str:
@@ -316,14 +302,12 @@ def main(argv: Sequence[str] | None = None) -> None:
         if args.mode is not None:
             cfg = dataclasses.replace(cfg, report=dataclasses.replace(cfg.report, mode=args.mode))
         if args.no_run:
-            planned = [j.run_dir for j in plan_jobs(cfg)]
-            done = [d for d in planned if RunFolder(d).outcome_json.is_file()]
+            planned = [j.folder for j in plan_jobs(cfg)]
+            done = [f.path for f in planned if f.outcome_json.is_file()]
             complete = len(done) == len(planned)
             if not done:
                 raise ConfigError(f"--no-run: no finished run folder under {cfg.out}")
-            from sumo_ayss.report.load import load_run
-
-            runs = [load_run(d) for d in done]
+            runs = [read_run(d) for d in done]
             analyses = analyse_loaded(runs, cfg.report)
         else:
             result = run_pipeline(cfg, live=console is not None, console=console)
@@ -344,9 +328,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     print(leaderboard_text(analyses))
     for c in checks:
         print(
-            f"{c['case']}, {c['mode']} mode, against the known order: Kendall tau = "
-            f"{c['tau']:.2f}; ends differ significantly: "
-            f"{'yes' if c['ends_significant'] else 'no'}"
+            f"{c.case}, {c.mode} mode, against the known order: Kendall tau = "
+            f"{c.tau:.2f}; ends differ significantly: "
+            f"{'yes' if c.ends_significant else 'no'}"
         )
     print(f"ranking (every mode): {md} and {csv_path.name}")
     if result is None:  # --no-run

@@ -29,7 +29,6 @@ from typing import Any
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.jobs import NOT_RETRIED, JobSpec, run_job
 from sumo_ayss.progress import GridProgress, JobStatus
-from sumo_ayss.run_folder import RunFolder
 
 logger = logging.getLogger(__name__)
 
@@ -132,7 +131,7 @@ def run_grid_ray(
                 else:
                     s.state = "failed"
                     s.spec.run_dir.mkdir(parents=True, exist_ok=True)
-                    log = RunFolder(s.spec.run_dir).job_log
+                    log = s.spec.folder.job_log
                     log.write_text(s.error + "\n")
                     logger.error(progress.line(s, f"FAILED: {s.error} (log: {log})"))
     finally:

@@ -376,13 +376,13 @@ def train(
     check_device(cfg.train.device)  # before the run folder exists
     seed = check_seed(seed, "--seed")
     check_out_dir(Path(out), "--out")
-    run_dir = run_dir_for(out, cfg.env.case, cfg.env.vut, seed)
-    config_file = RunFolder(run_dir).config
+    folder = RunFolder(run_dir_for(out, cfg.env.case, cfg.env.vut, seed))
+    run_dir = folder.path
     if resume:
-        if not config_file.is_file():
+        if not folder.config.is_file():
             raise CheckpointError(f"--resume: no run folder at {run_dir}")
-        check_same_config(run_dir, cfg, seed)
-    elif RunFolder(run_dir).checkpoints.exists():
+        check_same_config(folder, cfg, seed)
+    elif folder.checkpoints.exists():
         raise CheckpointError(
             f"{run_dir} already holds a run; pass --resume to continue it or choose another --out"
         )

@@ -791,7 +791,8 @@ def test_spcp_weights_are_never_unpickled(trained_run: tuple[Path, Path], tmp_pa
 def test_a_run_folder_controller_is_imported_only_when_trusted(
     trained_run: tuple[Path, Path], tmp_path: Path
 ) -> None:
-    from sumo_ayss.evaluate import load_run, main
+    from sumo_ayss.evaluate import main
+    from sumo_ayss.run_folder import read_run
 
     _, run = _copy_run(trained_run, tmp_path)
     marker = tmp_path / "imported"
@@ -809,8 +810,8 @@ def test_a_run_folder_controller_is_imported_only_when_trusted(
         "controller": {"target": f"{module}:C", "max_accel_mps2": 3.0, "max_decel_mps2": 6.0},
     }
     (run / "config.yaml").write_text(yaml.safe_dump(data))
-    info = load_run(run)  # the config is read and checked, its controller not imported
-    assert info.config.env.vut == "evil" and not marker.exists()
+    info = read_run(run)  # the config is read and checked, its controller not imported
+    assert info.experiment.env.vut == "evil" and not marker.exists()
     with pytest.raises(SystemExit) as exit_info:
         main([str(run), "--n-outcome", "2", "--n-ayss", "10", "--no-progress"])
     assert isinstance(exit_info.value.code, str) and "--trust-controller" in exit_info.value.code
@@ -826,7 +827,7 @@ def test_a_run_folder_controller_is_imported_only_when_trusted(
 def test_report_says_which_candidate_rows_it_dropped(
     trained_run: tuple[Path, Path], tmp_path: Path
 ) -> None:
-    from sumo_ayss.report.load import load_run
+    from sumo_ayss.run_folder import read_run
 
     _, run = _copy_run(trained_run, tmp_path)
     table = run / "eval.csv"
@@ -835,7 +836,7 @@ def test_report_says_which_candidate_rows_it_dropped(
     cells = first.split(",")
     cells[1] = "oops"
     table.write_text("\n".join([head, ",".join(cells), *rest]) + "\n")
-    loaded = load_run(run)
+    loaded = read_run(run)
     assert loaded.eval_curve is not None and loaded.eval_curve.n_dropped == 1
     assert any("1 candidate row(s)" in p for p in loaded.problems)
 

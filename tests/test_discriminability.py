@@ -15,6 +15,7 @@ from sumo_ayss import discriminability as disc
 from sumo_ayss.analysis.discriminability import BoxGrid
 from sumo_ayss.config import PROJECT_ROOT
 from sumo_ayss.errors import ConfigError
+from sumo_ayss.run_folder import CaseFolder
 
 pytestmark = pytest.mark.sumo
 
@@ -51,7 +52,7 @@ def record(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any], Pa
     buf = io.StringIO()
     with contextlib.redirect_stdout(buf):
         disc.main([str(_pipeline_yaml(tmp)), "--out", str(out), *COARSE])
-    return json.loads((out / disc.JSON_NAME).read_text()), out, buf.getvalue()
+    return json.loads((CaseFolder(out).discriminability_json).read_text()), out, buf.getvalue()
 
 
 def _pair(rec: dict[str, Any], a: str, b: str) -> dict[str, Any]:
@@ -87,8 +88,8 @@ def test_outputs_and_summary(record: tuple[dict, Path, str]) -> None:
     rec, out, printed = record
     assert rec["n_states"] == len(BoxGrid(speed_step_mps=3, headway_step_m=0.25).states())
     assert len(rec["pairs"]) == 6 and rec["case"] == "car_following"
-    assert (out / disc.PNG_NAME).stat().st_size > 10_000
-    lines = (out / disc.CSV_NAME).read_text().splitlines()
+    assert (CaseFolder(out).discriminability_png).stat().st_size > 10_000
+    lines = (CaseFolder(out).discriminability_csv).read_text().splitlines()
     assert lines[0] == "pair,dimension,bin_low,bin_high,share"
     assert sum(line.startswith("pi1 vs pi2,all,") for line in lines) == 1
     assert "pi1 vs twin: no difference anywhere in the AYSS box" in printed

@@ -29,10 +29,11 @@ ROOT = Path(__file__).resolve().parents[1] / PACKAGE
 MAX_MODULE_LINES = 500
 #: What :mod:`sumo_ayss.analysis` may import from the package besides itself: the error
 #: tree, range checks, the case records and the ranking modes. It reads no file (no
-#: run_folder, report or config) and runs nothing (no sim, envs or agents): its loader
-#: (:mod:`sumo_ayss.report.load`) reads the run folders and the cross-play table and hands
-#: it arrays and records. The ranking modes (:mod:`sumo_ayss.modes`) are held to the same
-#: rule, so that analysis stays pure through them.
+#: run_folder, report or config) and runs nothing (no sim, envs or agents): the run records
+#: (:func:`sumo_ayss.run_folder.read_run`) and the cross-play table
+#: (:func:`sumo_ayss.run_folder.load_crossplay`) are read outside and handed to it. The
+#: ranking modes (:mod:`sumo_ayss.modes`) are held to the same rule, so that analysis stays
+#: pure through them.
 ANALYSIS_MAY_IMPORT = (
     "sumo_ayss.analysis",
     "sumo_ayss.errors",

@@ -262,13 +262,13 @@ def test_adaptive_seeding_adds_seeds_until_the_cap_and_extends_crossplay(
     time up to max_seeds; each look is recorded; cross-play drives only the new opponents and
     its table equals a full rerun's; a rerun adds nothing."""
     from sumo_ayss.crossplay import run_case
-    from sumo_ayss.run_folder import read_adaptive
+    from sumo_ayss.run_folder import read_adaptive, read_run
 
     path = write_configs(tmp_path, [0, 1], max_seeds=3, report={"welch_alpha": 1e-12})
     cfg = load_pipeline(path)
     assert cfg.added_seeds == (2,)
     with caplog.at_level(logging.INFO):
-        statuses, _report, runs, _ = run_pipeline(cfg, live=False)
+        statuses, _report, runs, *_ = run_pipeline(cfg, live=False)
     assert "cross-play of 2 new SPCPs (the table of the other 4 is kept)" in caplog.text
     assert "adaptive seeding, car_following: not settled at 2 seeds per VUT" in caplog.text
     assert sorted((s.spec.vut, s.spec.seed) for s in statuses) == [
@@ -292,7 +292,10 @@ def test_adaptive_seeding_adds_seeds_until_the_cap_and_extends_crossplay(
     kept = (case / "crossplay.csv").read_bytes()
     full = tmp_path / "full"
     run_case(
-        [s.spec.run_dir for s in sorted(statuses, key=lambda s: (s.spec.vut, s.spec.seed))],
+        [
+            read_run(s.spec.run_dir)
+            for s in sorted(statuses, key=lambda s: (s.spec.vut, s.spec.seed))
+        ],
         full,
         n=10,
         seed=4242,

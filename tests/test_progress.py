@@ -11,7 +11,13 @@ import pytest
 
 from sumo_ayss.config import ExperimentConfig, TrainConfig
 from sumo_ayss.progress import GridProgress, JobStatus, format_duration
-from sumo_ayss.run_folder import PROGRESS_JSON, write_eval_table, write_progress
+from sumo_ayss.run_folder import (
+    PROGRESS_JSON,
+    RunFolder,
+    read_run,
+    write_eval_table,
+    write_progress,
+)
 
 
 @dataclass(frozen=True)
@@ -21,6 +27,10 @@ class Spec:
     experiment: ExperimentConfig = field(
         default_factory=lambda: ExperimentConfig(train=TrainConfig(total_timesteps=10_000))
     )
+
+    @property
+    def folder(self) -> RunFolder:
+        return RunFolder(self.run_dir)
 
 
 def _write(path: Path, data: dict[str, Any]) -> None:
@@ -180,10 +190,9 @@ def test_a_retry_is_counted_and_said_at_the_end(tmp_path: Path) -> None:
 
 def test_pipeline_final_messages_name_a_job_that_passed_on_retry(tmp_path: Path) -> None:
     from sumo_ayss.pipeline import PipelineResult, final_messages
-    from sumo_ayss.report.load import load_run
     from tests.report.test_report import make_run
 
-    run = load_run(make_run(tmp_path, "car_following", "pi1", 0))
+    run = read_run(make_run(tmp_path, "car_following", "pi1", 0))
     status = JobStatus(Spec("car_following/pi1/seed_0", run.path))
     status.attempts, status.state = 2, "done"
     status.error = "SimulationError: boom"

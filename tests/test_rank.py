@@ -11,6 +11,7 @@ import yaml
 from sumo_ayss.config import PROJECT_ROOT
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.rank import analyse, main, order_check, ranking_rows, write_ranking
+from sumo_ayss.run_folder import read_order_check, read_run
 from tests.report.test_report import EXPOSURE, OFFSET, make_crossplay, make_run
 
 
@@ -54,14 +55,14 @@ def test_exposure_mode_ranks_by_outcome_reward_and_checks_a_known_order(tmp_path
     assert rows[0]["significant_vs_next"] is True and "[exposure mode]" in rows[0]["vs_next"]
     check = order_check(analyses[0], ["cautious", "pi2", "pi1"])
     assert check is not None
-    assert check["tau"] == 1.0 and check["ends_significant"]
-    assert check["significant_adjacent"] == 2 and check["adjacent"] == 2
+    assert check.tau == 1.0 and check.ends_significant
+    assert check.significant_adjacent == 2 and check.adjacent == 2
     wrong = order_check(analyses[0], ["pi1", "pi2", "cautious"])
-    assert wrong is not None and wrong["tau"] == -1.0 and not wrong["ends_significant"]
+    assert wrong is not None and wrong.tau == -1.0 and not wrong.ends_significant
     assert order_check(analyses[0], ["pi1", "pi2"]) is None
     _, md = write_ranking(rows, tmp_path, [check], ["cautious", "pi2", "pi1"])
     assert "Kendall tau = 1.00" in md.read_text()
-    assert (tmp_path / "order_check.json").is_file()
+    assert read_order_check(tmp_path / "order_check.json").cases == (check,)
 
 
 def _pipe_yaml(tmp_path: Path, expected: list[str], **extra) -> Path:
@@ -89,8 +90,9 @@ def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, mon
     ranks those analyses; the rows equal ``--no-run``'s, which also computes once."""
     import sumo_ayss.analysis.case as case_mod
     import sumo_ayss.pipeline as pipeline_mod
-    import sumo_ayss.report.episodes as episodes_mod
     import sumo_ayss.report.load as load_mod
+    import sumo_ayss.run_folder.crossplay as crossplay_mod
+    import sumo_ayss.run_folder.record as record_mod
     from sumo_ayss.progress import JobStatus
 
     dirs = _three_vuts(tmp_path / "runs", monkeypatch)
@@ -114,12 +116,14 @@ def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, mon
         return wrapper
 
     monkeypatch.setattr(
-        load_mod, "read_ayss", counted("ayss", load_mod.read_ayss, lambda p: str(p.parent))
+        record_mod,
+        "_ayss_samples",
+        counted("ayss", record_mod._ayss_samples, lambda p: str(p.parent)),
     )
     monkeypatch.setattr(
-        episodes_mod,
+        crossplay_mod,
         "read_crossplay_matrix",
-        counted("crossplay", episodes_mod.read_crossplay_matrix, lambda p, *a: str(p)),
+        counted("crossplay", crossplay_mod.read_crossplay_matrix, lambda p, *a: str(p)),
     )
     monkeypatch.setattr(
         case_mod,
@@ -154,11 +158,11 @@ def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, mon
 def test_paper_rows_only_in_paper_mode_even_from_the_pipelines_analyses(tmp_path, monkeypatch):
     """The pipeline's analyses carry the paper mode (its report shows it); rank lists paper
     rows in paper mode only, as ``--no-run`` (which skips the bootstrap otherwise) does."""
-    from sumo_ayss.report.load import analyse_runs, load_run
+    from sumo_ayss.report.load import analyse_runs
 
     dirs = _three_vuts(tmp_path, monkeypatch)
     options = ReportOptions(mode="exposure", n_boot=200)
-    full = analyse_runs([load_run(d) for d in dirs], options)  # paper mode computed
+    full = analyse_runs([read_run(d) for d in dirs], options)  # paper mode computed
     assert full[0].ranking
     assert ranking_rows(full) == ranking_rows(analyse(dirs, options))
     assert {r["mode"] for r in ranking_rows(full)} == {"exposure"}

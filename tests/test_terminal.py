@@ -128,10 +128,10 @@ def test_leaderboard_with_one_seed_says_there_is_no_test(tmp_path, monkeypatch) 
     from sumo_ayss.analysis.case import analyse_case
     from sumo_ayss.config.report import ReportOptions
     from sumo_ayss.report.leaderboard import leaderboard_rows
-    from sumo_ayss.report.load import load_run
+    from sumo_ayss.run_folder import read_run
     from tests.report.test_report import make_run
 
-    runs = {v: [load_run(make_run(tmp_path, "car_following", v, 0))] for v in ("pi1", "pi2")}
+    runs = {v: [read_run(make_run(tmp_path, "car_following", v, 0))] for v in ("pi1", "pi2")}
     a = analyse_case("car_following", runs, ReportOptions(mode="exposure", n_boot=100))
     rows = leaderboard_rows(a)
     assert rows[0].vs_next == f"no test against {rows[1].vut}: 1 vs 1 seed(s), a test needs 2"

@@ -1,7 +1,7 @@
 """Statistics of one case: safety indices, rankings and verdicts per mode.
 
 :func:`analyse_case` turns the runs of one case (any objects shaped like
-:class:`sumo_ayss.report.load.Run`) into a :class:`CaseAnalysis`: the paper mode (AYSS
+:class:`sumo_ayss.run_folder.RunRecord`) into a :class:`CaseAnalysis`: the paper mode (AYSS
 safety index per VUT, hierarchical bootstrap, pairwise verdicts under
 :func:`~.significance.pair_verdict`), the exposure mode (seed-level ranking of the mean harm
 per episode of each VUT's own SPCPs, :mod:`.harm`), the cross-play mode (the case's
@@ -19,7 +19,7 @@ import zlib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Protocol, TypeAlias
 
 import numpy as np
 
@@ -47,6 +47,9 @@ __all__ = [
     "run_label",
     "vut_safety_index",
 ]
+
+if TYPE_CHECKING:
+    from sumo_ayss.run_folder import RunRecord
 
 logger = logging.getLogger(__name__)
 
@@ -85,10 +88,11 @@ class CaseOptions(Protocol):
     def premise_tolerances(self) -> Mapping[str, float]: ...
 
 
-Run = Any
-"""A run as :func:`sumo_ayss.report.load.load_run` returns it (read by attribute: ``case``,
+Run: TypeAlias = "RunRecord"
+"""A run as :func:`sumo_ayss.run_folder.read_run` returns it (read by attribute: ``case``,
 ``vut``, ``seed``, ``problems``, ``ayss`` with ``indicator`` and ``h``, ``outcome`` with
-``mean_return``, ``crash_rate`` and ``mean_final_headway_m`` estimates)."""
+``mean_return``, ``crash_rate`` and ``mean_final_headway_m`` estimates, ``episodes``). Only
+a type: analysis imports no file reader (the loader hands it the records)."""
 
 
 def run_label(run: Run) -> str:
@@ -202,13 +206,15 @@ def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
     scores = []
     counts: dict[str, tuple[int, int, float]] = {}
     for vut, members in out.runs.items():
-        done = [r for r in members if r.seed is not None and r.episodes is not None]
+        done = [
+            (r.seed, r.episodes) for r in members if r.seed is not None and r.episodes is not None
+        ]
         if done:
-            scores.append(SeedScores(vut, {r.seed: r.episodes.mean_harm for r in done}))
+            scores.append(SeedScores(vut, {seed: e.mean_harm for seed, e in done}))
             counts[vut] = (
-                sum(r.episodes.crashes for r in done),
-                sum(r.episodes.n for r in done),
-                float(np.mean([r.episodes.mobility for r in done])),
+                sum(e.crashes for _, e in done),
+                sum(e.n for _, e in done),
+                float(np.mean([e.mobility for _, e in done])),
             )
         else:
             out.problems.append(f"{vut}: no outcome table with a seed, so no exposure")
@@ -285,7 +291,7 @@ def analyse_case(
         runs: ``{vut: runs}``.
         options: Statistical settings.
         crossplay: The case's cross-play table as its loader found it
-            (:func:`sumo_ayss.report.load.load_crossplay`); None: no table.
+            (:func:`sumo_ayss.run_folder.load_crossplay`); None: no table.
         paper: Compute the paper mode (AYSS safety indices and their bootstrap, the slow
             part); the report always does, a ranking in exposure mode need not.
 

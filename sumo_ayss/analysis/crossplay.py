@@ -195,7 +195,7 @@ def crossplay_matrix(
 class CrossplayInput:
     """A case's cross-play table as its loader found it: the matrix, or why there is none.
 
-    The loader (:func:`sumo_ayss.report.load.load_crossplay`) reads the file; nothing in
+    The loader (:func:`sumo_ayss.run_folder.load_crossplay`) reads the file; nothing in
     :mod:`sumo_ayss.analysis` does.
 
     Attributes:

@@ -38,6 +38,8 @@ from sumo_ayss.run_folder import (
     OUTCOME_CSV,
     OUTCOME_SCHEMA,
     RunFolder,
+    RunRecord,
+    read_run,
     read_table,
 )
 from sumo_ayss.scenarios.rollout import Policy
@@ -72,14 +74,13 @@ class ExportResult:
 # --------------------------------------------------------------------------- export
 
 
-def _row(run_dir: Path, kind: Kind, index: int) -> dict[str, Any]:
-    folder = RunFolder(run_dir)
+def _row(folder: RunFolder, kind: Kind, index: int) -> dict[str, Any]:
     path, schema = (
         (folder.ayss_csv, AYSS_SCHEMA) if kind == "ayss" else (folder.outcome_csv, OUTCOME_SCHEMA)
     )
     if not path.is_file():
         raise CheckpointError(
-            f"{run_dir}: no {path.name} (run `python -m sumo_ayss.evaluate` first)"
+            f"{folder.path}: no {path.name} (run `python -m sumo_ayss.evaluate` first)"
         )
     table = read_table(path, schema)
     if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < len(table):
@@ -96,11 +97,11 @@ def _initial_condition(kind: Kind, row: dict[str, Any]) -> InitialCondition:
     return InitialCondition(row["v_pov0_mps"], row["v_vut0_mps"], row["gap0_m"])
 
 
-def _load_policy(run: Any) -> Policy:
+def _load_policy(run: RunRecord) -> Policy:
     """The run's SPCP, weights only (never unpickled: see "Trust model" in the README)."""
     from sumo_ayss.evaluate import load_spcp  # torch: only when a policy is needed
 
-    return load_spcp(run, make_env(run.config.env))
+    return load_spcp(run, make_env(run.experiment.env))
 
 
 def _vehicle_name(vtype: str) -> str:
@@ -147,8 +148,6 @@ def export_scenario(
         CheckpointError: If the run folder, a table or the SPCP cannot be read.
         SimulationError: If SUMO fails or does not reproduce the row's initial state.
     """
-    from sumo_ayss.evaluate import load_run  # the entry-point layer; imported lazily
-
     if (ayss_row is None) == (outcome_row is None):
         raise ConfigError(
             "give exactly one of ayss_row (--ayss-row) or outcome_row (--outcome-row)"
@@ -160,25 +159,23 @@ def export_scenario(
         isinstance(decisions, bool) or not isinstance(decisions, int) or decisions < 1
     ):
         raise ConfigError(f"decisions must be an integer >= 1, got {decisions!r}")
-    run_dir, out = Path(run_dir), Path(out)
+    out = Path(out)
     with controller_imports(trust_controller):
-        run = load_run(run_dir)
-        return _export(run, kind, index, out, policy, decisions)
+        return _export(read_run(run_dir), kind, index, out, policy, decisions)
 
 
 def _export(
-    run: Any, kind: Kind, index: int, out: Path, policy: Policy | None, decisions: int | None
+    run: RunRecord, kind: Kind, index: int, out: Path, policy: Policy | None, decisions: int | None
 ) -> Any:
-    run_dir = run.run_dir
-    row = _row(run_dir, kind, index)
+    env_cfg = run.experiment.env  # raises first if the folder is not a run folder
+    row = _row(run.folder, kind, index)
     ic = _initial_condition(kind, row)
     pol = policy if policy is not None else _load_policy(run)
-    env_cfg = run.config.env
     limit = decisions if decisions is not None else (1 if kind == "ayss" else None)
     out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="sumo_ayss_rec_") as tmp:
         recorded = Path(tmp) / "recorded.fcd.xml"
-        rec = _record(env_cfg, run.seed, ic, pol, limit, recorded)
+        rec = _record(env_cfg, run.config_seed, ic, pol, limit, recorded)
         sumo_points = export.read_fcd(recorded)
     dt = env_cfg.sim.step_length_s
     # SUMO labels the state after the step starting at T with T; the initial state was
@@ -194,7 +191,7 @@ def _export(
     vt = env_cfg.vut_type
     atomic_write_text(out / VTYPES_FILE, vtypes_xml({f"vut_{env_cfg.vut}": vt, "pov": env_cfg.pov}))
     comment = (
-        f"{kind} row {index} of {run_dir.resolve()}; t = 0 inserts the vehicles, the scenario "
+        f"{kind} row {index} of {run.path}; t = 0 inserts the vehicles, the scenario "
         f"(tau = 0) starts at t = {dt:g} s"
     )
     export.write_fcd(out / TRAJECTORY_FILE, trajectory, comment)
@@ -213,7 +210,7 @@ def _export(
         fcd_replay=TRAJECTORY_FILE,
         sim=env_cfg.sim,
         end_s=end_s,
-        seed=run.seed,
+        seed=run.config_seed,
         gui_settings=GUI_FILE,
     )
     info = _info(run, kind, index, row, ic, rec, dt, end_s)
@@ -287,7 +284,7 @@ def _json_value(v: Any) -> Any:
 
 
 def _info(
-    run: Any,
+    run: RunRecord,
     kind: Kind,
     index: int,
     row: dict[str, Any],
@@ -298,7 +295,7 @@ def _info(
 ) -> dict[str, Any]:
     from sumo_ayss.sim.session import sumo_version
 
-    env_cfg: EnvConfig = run.config.env
+    env_cfg: EnvConfig = run.experiment.env
     steps = rec["steps"]
     ep_return = sum(s["reward"] for s in steps)
     collided = any(s["collision"] for s in steps)
@@ -314,17 +311,17 @@ def _info(
         }
     return {
         "source": {
-            "run_dir": portable_path(run.run_dir),
+            "run_dir": portable_path(run.path),
             "table": AYSS_CSV if kind == "ayss" else OUTCOME_CSV,
             "row": index,
             "values": {k: _json_value(v) for k, v in row.items()},
-            "spcp_step": run.spcp_step,
+            "spcp_step": run.spcp.step if run.spcp is not None else None,
         },
         "case": env_cfg.case,
         "vut": env_cfg.vut,
         "vut_type": to_dict(env_cfg.vut_type),
-        "train_seed": run.seed,
-        "sumo_seed": run.seed,
+        "train_seed": run.config_seed,
+        "sumo_seed": run.config_seed,
         "sumo_version": sumo_version(),
         "step_length_s": dt,
         "decision_period_s": env_cfg.decision_period_s,

@@ -43,6 +43,7 @@ from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.errors import ConfigError, SimulationError
 from sumo_ayss.paths import portable_path
 from sumo_ayss.replay.record import Kind, _initial_condition, _load_policy, _row
+from sumo_ayss.run_folder import read_run
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.scenarios.trajectory import body_width_m, trajectory_from_infos
 from sumo_ayss.sim.network import network_path
@@ -265,8 +266,6 @@ def export_xosc(
         CheckpointError: If the run folder, a table or the SPCP cannot be read.
         SimulationError: If SUMO fails.
     """
-    from sumo_ayss.evaluate import load_run
-
     if (ayss_row is None) == (outcome_row is None):
         raise ConfigError(
             "give exactly one of ayss_row (--ayss-row) or outcome_row (--outcome-row)"
@@ -280,13 +279,13 @@ def export_xosc(
     assert index is not None
     out = Path(out)
     with controller_imports(trust_controller):
-        run = load_run(Path(run_dir))
-        row = _row(run.run_dir, kind, index)
+        run = read_run(run_dir)
+        env_cfg: EnvConfig = run.experiment.env  # raises first if not a run folder
+        row = _row(run.folder, kind, index)
         ic = _initial_condition(kind, row)
         pol = policy if policy is not None else _load_policy(run)
-        env_cfg: EnvConfig = run.config.env
         limit = decisions if decisions is not None else (1 if kind == "ayss" else None)
-        reset_info, infos, actions, rewards = _record(env_cfg, run.seed, ic, pol, limit)
+        reset_info, infos, actions, rewards = _record(env_cfg, run.config_seed, ic, pol, limit)
     if not infos:
         raise SimulationError("the episode recorded no decision")
     net = env_cfg.network if env_cfg.network is not None else network_path(env_cfg.case)
@@ -297,9 +296,7 @@ def export_xosc(
     y_pov = tr.pov_y_m if "pov_y_m" in reset_info else lane0
     out.mkdir(parents=True, exist_ok=True)
     _xodr(road, out / XODR_FILE)
-    description = (
-        f"{kind} row {index} of {portable_path(run.run_dir)} ({env_cfg.case}, {env_cfg.vut})"
-    )
+    description = f"{kind} row {index} of {portable_path(run.path)} ({env_cfg.case}, {env_cfg.vut})"
     _xosc(tr, road, y_vut, y_pov, out / XOSC_FILE, description)
     collided = bool(infos[-1]["collision"])
     reproduced: dict[str, bool]
@@ -312,10 +309,10 @@ def export_xosc(
             "n_steps": len(infos) == row["n_steps"],
         }
     info = {
-        "source": {"run_dir": portable_path(run.run_dir), "kind": kind, "row": index},
+        "source": {"run_dir": portable_path(run.path), "kind": kind, "row": index},
         "case": env_cfg.case,
         "vut": env_cfg.vut,
-        "sumo_seed": run.seed,
+        "sumo_seed": run.config_seed,
         "decisions": len(infos),
         "decision_period_s": env_cfg.decision_period_s,
         "collided": collided,

@@ -33,13 +33,8 @@ _LAZY = {
     "vut_safety_index": "sumo_ayss.analysis.case",
     "write_report": "sumo_ayss.report.document",
     "write_report_for": "sumo_ayss.report.document",
-    "RUN_FILES": "sumo_ayss.report.load",
-    "Run": "sumo_ayss.report.load",
-    "find_run_dirs": "sumo_ayss.report.load",
     "group_runs": "sumo_ayss.report.load",
     "analyse_runs": "sumo_ayss.report.load",
-    "load_crossplay": "sumo_ayss.report.episodes",
-    "load_run": "sumo_ayss.report.load",
     "ReportOptions": "sumo_ayss.config.report",
 }
 """Public names and their modules, imported on first use: importing the package loads

@@ -1,15 +1,15 @@
 """Checks that keep a report from misleading: training budget, SPCP still improving, mixed runs.
 
-Read from the light files of a run folder only (``config.yaml``, ``eval.csv``,
-``spcp.json``), so the pipeline can print the same warnings as the report without loading
-the AYSS tables.
+They read the run records (:class:`~sumo_ayss.run_folder.RunRecord`: each run's
+:class:`~sumo_ayss.run_folder.Training`, from ``config.yaml``, ``eval.csv`` and
+``spcp.json``) and the analyses; no file.
 
-- :func:`read_training` — a run's budget (``train.total_timesteps``, ``train.eval_every``)
-  and the state of its learning curve at the end: the SPCP is the last candidate (the curve
-  was still at its best when training stopped: it may still be improving), the last
-  candidate's mean evaluation reward is within :data:`NOISE_SE` standard errors of the
-  SPCP's (a plateau: the SPCP is one of several candidates equal within noise), or it is
-  clearly below (the curve peaked earlier).
+- :func:`training_status` — the state of a run's learning curve at the end (its
+  :class:`~sumo_ayss.run_folder.Training`, read with the run): the SPCP is the last
+  candidate (the curve was still at its best when training stopped: it may still be
+  improving), the last candidate's mean evaluation reward is within :data:`NOISE_SE`
+  standard errors of the SPCP's (a plateau: the SPCP is one of several candidates equal
+  within noise), or it is clearly below (the curve peaked earlier).
 - :func:`trust_warnings` — sentences for the top of a report (and the terminal) when the
   budget is below :data:`TRUSTED_TIMESTEPS`, the seeds too few for it (no named budget of
   :mod:`sumo_ayss.config.budget` covers the protocol), or SPCPs may still be improving.
@@ -25,19 +25,14 @@ Imports neither SUMO nor torch.
 from __future__ import annotations
 
 import contextlib
-import hashlib
-import json
-import math
 import os
 from collections import Counter, defaultdict
-from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from sumo_ayss.config.budget import BUDGETS
-from sumo_ayss.errors import AyssError
-from sumo_ayss.run_folder import RunFolder, read_eval_rows, read_run_config, read_spcp
+from sumo_ayss.run_folder import Training
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
@@ -51,99 +46,17 @@ NOISE_SE = 2.0
 """The last candidate counts as "within noise" of the SPCP when its mean evaluation reward
 is less than this many standard errors (SPCP's ``std_return / sqrt(n_episodes)``) lower."""
 
-_IGNORED_KEYS = (("seed",), ("vut",), ("env", "vut"), ("env", "vuts"), ("train", "progress_bar"))
-"""Config entries that may differ between runs pooled in one report: the run's own VUT and
-seed, the VUT catalog (a leaderboard adds VUTs), and display-only settings."""
 
-
-@dataclass(frozen=True)
-class Training:
-    """A run's training budget and the state of its SPCP.
-
-    Attributes:
-        total_timesteps: ``train.total_timesteps`` (transitions), None if unknown.
-        eval_every: ``train.eval_every`` (transitions between candidates), None if unknown.
-        config_key: Hash of the configuration without :data:`_IGNORED_KEYS`, "" if unknown.
-        n_candidates: Rows of ``eval.csv``.
-        spcp_step: The SPCP's training step, None if unknown.
-        last_step: The last candidate's training step, None if no candidate.
-        gap_se: (SPCP reward − last candidate's reward) / SPCP's standard error; NaN if
-            unknown.
-        still_improving: True when the SPCP is the last candidate; None when unknown.
-    """
-
-    total_timesteps: int | None = None
-    eval_every: int | None = None
-    config_key: str = ""
-    n_candidates: int = 0
-    spcp_step: int | None = None
-    last_step: int | None = None
-    gap_se: float = math.nan
-    still_improving: bool | None = None
-
-    @property
-    def status(self) -> str:
-        """One phrase for a table cell."""
-        if self.still_improving is None:
-            return "unknown"
-        if self.still_improving:
-            return "may still improve: SPCP is the last candidate"
-        if self.gap_se < NOISE_SE:
-            return f"plateau: last candidate within {self.gap_se:.1f} SE of the SPCP"
-        return f"peaked: last candidate {self.gap_se:.1f} SE below the SPCP"
-
-
-def _drop(data: dict[str, Any], key: tuple[str, ...]) -> None:
-    node: Any = data
-    for part in key[:-1]:
-        node = node.get(part) if isinstance(node, Mapping) else None
-    if isinstance(node, dict):
-        node.pop(key[-1], None)
-
-
-def config_key(config: Mapping[str, Any]) -> str:
-    """A short hash of a resolved ``config.yaml`` without the VUT, seed and catalog."""
-    data = json.loads(json.dumps(config, default=str))
-    for key in _IGNORED_KEYS:
-        _drop(data, key)
-    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:12]
-
-
-def _int_or_none(value: Any) -> int | None:
-    return int(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
-
-
-def read_training(run_dir: Path) -> Training:
-    """The :class:`Training` of ``run_dir``; unreadable files leave fields unknown."""
-    folder = RunFolder(run_dir)
-    total = every = None
-    key = ""
-    with contextlib.suppress(AyssError, AttributeError):
-        config = read_run_config(folder.config)
-        train = config.experiment.get("train") or {}
-        total, every = (
-            _int_or_none(train.get("total_timesteps")),
-            _int_or_none(train.get("eval_every")),
-        )
-        key = config_key(config.as_dict())
-    rows: list[dict[str, Any]] = []
-    with contextlib.suppress(AyssError):
-        rows = read_eval_rows(folder.eval_table, skip_bad_rows=True)[0]
-    rows.sort(key=lambda r: r["step"])
-    spcp_step = None
-    with contextlib.suppress(AyssError):
-        spcp_step = read_spcp(folder.spcp_json).step
-    if not rows or spcp_step is None:
-        return Training(total, every, key, len(rows), spcp_step)
-    last = rows[-1]
-    spcp = next((r for r in rows if int(r["step"]) == spcp_step), None)
-    gap = math.nan
-    if spcp is not None:
-        se = spcp["std_return"] / math.sqrt(spcp["n_episodes"]) if spcp["n_episodes"] > 0 else 0
-        diff = spcp["mean_return"] - last["mean_return"]
-        gap = diff / se if se > 0 else (0.0 if diff == 0 else math.inf)
-    improving = int(last["step"]) == spcp_step
-    return Training(total, every, key, len(rows), spcp_step, int(last["step"]), gap, improving)
+def training_status(t: Training) -> str:
+    """A run's SPCP state (:class:`~sumo_ayss.run_folder.Training`) in one phrase, for a
+    table cell."""
+    if t.still_improving is None:
+        return "unknown"
+    if t.still_improving:
+        return "may still improve: SPCP is the last candidate"
+    if t.gap_se < NOISE_SE:
+        return f"plateau: last candidate within {t.gap_se:.1f} SE of the SPCP"
+    return f"peaked: last candidate {t.gap_se:.1f} SE below the SPCP"
 
 
 def fewest_seeds(keys: Iterable[tuple[str, str]]) -> int | None:

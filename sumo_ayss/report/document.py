@@ -44,18 +44,12 @@ from sumo_ayss.report.blocks import (
 from sumo_ayss.report.checks import fewest_seeds, mixing_problems, trust_warnings
 from sumo_ayss.report.figstyle import vut_colors
 from sumo_ayss.report.leaderboard import leaderboard_table
-from sumo_ayss.report.load import (
-    RUN_FILES,
-    Run,
-    analyse_runs,
-    find_run_dirs,
-    group_runs,
-    load_run,
-)
+from sumo_ayss.report.load import analyse_runs, group_runs
 from sumo_ayss.report.render import render_html, render_markdown
 from sumo_ayss.report.sections.case import case_blocks, verdict_lines
 from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.inputs import inputs_blocks
+from sumo_ayss.run_folder import CONFIG_YAML, RunRecord, find_run_dirs, read_run
 
 __all__ = [
     "DEFAULT_TITLE",
@@ -91,7 +85,7 @@ MARKDOWN_NAME = "summary.md"
 
 
 def build_report(
-    runs: Sequence[Run],
+    runs: Sequence[RunRecord],
     out_dir: Path,
     *,
     title: str = DEFAULT_TITLE,
@@ -188,14 +182,14 @@ def modes_paragraph(analyses: Sequence[CaseAnalysis], mode: str) -> str:
     )
 
 
-def load_runs(paths: Sequence[str | Path]) -> list[Run]:
+def load_runs(paths: Sequence[str | Path]) -> list[RunRecord]:
     """The run folders among ``paths`` (and below them), loaded, checked to be poolable.
 
     Args:
         paths: Run folders ``<out>/<case>/<vut>/seed_<k>`` and/or roots to search.
 
     Returns:
-        The loaded runs (:func:`.load.load_run`), in :func:`find_run_dirs` order.
+        The loaded runs (:func:`~sumo_ayss.run_folder.read_run`), in :func:`find_run_dirs` order.
 
     Raises:
         ConfigError: If ``paths`` is empty, a path is not a folder, no run folder is found,
@@ -205,8 +199,8 @@ def load_runs(paths: Sequence[str | Path]) -> list[Run]:
         raise ConfigError("paths: expected at least one run folder or root")
     run_dirs = find_run_dirs(paths)
     if not run_dirs:
-        raise ConfigError(f"no run folder (with {RUN_FILES.config}) under {list(map(str, paths))}")
-    runs = [load_run(d) for d in run_dirs]
+        raise ConfigError(f"no run folder (with {CONFIG_YAML}) under {list(map(str, paths))}")
+    runs = [read_run(d) for d in run_dirs]
     problems = mixing_problems(
         [(r.case, r.vut, r.seed, display_path(r.path, Path.cwd()), r.training) for r in runs]
     )
@@ -245,7 +239,7 @@ def write_report(
 
 
 def write_report_for(
-    runs: Sequence[Run],
+    runs: Sequence[RunRecord],
     out_dir: Path,
     *,
     analyses: Sequence[CaseAnalysis] | None = None,

@@ -38,7 +38,7 @@ from sumo_ayss.report.figstyle import (
     style,
     vut_colors,
 )
-from sumo_ayss.report.load import Run
+from sumo_ayss.run_folder import RunRecord
 
 __all__ = [
     "DPI",
@@ -116,7 +116,7 @@ def _thousands(x: float, _pos: int) -> str:
 
 
 def learning_curves_figure(
-    runs_by_vut: Mapping[str, Sequence[Run]],
+    runs_by_vut: Mapping[str, Sequence[RunRecord]],
     colors: Mapping[str, str],
     path: Path,
     *,
@@ -180,7 +180,7 @@ def learning_curves_figure(
         return save(fig, path)
 
 
-def _draw_curve(ax: Axes, run: Run, column: str, scale: float, color: str, pos: int) -> bool:
+def _draw_curve(ax: Axes, run: RunRecord, column: str, scale: float, color: str, pos: int) -> bool:
     curve = run.eval_curve
     if curve is None or len(curve) == 0:
         return False
@@ -206,7 +206,9 @@ def _draw_curve(ax: Axes, run: Run, column: str, scale: float, color: str, pos: 
     return True
 
 
-def _run_legend(runs_by_vut: Mapping[str, Sequence[Run]], colors: Mapping[str, str]) -> list[Any]:
+def _run_legend(
+    runs_by_vut: Mapping[str, Sequence[RunRecord]], colors: Mapping[str, str]
+) -> list[Any]:
     handles: list[Any] = []
     for vut, members in runs_by_vut.items():
         for pos, run in enumerate(members):
@@ -225,7 +227,7 @@ def _run_legend(runs_by_vut: Mapping[str, Sequence[Run]], colors: Mapping[str, s
 # --------------------------------------------------------------------------- indicator vs headway
 
 
-def _seed_arrays(run: Run) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+def _seed_arrays(run: RunRecord) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
     if run.ayss is None or len(run.ayss) == 0:
         return None
     return run.ayss.h, run.ayss.indicator
@@ -254,7 +256,7 @@ def _band(
 
 
 def indicator_figure(
-    runs_by_vut: Mapping[str, Sequence[Run]],
+    runs_by_vut: Mapping[str, Sequence[RunRecord]],
     colors: Mapping[str, str],
     path: Path,
     *,

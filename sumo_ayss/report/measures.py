@@ -15,8 +15,6 @@ Kendall's τ between the two orders — and per VUT the R157 cut-in share
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -34,32 +32,9 @@ from sumo_ayss.analysis.measure_ranking import (
 )
 from sumo_ayss.errors import AyssError
 from sumo_ayss.modes import CROSSPLAY, EXPOSURE
-from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA, RunFolder, read_table
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, StudyFolder, read_table, write_measures_csv
 
-__all__ = ["MEASURES_CSV", "CaseMeasures", "case_measures", "write_measures"]
-
-MEASURES_CSV = "measures.csv"
-
-COLUMNS = [
-    "case",
-    "pool",
-    "measure",
-    "unit",
-    "higher_is_safer",
-    "vut",
-    "rank",
-    "median",
-    "lo",
-    "hi",
-    "p10",
-    "p90",
-    "share_inf",
-    "n",
-    "n_total",
-    "primary_mode",
-    "primary_rank",
-    "tau_vs_primary",
-]
+__all__ = ["CaseMeasures", "case_measures", "write_measures"]
 
 
 @dataclass(frozen=True)
@@ -106,14 +81,13 @@ def _pool_columns(a: CaseAnalysis) -> tuple[str, dict[str, np.ndarray]] | None:
     parts: list[dict[str, np.ndarray]] = []
     for vut, runs in a.runs.items():
         for run in runs:
-            path = RunFolder(run.path).outcome_csv
-            if not path.is_file():
+            table = run.outcome_table
+            if table is None:  # missing or unreadable: the run's problems say which
                 continue
-            t = read_table(path, OUTCOME_SCHEMA)
-            n = len(t)
+            n = len(table)
             part = {"vut": np.full(n, vut), "group": np.full(n, str(run.seed))}
-            part["collided"] = t["collided"]
-            parts.append({**part, **{c: t[c] for c in _measure_columns()}})
+            part["collided"] = table["collided"]
+            parts.append({**part, **{c: table[c] for c in _measure_columns()}})
     if not parts:
         return None
     return "own SPCPs", {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
@@ -217,9 +191,8 @@ def _rows(m: CaseMeasures) -> list[dict[str, object]]:
 
 
 def write_measures(out: Path, analyses: Sequence[CaseAnalysis]) -> Path | None:
-    """``<out>/measures.csv`` of every case with recorded measures (atomic); None if none."""
-    from sumo_ayss.atomic import atomic_write_text
-
+    """``<out>/measures.csv`` of every case with recorded measures
+    (:func:`~sumo_ayss.run_folder.write_measures_csv`); None if none."""
     rows: list[dict[str, object]] = []
     for a in analyses:
         m = case_measures(a)
@@ -227,9 +200,6 @@ def write_measures(out: Path, analyses: Sequence[CaseAnalysis]) -> Path | None:
             rows += _rows(m)
     if not rows:
         return None
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    atomic_write_text(out / MEASURES_CSV, buf.getvalue())
-    return out / MEASURES_CSV
+    path = StudyFolder(out).measures_csv
+    write_measures_csv(path, rows)
+    return path

@@ -23,18 +23,29 @@ file                    writer / reader              what
 ``ayss.csv``            write_/read_table            one row per kept AYSS sample
                         (:data:`AYSS_SCHEMA`)
 ``ayss.json``           write_/read_ayss_json        filter counts, settings, throughput
-``evaluate.done.json``  write_/read_evaluate_done    the pipeline's evaluation marker
+``evaluate.done.json``  write_/read_done_marker      the pipeline's evaluation marker
 ``job.log``             (logging)                    the pipeline job's log
 ======================  ===========================  =========================================
 
 The case folder ``<out>/<case>/`` (:func:`case_dir_for`, :class:`CaseFolder`), one level
-above the case's run folders, holds the cross-play stage's files:
+above the case's run folders, holds the cross-play and discriminability stages' files:
 
-======================  ===========================  =========================================
-``crossplay.csv``       write_/read_table            one row per (VUT, opponent SPCP,
-                        (:data:`CROSSPLAY_SCHEMA`)   scenario)
-``crossplay.json``      write_/read_crossplay_json   settings, opponents, wall time
-======================  ===========================  =========================================
+==========================  ==============================  ==================================
+``crossplay.csv``           write_/read_table               one row per (VUT, opponent SPCP,
+                            (:data:`CROSSPLAY_SCHEMA`)      scenario)
+``crossplay.json``          write_/read_crossplay_json      settings, opponents, wall time
+``discriminability.json``   write_discriminability /        where the VUTs' responses differ
+``discriminability.csv``    read_discriminability_json      over the AYSS box
+``adaptive.json``           write_/read_adaptive            adaptive seeding: looks and seeds
+==========================  ==============================  ==================================
+
+The study folder ``<out>/`` (:class:`StudyFolder`) holds ``pipeline.json``, ``ranking.csv``,
+``ranking.md``, ``order_check.json`` and ``measures.csv`` (:mod:`.study`).
+
+A run folder is read once into a :class:`RunRecord` (:func:`read_run`, :mod:`.record`) and
+that record is handed on; a case's cross-play table is read by :func:`load_crossplay`.
+Whether a stage is done with the inputs asked for now is one contract for every stage
+(:mod:`.stage`: :func:`fingerprint`, :class:`Stage`, :func:`is_done`).
 
 Every file is written atomically (:mod:`sumo_ayss.atomic`). No other module spells one of
 these names or parses one of these files. Imports neither SUMO nor torch.
@@ -52,8 +63,14 @@ from sumo_ayss.run_folder.crossplay import (
     CrossplayOpponent,
     CrossplayRecord,
     DiagonalCheck,
+    load_crossplay,
     read_crossplay_json,
+    read_crossplay_matrix,
     write_crossplay_json,
+)
+from sumo_ayss.run_folder.discriminability import (
+    read_discriminability_json,
+    write_discriminability,
 )
 from sumo_ayss.run_folder.eval_table import (
     EVAL_COLUMNS,
@@ -71,6 +88,9 @@ from sumo_ayss.run_folder.layout import (
     CONFIG_YAML,
     CROSSPLAY_CSV,
     CROSSPLAY_JSON,
+    DISCRIMINABILITY_CSV,
+    DISCRIMINABILITY_JSON,
+    DISCRIMINABILITY_PNG,
     EVAL_CSV,
     EVALUATE_DONE_JSON,
     JOB_LOG,
@@ -103,7 +123,6 @@ from sumo_ayss.run_folder.metadata import (
     SpcpChoice,
     read_checkpoint_state,
     read_command,
-    read_evaluate_done,
     read_json_object,
     read_latest,
     read_progress,
@@ -113,7 +132,6 @@ from sumo_ayss.run_folder.metadata import (
     read_versions,
     write_checkpoint_state,
     write_command,
-    write_evaluate_done,
     write_latest,
     write_progress,
     write_run_config,
@@ -121,12 +139,56 @@ from sumo_ayss.run_folder.metadata import (
     write_spcp,
     write_versions,
 )
+from sumo_ayss.run_folder.record import (
+    AyssSamples,
+    EvalCurve,
+    RunRecord,
+    Training,
+    config_key,
+    harm_scale_of,
+    read_run,
+)
 from sumo_ayss.run_folder.schemas import (
     AYSS_SCHEMA,
     CROSSPLAY_SCHEMA,
     INDICATOR_ACCEL,
     INDICATOR_DELTA_V_BAR,
     OUTCOME_SCHEMA,
+)
+from sumo_ayss.run_folder.stage import (
+    AyssStage,
+    CrossplayStage,
+    DiscriminabilityStage,
+    EvaluateStage,
+    OutcomeStage,
+    Stage,
+    TrainStage,
+    fingerprint,
+    is_done,
+    read_done_marker,
+    stored_experiment,
+    write_done_marker,
+)
+from sumo_ayss.run_folder.study import (
+    MEASURES_COLUMNS,
+    MEASURES_CSV,
+    ORDER_CHECK_JSON,
+    PIPELINE_JSON,
+    RANKING_COLUMNS,
+    RANKING_CSV,
+    RANKING_MD,
+    REPORT_DIR,
+    OrderCheck,
+    OrderChecks,
+    StudyFolder,
+    read_measures_csv,
+    read_order_check,
+    read_pipeline_json,
+    read_ranking_csv,
+    write_measures_csv,
+    write_order_check,
+    write_pipeline_json,
+    write_ranking_csv,
 )
 from sumo_ayss.run_folder.summaries import (
     AyssRecord,
@@ -161,6 +223,9 @@ __all__ = [
     "CROSSPLAY_CSV",
     "CROSSPLAY_JSON",
     "CROSSPLAY_SCHEMA",
+    "DISCRIMINABILITY_CSV",
+    "DISCRIMINABILITY_JSON",
+    "DISCRIMINABILITY_PNG",
     "EVALUATE_DONE_JSON",
     "EVAL_COLUMNS",
     "EVAL_CSV",
@@ -168,12 +233,20 @@ __all__ = [
     "INDICATOR_DELTA_V_BAR",
     "JOB_LOG",
     "LATEST_JSON",
+    "MEASURES_COLUMNS",
+    "MEASURES_CSV",
     "MODEL_ZIP",
+    "ORDER_CHECK_JSON",
     "OUTCOME_CSV",
     "OUTCOME_JSON",
     "OUTCOME_SCHEMA",
+    "PIPELINE_JSON",
     "PROGRESS_JSON",
+    "RANKING_COLUMNS",
+    "RANKING_CSV",
+    "RANKING_MD",
     "REPLAY_PKL",
+    "REPORT_DIR",
     "RESUME_FILES",
     "RESUME_MODEL_ZIP",
     "SEEDS_JSON",
@@ -186,38 +259,64 @@ __all__ = [
     "AdaptiveLook",
     "AdaptiveRecord",
     "AyssRecord",
+    "AyssSamples",
+    "AyssStage",
     "CaseFolder",
     "Column",
     "CrossplayOpponent",
     "CrossplayRecord",
+    "CrossplayStage",
     "DiagonalCheck",
+    "DiscriminabilityStage",
     "Estimate",
+    "EvalCurve",
+    "EvaluateStage",
+    "OrderCheck",
+    "OrderChecks",
     "Outcome",
     "OutcomeRecord",
+    "OutcomeStage",
     "OutcomeSubset",
     "RunConfig",
     "RunFolder",
+    "RunRecord",
     "Seeds",
     "SpcpChoice",
+    "Stage",
     "StageHeader",
+    "StudyFolder",
     "Table",
     "TableSchema",
+    "TrainStage",
+    "Training",
     "case_dir_for",
+    "config_key",
     "find_run_dirs",
+    "fingerprint",
+    "harm_scale_of",
+    "is_done",
     "is_run_dir",
+    "load_crossplay",
     "read_adaptive",
     "read_ayss_json",
     "read_checkpoint_state",
     "read_command",
     "read_crossplay_json",
+    "read_crossplay_matrix",
+    "read_discriminability_json",
+    "read_done_marker",
     "read_eval_rows",
     "read_eval_table",
-    "read_evaluate_done",
     "read_json",
     "read_json_object",
     "read_latest",
+    "read_measures_csv",
+    "read_order_check",
     "read_outcome_json",
+    "read_pipeline_json",
     "read_progress",
+    "read_ranking_csv",
+    "read_run",
     "read_run_config",
     "read_seeds",
     "read_spcp",
@@ -226,18 +325,24 @@ __all__ = [
     "run_dir_for",
     "schema_markdown",
     "seed_of_dir",
+    "stored_experiment",
     "table_from_rows",
     "write_adaptive",
     "write_ayss_json",
     "write_checkpoint_state",
     "write_command",
     "write_crossplay_json",
+    "write_discriminability",
+    "write_done_marker",
     "write_eval_table",
-    "write_evaluate_done",
     "write_json",
     "write_latest",
+    "write_measures_csv",
+    "write_order_check",
     "write_outcome_json",
+    "write_pipeline_json",
     "write_progress",
+    "write_ranking_csv",
     "write_run_config",
     "write_seeds",
     "write_spcp",

@@ -17,26 +17,39 @@ how tables were made before issue 21; such a table is re-run). ``diagonal`` is t
 that each SPCP, driven against its own VUT, reproduced its run's ``outcome.csv``: per run,
 how many of the ``n`` episodes were equal (absent in older records).
 
-Imports neither SUMO nor torch.
+:func:`load_crossplay` reads a case's table and record back for the analysis, as a
+:class:`~sumo_ayss.analysis.crossplay.CrossplayInput` scored on the runs' harm scale.
+
+Imports neither SUMO nor torch (nor, until a table is read, the analysis).
 """
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
-from sumo_ayss.errors import TableError
+from sumo_ayss.errors import ConfigError, TableError
 from sumo_ayss.run_folder.jsonio import read_json, write_json
+from sumo_ayss.run_folder.layout import CaseFolder
+from sumo_ayss.run_folder.schemas import CROSSPLAY_SCHEMA
+from sumo_ayss.run_folder.table import read_table
+
+if TYPE_CHECKING:
+    from sumo_ayss.analysis.crossplay import CrossplayInput, CrossplayMatrix
+    from sumo_ayss.analysis.harm import HarmScale
+    from sumo_ayss.run_folder.record import RunRecord
 
 __all__ = [
     "ROLLOUT",
     "CrossplayOpponent",
     "CrossplayRecord",
     "DiagonalCheck",
+    "load_crossplay",
     "read_crossplay_json",
+    "read_crossplay_matrix",
     "write_crossplay_json",
 ]
 
@@ -113,11 +126,15 @@ class CrossplayRecord:
     rollout: str = ROLLOUT
     diagonal: tuple[DiagonalCheck, ...] = ()
 
-    def same_inputs(self, other: CrossplayRecord) -> bool:
-        """Whether ``other`` ran the same scenarios against the same SPCPs the same way (a
-        rerun skips)."""
-        mine = (self.n, self.seed, self.opponents, self.rollout)
-        return mine == (other.n, other.seed, other.opponents, other.rollout)
+    def inputs(self) -> dict[str, Any]:
+        """What the table was made from: the scenario set, the opponents and how they were
+        driven (the cross-play stage's inputs, :class:`~.stage.CrossplayStage`)."""
+        return {
+            "n": self.n,
+            "seed": self.seed,
+            "opponents": [dataclasses.asdict(o) for o in self.opponents],
+            "rollout": self.rollout,
+        }
 
     def extended_by(self, other: CrossplayRecord) -> bool:
         """Whether ``other`` is this run with more opponents (same scenarios, same rollout,
@@ -200,3 +217,102 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
         rollout=rollout,
         diagonal=diagonal,
     )
+
+
+# --------------------------------------------------------------------------- the analysis's input
+
+
+def read_crossplay_matrix(path: Path, scale: HarmScale) -> CrossplayMatrix:
+    """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of a case folder's
+    ``crossplay.csv`` (read against :data:`~.schemas.CROSSPLAY_SCHEMA`), each episode's
+    harm on ``scale`` (a table written before ``near_miss_pay`` existed derives it from the
+    return).
+
+    Raises:
+        TableError: If the file is missing or does not follow the schema.
+        ConfigError: If the design is not complete and balanced
+            (:func:`~sumo_ayss.analysis.crossplay.crossplay_matrix`), or a pay does not fit
+            the scale.
+    """
+    from sumo_ayss.analysis.crossplay import crossplay_matrix
+    from sumo_ayss.analysis.harm import episode_harm
+
+    c = read_table(path, CROSSPLAY_SCHEMA).columns
+    pay = scale.near_miss_pay(c["near_miss_pay"], c["episode_return"], c["collided"])
+    return crossplay_matrix(
+        c["vut"],
+        c["opponent_vut"],
+        c["opponent_seed"],
+        episode_harm(pay, c["collided"], scale.max_episode_pay),
+        c["collided"],
+        episode_return=c["episode_return"],
+        mobility=c["vut_mean_speed_mps"],
+    )
+
+
+def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
+    """The cross-play table of one case's runs: ``crossplay.csv`` of the case folder they lie
+    in (the parent of the VUT folders), read against :data:`~.schemas.CROSSPLAY_SCHEMA`,
+    with its record's diagonal check (``crossplay.json``); never raises.
+
+    Args:
+        runs: ``{vut: runs}`` of one case (:func:`~.record.read_run`).
+
+    Returns:
+        The :class:`~sumo_ayss.analysis.crossplay.CrossplayInput`: the matrix, its path and
+        its diagonal check, or why there is none (no table, runs in several case folders or
+        on different harm scales, an unreadable table or one whose design is not complete
+        and balanced, or a table whose diagonal did not reproduce the outcome tables).
+    """
+    from sumo_ayss.analysis.crossplay import CrossplayInput
+
+    case_dirs = sorted({r.path.parent.parent for rs in runs.values() for r in rs})
+    if len(case_dirs) != 1:
+        folders = ", ".join(map(str, case_dirs))
+        return CrossplayInput(
+            missing=f"no cross-play table: the runs lie in several case folders ({folders})"
+        )
+    folder = CaseFolder(case_dirs[0])
+    path = folder.crossplay_csv
+    if not path.is_file():
+        return CrossplayInput()
+    scales = {r.harm_scale for rs in runs.values() for r in rs}
+    scale = next(iter(scales)) if len(scales) == 1 else None
+    if scale is None:
+        return CrossplayInput(
+            path=path,
+            missing="the cross-play table cannot be scored: the runs' config.yaml files do "
+            "not give one reward and episode length for all (harm scale)",
+        )
+    diagonal: tuple[tuple[str, int, int, int], ...] = ()
+    if folder.crossplay_json.is_file():
+        try:
+            record = read_crossplay_json(folder.crossplay_json)
+        except TableError as exc:
+            return CrossplayInput(
+                path=path,
+                missing=f"the cross-play record is unreadable ({exc})",
+                problem=str(exc),  # names the file
+            )
+        diagonal = tuple((d.vut, d.seed, d.n, d.n_equal) for d in record.diagonal)
+        bad = [d for d in record.diagonal if not d.ok]
+        if bad:
+            names = ", ".join(f"{d.vut} (seed {d.seed}: {d.n - d.n_equal}/{d.n})" for d in bad)
+            why = (
+                "the cross-play table is refused: its diagonal did not reproduce the outcome "
+                f"tables of {names}; it would rank another vehicle than the one the opponents "
+                "were trained against"
+            )
+            return CrossplayInput(
+                path=path, missing=why, problem=f"{path}: {why}", diagonal=diagonal
+            )
+    try:
+        matrix = read_crossplay_matrix(path, scale)
+    except (TableError, ConfigError) as exc:
+        text = str(exc)  # a TableError names the file already
+        return CrossplayInput(
+            path=path,
+            missing=f"the cross-play table is unreadable ({exc})",
+            problem=text if text.startswith(str(path)) else f"{path}: {text}",
+        )
+    return CrossplayInput(matrix, path, diagonal=diagonal)

@@ -2,8 +2,8 @@
 
 A run folder is ``<out>/<case>/<vut>/seed_<k>/`` (:func:`run_dir_for`). :class:`RunFolder`
 gives the path of every file in it; no other module spells a file name of a run folder.
-The case folder ``<out>/<case>/`` above a case's runs holds the cross-play files
-(:class:`CaseFolder`).
+The case folder ``<out>/<case>/`` above a case's runs holds the cross-play and
+discriminability files (:class:`CaseFolder`).
 """
 
 from __future__ import annotations
@@ -24,6 +24,9 @@ __all__ = [
     "CONFIG_YAML",
     "CROSSPLAY_CSV",
     "CROSSPLAY_JSON",
+    "DISCRIMINABILITY_CSV",
+    "DISCRIMINABILITY_JSON",
+    "DISCRIMINABILITY_PNG",
     "EVALUATE_DONE_JSON",
     "EVAL_CSV",
     "JOB_LOG",
@@ -107,6 +110,15 @@ CROSSPLAY_CSV = "crossplay.csv"
 CROSSPLAY_JSON = "crossplay.json"
 ADAPTIVE_JSON = "adaptive.json"
 """Cross-play record: settings, opponents with their SPCP's SHA-256, wall time."""
+
+# -- written by the discriminability stage, in the case folder too ------------------------
+DISCRIMINABILITY_JSON = "discriminability.json"
+"""Where the VUTs' one-step responses differ over the AYSS box, with the fingerprint of the
+inputs (:mod:`.discriminability`)."""
+DISCRIMINABILITY_CSV = "discriminability.csv"
+"""The same shares as a long table: one row per (VUT pair, dimension, bin)."""
+DISCRIMINABILITY_PNG = "discriminability.png"
+"""Its figure (drawn by the report's discriminability section)."""
 
 _SEED_DIR = re.compile(r"^seed_(-?\d+)$")
 
@@ -237,7 +249,8 @@ class RunFolder:
 
 @dataclass(frozen=True)
 class CaseFolder:
-    """The paths of a case folder's own files (cross-play), one level above its runs.
+    """The paths of a case folder's own files (cross-play, discriminability), one level
+    above its runs.
 
     Attributes:
         path: The case folder ``<out>/<case>/`` (:func:`case_dir_for`).
@@ -262,6 +275,21 @@ class CaseFolder:
     def adaptive_json(self) -> Path:
         """``adaptive.json`` (adaptive seeding's looks, :mod:`.adaptive`)."""
         return self.path / ADAPTIVE_JSON
+
+    @property
+    def discriminability_json(self) -> Path:
+        """``discriminability.json``."""
+        return self.path / DISCRIMINABILITY_JSON
+
+    @property
+    def discriminability_csv(self) -> Path:
+        """``discriminability.csv``."""
+        return self.path / DISCRIMINABILITY_CSV
+
+    @property
+    def discriminability_png(self) -> Path:
+        """``discriminability.png``."""
+        return self.path / DISCRIMINABILITY_PNG
 
 
 def is_run_dir(path: Path) -> bool:

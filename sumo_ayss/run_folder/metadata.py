@@ -8,7 +8,6 @@
 ``spcp.json``               :func:`write_spcp` / :func:`read_spcp`
 ``checkpoints/latest.json`` :func:`write_latest` / :func:`read_latest`
 ``<checkpoint>/state.json`` :func:`write_checkpoint_state` / :func:`read_checkpoint_state`
-``evaluate.done.json``      :func:`write_evaluate_done` / :func:`read_evaluate_done`
 ``progress.json``           :func:`write_progress` / :func:`read_progress`
 ==========================  =============================================================
 
@@ -41,7 +40,6 @@ __all__ = [
     "SpcpChoice",
     "read_checkpoint_state",
     "read_command",
-    "read_evaluate_done",
     "read_json_object",
     "read_latest",
     "read_progress",
@@ -51,7 +49,6 @@ __all__ = [
     "read_versions",
     "write_checkpoint_state",
     "write_command",
-    "write_evaluate_done",
     "write_latest",
     "write_progress",
     "write_run_config",
@@ -318,26 +315,6 @@ def read_checkpoint_state(path: Path) -> dict[str, Any]:
     if not isinstance(data, dict) or not {"num_timesteps", "next_eval"} <= set(data):
         raise CheckpointError(f"{path}: not a checkpoint state")
     return data
-
-
-# --------------------------------------------------------------------------- pipeline markers
-
-
-def write_evaluate_done(path: Path, inputs: str) -> None:
-    """Write ``evaluate.done.json``: the fingerprint of the inputs the evaluation used."""
-    atomic_write_json(path, {"inputs": inputs})
-
-
-def read_evaluate_done(path: Path) -> str | None:
-    """The fingerprint in ``evaluate.done.json``; None when the file is missing.
-
-    Raises:
-        CheckpointError: The file exists but is unreadable or not a JSON object.
-    """
-    if not path.is_file():
-        return None
-    inputs = read_json_object(path).get("inputs")
-    return inputs if isinstance(inputs, str) else None
 
 
 def write_progress(run_dir: Path, stage: str, **fields: Any) -> None:

@@ -8,10 +8,12 @@ import pytest
 
 from sumo_ayss.errors import ConfigError
 from sumo_ayss.report import write_report
-from sumo_ayss.report.checks import Training, fewest_seeds, read_training, trust_warnings
+from sumo_ayss.report.checks import fewest_seeds, training_status, trust_warnings
 from sumo_ayss.run_folder import (
     RunConfig,
     RunFolder,
+    Training,
+    read_run,
     read_run_config,
     write_eval_table,
     write_run_config,
@@ -55,13 +57,16 @@ def _set_eval(run_dir: Path, returns: list[float], spcp_step: int) -> None:
 def test_spcp_state_from_the_learning_curve(tmp_path: Path) -> None:
     run = make_run(tmp_path, "car_following", "pi1", 0, files=("config", "eval", "spcp"))
     _set_eval(run, [10.0, 12.0, 13.0], 30_000)  # best at the end
-    t = read_training(run)
-    assert t.still_improving and t.status == "may still improve: SPCP is the last candidate"
+    t = read_run(run).training
+    assert t.still_improving
+    assert training_status(t) == "may still improve: SPCP is the last candidate"
     _set_eval(run, [10.0, 13.0, 12.9], 20_000)  # SE = 2 / sqrt(100) = 0.2: 0.5 SE below
-    assert read_training(run).status == "plateau: last candidate within 0.5 SE of the SPCP"
+    t = read_run(run).training
+    assert training_status(t) == "plateau: last candidate within 0.5 SE of the SPCP"
     _set_eval(run, [10.0, 13.0, 11.0], 20_000)  # 10 SE below
-    t = read_training(run)
-    assert not t.still_improving and t.status == "peaked: last candidate 10.0 SE below the SPCP"
+    t = read_run(run).training
+    assert not t.still_improving
+    assert training_status(t) == "peaked: last candidate 10.0 SE below the SPCP"
 
 
 def test_small_budget_report_says_so_first(tmp_path: Path) -> None:
@@ -83,7 +88,7 @@ def test_full_budget_gives_no_budget_warning(tmp_path: Path) -> None:
     run = make_run(tmp_path, "car_following", "pi1", 0, files=("config", "eval", "spcp"))
     _set_budget(run, 100_000)
     _set_eval(run, [10.0, 13.0, 11.0], 20_000)
-    assert trust_warnings([("r", read_training(run))]) == []
+    assert trust_warnings([("r", read_run(run).training)]) == []
 
 
 def test_duplicate_case_vut_seed_is_refused_naming_both(tmp_path: Path) -> None:

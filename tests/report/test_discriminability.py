@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from sumo_ayss.analysis.discriminability import BoxGrid, BoxStates, compare_responses
-from sumo_ayss.discriminability import JSON_NAME, write_outputs
+from sumo_ayss.discriminability import write_outputs
 from sumo_ayss.report import write_report
 from sumo_ayss.report.blocks import FigureBlock, Table
 from sumo_ayss.report.sections.discriminability import (
@@ -16,6 +16,7 @@ from sumo_ayss.report.sections.discriminability import (
     pair_summary,
     read_record,
 )
+from sumo_ayss.run_folder import DISCRIMINABILITY_JSON, CaseFolder
 from tests.report.test_report import FAST, make_run
 
 
@@ -57,7 +58,7 @@ def test_pair_summary_golden() -> None:
 def test_blocks_from_a_record(tmp_path: Path) -> None:
     case_dir = tmp_path / "out" / "car_following"
     write_outputs(_record(), case_dir)
-    rec = read_record(case_dir / JSON_NAME)
+    rec = read_record(CaseFolder(case_dir).discriminability_json)
     assert rec is not None and rec["pairs"][0]["lowest_h_m"] == 3.5
     blocks = discriminability_blocks("car_following", ["pi1", "pi2"], [case_dir], tmp_path / "r")
     figs = [b for b in blocks if isinstance(b, FigureBlock)]
@@ -82,7 +83,7 @@ def test_report_shows_the_section_when_a_record_is_beside_the_runs(tmp_path: Pat
             make_run(root, "car_following", vut, seed, n_samples=60)
     html_path = write_report([root], tmp_path / "r0", options=FAST)
     assert "not computed for these vuts" in html_path.read_text(encoding="utf-8").lower()
-    (root / "car_following" / JSON_NAME).write_text(json.dumps(_record()))
+    (root / "car_following" / DISCRIMINABILITY_JSON).write_text(json.dumps(_record()))
     html_path = write_report([root], tmp_path / "r1", options=FAST)
     html = html_path.read_text(encoding="utf-8")
     assert "(h) Discriminability before training" in html

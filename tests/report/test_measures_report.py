@@ -10,8 +10,15 @@ import numpy as np
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.rank import analyse
 from sumo_ayss.report import write_report
-from sumo_ayss.report.measures import MEASURES_CSV, write_measures
-from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA, Table, read_table, write_table
+from sumo_ayss.report.measures import write_measures
+from sumo_ayss.run_folder import (
+    CROSSPLAY_SCHEMA,
+    MEASURES_CSV,
+    OUTCOME_SCHEMA,
+    Table,
+    read_table,
+    write_table,
+)
 from tests.report.test_report import FAST, make_crossplay, make_run
 
 

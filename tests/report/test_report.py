@@ -22,24 +22,27 @@ from sumo_ayss.modes import headline_text
 from sumo_ayss.modes.crossplay import crossplay_gap_text
 from sumo_ayss.modes.paper import pair_sentence
 from sumo_ayss.report import (
-    RUN_FILES,
     ReportOptions,
-    find_run_dirs,
-    load_run,
     pair_verdict,
     vut_safety_index,
     write_report,
 )
 from sumo_ayss.report.__main__ import main
 from sumo_ayss.run_folder import (
+    AYSS_CSV,
     AYSS_SCHEMA,
     CROSSPLAY_SCHEMA,
+    EVAL_CSV,
+    OUTCOME_JSON,
     OUTCOME_SCHEMA,
     CaseFolder,
     RunConfig,
     RunFolder,
     StageHeader,
     Table,
+    find_run_dirs,
+    load_crossplay,
+    read_run,
     write_eval_table,
     write_outcome_json,
     write_run_config,
@@ -300,8 +303,8 @@ def test_no_ayss_at_all_gives_no_verdict(tmp_path: Path) -> None:
 
 
 def test_same_vut_under_two_seed_sets_is_no_difference(tmp_path: Path) -> None:
-    first = [load_run(make_run(tmp_path, "car_following", "pi1", s)) for s in range(3)]
-    second = [load_run(make_run(tmp_path, "car_following", "pi1_again", s)) for s in (3, 4, 5)]
+    first = [read_run(make_run(tmp_path, "car_following", "pi1", s)) for s in range(3)]
+    second = [read_run(make_run(tmp_path, "car_following", "pi1_again", s)) for s in (3, 4, 5)]
     a = vut_safety_index(first, FAST, rng=1)
     b = vut_safety_index(second, FAST, rng=2)
     assert a is not None and b is not None
@@ -358,8 +361,8 @@ def test_outcome_reader_refuses_shapes_no_writer_produces(tmp_path: Path) -> Non
         "lane_change_rate": 0.98,
         "mean_return": {"value": 20.1, "lo": 19.9, "hi": 20.3},
     }
-    (run_dir / RUN_FILES.outcome).write_text(json.dumps(outcome))
-    run = load_run(run_dir)
+    (run_dir / OUTCOME_JSON).write_text(json.dumps(outcome))
+    run = read_run(run_dir)
     assert run.outcome is None
     text = " | ".join(run.problems)
     assert "outcome.json unreadable" in text and "missing field 'summary'" in text
@@ -369,10 +372,10 @@ def test_outcome_reader_refuses_shapes_no_writer_produces(tmp_path: Path) -> Non
 
 def test_unreadable_files_are_reported_not_fatal(tmp_path: Path) -> None:
     run_dir = make_run(tmp_path, "car_following", "pi1", 0, files=())
-    (run_dir / RUN_FILES.outcome).write_text("{not json")
-    (run_dir / RUN_FILES.ayss).write_text("h_m,indicator,indicator_name\n1.0,-2.0,x\nnan,1,x\n")
-    (run_dir / RUN_FILES.eval_table).write_text("step,other\n1,2\n")
-    run = load_run(run_dir)
+    (run_dir / OUTCOME_JSON).write_text("{not json")
+    (run_dir / AYSS_CSV).write_text("h_m,indicator,indicator_name\n1.0,-2.0,x\nnan,1,x\n")
+    (run_dir / EVAL_CSV).write_text("step,other\n1,2\n")
+    run = read_run(run_dir)
     assert run.case == "car_following" and run.vut == "pi1" and run.seed == 0
     assert run.outcome is None and run.eval_curve is None and run.ayss is None
     text = " | ".join(run.problems)
@@ -383,8 +386,8 @@ def test_unreadable_files_are_reported_not_fatal(tmp_path: Path) -> None:
 
 def test_ayss_of_the_other_case_is_reported(tmp_path: Path) -> None:
     run_dir = make_run(tmp_path, "car_following", "pi1", 0, files=("config",))
-    _write_ayss(run_dir / RUN_FILES.ayss, "cut_in", "pi1", np.random.default_rng(0), 10)
-    run = load_run(run_dir)
+    _write_ayss(run_dir / AYSS_CSV, "cut_in", "pi1", np.random.default_rng(0), 10)
+    run = read_run(run_dir)
     assert run.ayss is not None and len(run.ayss) == 10
     assert any("belongs to cut_in, not car_following" in p for p in run.problems)
 
@@ -468,19 +471,18 @@ def test_crossplay_section_and_headline_from_the_case_table(tmp_path: Path) -> N
 
 def test_crossplay_needs_two_vuts_and_a_table_of_these_runs(tmp_path: Path) -> None:
     from sumo_ayss.analysis.case import analyse_case
-    from sumo_ayss.report.episodes import load_crossplay
     from sumo_ayss.report.load import group_runs
 
     root = tmp_path / "runs"
     dirs = [make_run(root, "cut_in", "pi1", s) for s in range(2)]
-    one = analyse_case("cut_in", group_runs([load_run(d) for d in dirs])["cut_in"], FAST)
+    one = analyse_case("cut_in", group_runs([read_run(d) for d in dirs])["cut_in"], FAST)
     assert one.crossplay_gap == CrossplayGap("one_vut", vut="pi1") and not one.crossplay_rows
     assert "one VUT only (pi1)" in crossplay_gap_text(one.crossplay_gap)
     assert headline_text(one).startswith("[crossplay mode] no cross-play for this case")
     assert one.ranking_mode == "exposure" and one.verdict.kind == "warning"
     dirs += [make_run(root, "cut_in", "pi2", s) for s in range(2)]
     make_crossplay(root / "cut_in", ["pi1", "pi2"], range(3))  # a seed these runs lack
-    runs = group_runs([load_run(d) for d in dirs])["cut_in"]
+    runs = group_runs([read_run(d) for d in dirs])["cut_in"]
     stale = analyse_case("cut_in", runs, FAST, crossplay=load_crossplay(runs))
     assert stale.crossplay_gap is not None and stale.ranking_mode == "exposure"
     assert (stale.crossplay_gap.reason, stale.crossplay_gap.n_runs) == ("not_these_runs", 4)
@@ -493,12 +495,11 @@ def test_crossplay_needs_two_vuts_and_a_table_of_these_runs(tmp_path: Path) -> N
 def test_the_loader_hands_analysis_the_crossplay_table_or_why_there_is_none(tmp_path: Path) -> None:
     """analysis/ reads no file: :func:`load_crossplay` reads the case's crossplay.csv."""
     from sumo_ayss.analysis.case import analyse_case
-    from sumo_ayss.report.episodes import load_crossplay
     from sumo_ayss.report.load import group_runs
 
     root = tmp_path / "runs"
     dirs = [make_run(root, "cut_in", v, s) for v in ("pi1", "pi2") for s in range(2)]
-    runs = group_runs([load_run(d) for d in dirs])["cut_in"]
+    runs = group_runs([read_run(d) for d in dirs])["cut_in"]
     assert load_crossplay(runs).matrix is None and not load_crossplay(runs).missing  # no table
     path = make_crossplay(root / "cut_in", ["pi1", "pi2"], range(2))
     found = load_crossplay(runs)
@@ -512,5 +513,5 @@ def test_the_loader_hands_analysis_the_crossplay_table_or_why_there_is_none(tmp_
     assert a.crossplay_gap == CrossplayGap("not_found", loader=broken.missing)
     assert crossplay_gap_text(a.crossplay_gap) == broken.missing and broken.problem in a.problems
     other = make_run(tmp_path / "elsewhere", "cut_in", "pi2", 5)
-    mixed = group_runs([load_run(d) for d in [*dirs, other]])["cut_in"]
+    mixed = group_runs([read_run(d) for d in [*dirs, other]])["cut_in"]
     assert "several case folders" in load_crossplay(mixed).missing

@@ -15,10 +15,9 @@ from sumo_ayss.analysis.case import analyse_case
 from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.report import write_report
 from sumo_ayss.report.crossplay_figure import crossplay_lines
-from sumo_ayss.report.episodes import load_crossplay
 from sumo_ayss.report.figstyle import set_wrapped_title, style
 from sumo_ayss.report.leaderboard import leaderboard_rows, leaderboard_text
-from sumo_ayss.report.load import load_run
+from sumo_ayss.run_folder import load_crossplay, read_run
 from tests.report.test_report import FAST, make_crossplay, make_run
 
 
@@ -26,7 +25,7 @@ def _runs(root: Path, case: str, vuts: tuple[str, ...], seeds: range) -> dict:
     for vut in vuts:
         for seed in seeds:
             make_run(root, case, vut, seed)
-    return {v: [load_run(root / case / v / f"seed_{s}") for s in seeds] for v in vuts}
+    return {v: [read_run(root / case / v / f"seed_{s}") for s in seeds] for v in vuts}
 
 
 @pytest.fixture(scope="module")

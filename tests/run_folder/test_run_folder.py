@@ -15,8 +15,6 @@ from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.catalog import BUILTIN_VUTS
 from sumo_ayss.config import RewardConfig, to_dict
 from sumo_ayss.errors import CheckpointError, TableError
-from sumo_ayss.report.checks import read_training
-from sumo_ayss.report.load import load_run
 from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     CROSSPLAY_SCHEMA,
@@ -35,11 +33,12 @@ from sumo_ayss.run_folder import (
     read_checkpoint_state,
     read_command,
     read_crossplay_json,
+    read_done_marker,
     read_eval_table,
-    read_evaluate_done,
     read_latest,
     read_outcome_json,
     read_progress,
+    read_run,
     read_run_config,
     read_seeds,
     read_spcp,
@@ -50,8 +49,8 @@ from sumo_ayss.run_folder import (
     write_checkpoint_state,
     write_command,
     write_crossplay_json,
+    write_done_marker,
     write_eval_table,
-    write_evaluate_done,
     write_latest,
     write_outcome_json,
     write_progress,
@@ -150,7 +149,7 @@ def run_folder(tmp_path: Path) -> RunFolder:
     ayss_settings = {"n_samples": 100, "seed": 7}
     summary = {"case": "cut_in", "indicator_name": "delta_v_bar_mps", "counts": {"kept": 5}}
     write_ayss_json(folder.ayss_json, header, ayss_settings, summary)
-    write_evaluate_done(folder.evaluate_done, "abc123")
+    write_done_marker(folder.evaluate_done, "abc123")
     return folder
 
 
@@ -215,13 +214,13 @@ def test_every_file_reads_back_as_written(run_folder: RunFolder) -> None:
     ayss = read_ayss_json(f.ayss_json)
     assert ayss.settings == {"n_samples": 100, "seed": 7}
     assert (ayss.indicator_name, ayss.counts) == ("delta_v_bar_mps", {"kept": 5})
-    assert read_evaluate_done(f.evaluate_done) == "abc123"
+    assert read_done_marker(f.evaluate_done) == "abc123"
 
 
 def test_report_loads_what_the_writers_wrote(run_folder: RunFolder, tmp_path: Path) -> None:
     assert find_run_dirs([tmp_path]) == [run_folder.path.resolve()]
-    run = load_run(run_folder.path)
-    assert run.problems == []
+    run = read_run(run_folder.path)
+    assert run.problems == ()
     assert (run.case, run.vut, run.seed) == ("cut_in", "pi2", 3)
     assert run.reward == RewardConfig() and run.vut_description
     assert run.versions == {"python": "3.11.2", "numpy": "2.0.0"}
@@ -233,7 +232,7 @@ def test_report_loads_what_the_writers_wrote(run_folder: RunFolder, tmp_path: Pa
     assert run.ayss is not None and len(run.ayss) == 5
     assert run.ayss.indicator_name == "delta_v_bar_mps"
     assert run.ayss.h.tolist() == _ayss_table()["h_m"].tolist()
-    training = read_training(run_folder.path)
+    training = run.training
     assert (training.total_timesteps, training.eval_every) == (10000, 5000)
     assert (training.n_candidates, training.spcp_step, training.still_improving) == (
         2,
@@ -301,8 +300,8 @@ def test_crossplay_files_of_a_case_folder_round_trip(tmp_path: Path) -> None:
     )
     write_crossplay_json(folder.crossplay_json, record)
     assert read_crossplay_json(folder.crossplay_json) == record
-    assert record.same_inputs(dataclasses.replace(record, vuts=(), wall_s=0.0))
-    assert not record.same_inputs(dataclasses.replace(record, n=7))
+    assert record.inputs() == dataclasses.replace(record, vuts=(), wall_s=0.0).inputs()
+    assert record.inputs() != dataclasses.replace(record, n=7).inputs()
     folder.crossplay_json.write_text('{"case": "cut_in", "n": 6, "seed": 1, "opponents": [{}]}')
     with pytest.raises(TableError, match=r"crossplay\.json: opponents\[0\]: missing field 'vut'"):
         read_crossplay_json(folder.crossplay_json)

@@ -50,12 +50,12 @@ def test_resume_check_accepts_a_display_change_and_names_a_real_one(tmp_path: Pa
     cfg = ExperimentConfig()
     run = _stored_run(tmp_path, cfg)
     quiet = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, progress_bar=False))
-    check_same_config(run, quiet, 0)  # --no-progress alone: allowed
+    check_same_config(RunFolder(run), quiet, 0)  # --no-progress alone: allowed
     longer = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, total_timesteps=300_000))
     with pytest.raises(CheckpointError, match=r"train\.total_timesteps: 200000 -> 300000"):
-        check_same_config(run, longer, 0)
+        check_same_config(RunFolder(run), longer, 0)
     with pytest.raises(CheckpointError, match=r"seed: 0 -> 1"):
-        check_same_config(run, cfg, 1)
+        check_same_config(RunFolder(run), cfg, 1)
 
 
 @pytest.mark.sumo

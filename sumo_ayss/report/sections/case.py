@@ -18,6 +18,7 @@ from sumo_ayss.modes import get_mode, headline_text
 from sumo_ayss.modes.formatting import fmt_num, ranking_line
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragraph, Table
+from sumo_ayss.report.checks import training_status
 from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.crossplay import crossplay_blocks
 from sumo_ayss.report.sections.discriminability import discriminability_blocks
@@ -109,7 +110,7 @@ def learning_blocks(a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path) -
                     step,
                     score,
                     crit,
-                    run.training.status,
+                    training_status(run.training),
                     display_path(run.path, out_dir),
                 )
             )

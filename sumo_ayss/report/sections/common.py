@@ -12,7 +12,7 @@ from sumo_ayss.analysis.ranking import SafetyIndex
 from sumo_ayss.analysis.seeds import SeedComparison
 from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_prob
 from sumo_ayss.report.blocks import Table
-from sumo_ayss.report.load import Estimate, Run
+from sumo_ayss.run_folder import Estimate, RunRecord
 
 __all__ = [
     "TIMID_NOTE",
@@ -36,7 +36,7 @@ def fmt_est(e: Estimate | None, digits: int = 2, scale: float = 1.0, unit: str =
     return f"{value} ({ci})" if ci else value
 
 
-def seed_points_text(members: Sequence[Run], idx: SafetyIndex) -> str:
+def seed_points_text(members: Sequence[RunRecord], idx: SafetyIndex) -> str:
     """Per-seed indices, labelled by seed when every seed with samples entered the index."""
     seeds = [r.seed for r in members if r.ayss is not None and len(r.ayss) > 0]
     if len(seeds) != len(idx.seed_points):
@@ -44,7 +44,7 @@ def seed_points_text(members: Sequence[Run], idx: SafetyIndex) -> str:
     return ", ".join(f"s{s}: {fmt_num(p)}" for s, p in zip(seeds, idx.seed_points, strict=True))
 
 
-def seeds_text(members: Sequence[Run]) -> str:
+def seeds_text(members: Sequence[RunRecord]) -> str:
     return ", ".join(str(r.seed) if r.seed is not None else "?" for r in members)
 
 

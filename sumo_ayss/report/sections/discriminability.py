@@ -12,7 +12,6 @@ VUT's mean response vs headway.
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 import os
@@ -25,24 +24,17 @@ from matplotlib.figure import Figure
 
 from sumo_ayss.analysis.discriminability import PairDiscriminability
 from sumo_ayss.cases import case_info
+from sumo_ayss.errors import TableError
 from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.report import figstyle
 from sumo_ayss.report.blocks import Block, FigureBlock, Heading, Paragraph, Table
+from sumo_ayss.run_folder import CaseFolder, read_discriminability_json
 
 logger = logging.getLogger(__name__)
 
-__all__ = [
-    "RECORD_NAME",
-    "discriminability_blocks",
-    "discriminability_figure",
-    "pair_summary",
-    "read_record",
-]
+__all__ = ["discriminability_blocks", "discriminability_figure", "pair_summary", "read_record"]
 
 _MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
-
-#: File name of the record, in ``<out>/<case>/`` (the same name the CLI writes).
-RECORD_NAME = "discriminability.json"
 
 
 def pair_summary(
@@ -70,19 +62,15 @@ def pair_summary(
 
 
 def read_record(path: Path) -> dict[str, Any] | None:
-    """The JSON record at ``path``, or None if missing or unreadable (logged)."""
+    """The record at ``path`` (:func:`~sumo_ayss.run_folder.read_discriminability_json`),
+    or None if missing or unreadable (logged)."""
     if not path.is_file():
         return None
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as e:  # ValueError: not JSON or not UTF-8
-        logger.warning("unreadable %s: %s", path, e)
+        return read_discriminability_json(path)
+    except TableError as e:  # names the file
+        logger.warning("%s", e)
         return None
-    needed = {"pairs", "h_edges_m", "v_edges_mps", "vuts", "mean_response_mps2"}
-    if not isinstance(data, dict) or not needed <= set(data):
-        logger.warning("%s lacks %s", path, sorted(needed - set(data or {})))
-        return None
-    return data
 
 
 def _series(values: Sequence[float | None]) -> np.ndarray:
@@ -194,13 +182,13 @@ def discriminability_blocks(
     heading = Heading("(h) Discriminability before training: where the VUTs' responses differ", 3)
     record, where = None, None
     for d in case_dirs:
-        rec = read_record(d / RECORD_NAME)
+        rec = read_record(CaseFolder(d).discriminability_json)
         if (
             rec is not None
             and len(set(rec["vuts"]) & set(vuts)) >= 2
             and rec.get("case", case) == case
         ):
-            record, where = rec, _rel(d / RECORD_NAME, out_dir)
+            record, where = rec, _rel(CaseFolder(d).discriminability_json, out_dir)
             break
     if record is None:
         target = case_dirs[0] if case_dirs else Path(f"<out>/{case}")

@@ -7,14 +7,14 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from sumo_ayss.report.blocks import Block, BulletList, Heading, Paragraph, Table
-from sumo_ayss.report.checks import NOISE_SE, TRUSTED_TIMESTEPS
-from sumo_ayss.report.load import RUN_FILES, Run
+from sumo_ayss.report.checks import NOISE_SE, TRUSTED_TIMESTEPS, training_status
 from sumo_ayss.report.sections.common import display_path, seeds_text
+from sumo_ayss.run_folder import VERSIONS_JSON, RunRecord
 
 __all__ = ["inputs_blocks", "training_table"]
 
 
-def training_table(runs: Sequence[Run]) -> Table:
+def training_table(runs: Sequence[RunRecord]) -> Table:
     rows = []
     for r in runs:
         t = r.training
@@ -27,7 +27,7 @@ def training_table(runs: Sequence[Run]) -> Table:
                 str(t.n_candidates),
                 "?" if t.spcp_step is None else f"{t.spcp_step:,}",
                 "?" if t.last_step is None else f"{t.last_step:,}",
-                t.status,
+                training_status(t),
             )
         )
     return Table(
@@ -56,7 +56,7 @@ def training_table(runs: Sequence[Run]) -> Table:
 
 
 def inputs_blocks(
-    runs: Sequence[Run], groups: Mapping[str, Mapping[str, list[Run]]], out_dir: Path
+    runs: Sequence[RunRecord], groups: Mapping[str, Mapping[str, list[RunRecord]]], out_dir: Path
 ) -> list[Block]:
     blocks: list[Block] = [Heading("Inputs", 2, "inputs")]
     rows = []
@@ -94,11 +94,11 @@ def inputs_blocks(
         )
         blocks.append(
             Table(
-                f"Versions ({RUN_FILES.versions} of {with_versions} of {len(runs)} runs)",
+                f"Versions ({VERSIONS_JSON} of {with_versions} of {len(runs)} runs)",
                 ("package", "version"),
                 v_rows,
             )
         )
     else:
-        blocks.append(Paragraph(f"No run holds a {RUN_FILES.versions}: versions unknown."))
+        blocks.append(Paragraph(f"No run holds a {VERSIONS_JSON}: versions unknown."))
     return blocks

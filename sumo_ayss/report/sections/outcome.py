@@ -21,7 +21,6 @@ from sumo_ayss.report.blocks import (
     Paragraph,
     Table,
 )
-from sumo_ayss.report.load import Outcome
 from sumo_ayss.report.sections.common import (
     TIMID_NOTE,
     crash_cell,
@@ -30,6 +29,7 @@ from sumo_ayss.report.sections.common import (
     pairs_table,
 )
 from sumo_ayss.report.seed_figure import seed_scores_figure
+from sumo_ayss.run_folder import Outcome
 
 __all__ = ["exposure_blocks", "outcome_blocks", "premise_blocks"]
 

@@ -1,0 +1,457 @@
+"""The run record: everything a run folder holds, read once, typed, handed on.
+
+:func:`read_run` reads a run folder ``<out>/<case>/<vut>/seed_<k>/`` through the one reader
+of each file (:mod:`sumo_ayss.run_folder`) into a frozen :class:`RunRecord`. Every stage
+that starts from a run folder takes that record: evaluate and cross-play (the run's
+experiment, seed and SPCP), the report and rank (its tables, reduced to the arrays the
+analysis needs), replay and the scripts. No other module builds its own view of a run.
+
+Reading never raises for a missing or unreadable file: the field stays None and
+:attr:`RunRecord.problems` gets a sentence naming the file, so a report on a run that has
+not been evaluated yet says what is missing. A stage that cannot do without a file asks the
+record for it and gets a :class:`~sumo_ayss.errors.CheckpointError` naming the file
+(:attr:`RunRecord.experiment`).
+
+Imports neither SUMO nor torch; the harm reduction (:mod:`sumo_ayss.analysis.harm`, numpy
+and scipy) is imported when a record is read.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from collections import Counter
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sumo_ayss.cases import case_of_indicator
+from sumo_ayss.config import EnvConfig, ExperimentConfig, RewardConfig, build, experiment_from_dict
+from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
+from sumo_ayss.run_folder.eval_table import read_eval_rows
+from sumo_ayss.run_folder.layout import AYSS_CSV, CONFIG_YAML, EVAL_CSV, RunFolder, seed_of_dir
+from sumo_ayss.run_folder.metadata import RunConfig, SpcpChoice, read_run_config, read_spcp
+from sumo_ayss.run_folder.metadata import read_versions as _read_versions
+from sumo_ayss.run_folder.schemas import AYSS_SCHEMA, OUTCOME_SCHEMA
+from sumo_ayss.run_folder.summaries import Outcome, OutcomeRecord, read_outcome_json
+from sumo_ayss.run_folder.table import Table, read_table
+
+if TYPE_CHECKING:
+    from sumo_ayss.analysis.harm import EpisodeStats, HarmScale
+
+__all__ = [
+    "AyssSamples",
+    "EvalCurve",
+    "RunRecord",
+    "Training",
+    "config_key",
+    "episode_stats",
+    "harm_scale_of",
+    "read_run",
+]
+
+_T = TypeVar("_T")
+
+_IGNORED_KEYS = (("seed",), ("vut",), ("env", "vut"), ("env", "vuts"), ("train", "progress_bar"))
+"""Config entries that may differ between runs pooled in one report: the run's own VUT and
+seed, the VUT catalog (a leaderboard adds VUTs), and display-only settings."""
+
+
+def _empty_f() -> NDArray[np.float64]:
+    return np.empty(0, dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class EvalCurve:
+    """The SPCP-candidate evaluations of one run (``eval.csv``), sorted by step.
+
+    Attributes:
+        step: Training steps of each candidate, shape ``(k,)``.
+        mean_return: Mean evaluation episode reward, shape ``(k,)``.
+        crash_rate: Fraction of evaluation episodes with a collision, shape ``(k,)``.
+        lane_change_rate: Fraction with a lane change, shape ``(k,)`` (0 in car-following).
+        mean_final_headway_m: Mean final headway in m, shape ``(k,)``.
+        n_dropped: Rows skipped because a cell was not a (finite) number.
+    """
+
+    step: NDArray[np.float64] = field(default_factory=_empty_f)
+    mean_return: NDArray[np.float64] = field(default_factory=_empty_f)
+    crash_rate: NDArray[np.float64] = field(default_factory=_empty_f)
+    lane_change_rate: NDArray[np.float64] = field(default_factory=_empty_f)
+    mean_final_headway_m: NDArray[np.float64] = field(default_factory=_empty_f)
+    n_dropped: int = 0
+
+    def __len__(self) -> int:
+        return int(self.step.size)
+
+
+@dataclass(frozen=True)
+class AyssSamples:
+    """The adversarial-yet-safe samples of one SPCP (``ayss.csv``).
+
+    Attributes:
+        h: Distance headway per sample, m, shape ``(n,)``, finite.
+        indicator: Aggressiveness indicator per sample, shape ``(n,)``, finite: POV
+            acceleration in m/s² or Δv̄ in m/s; more negative = more aggressive.
+        indicator_name: The file's ``indicator_name`` (most common value), or None.
+    """
+
+    h: NDArray[np.float64]
+    indicator: NDArray[np.float64]
+    indicator_name: str | None
+
+    def __len__(self) -> int:
+        return int(self.h.size)
+
+
+@dataclass(frozen=True)
+class Training:
+    """A run's training budget and the state of its SPCP at the end of training.
+
+    Attributes:
+        total_timesteps: ``train.total_timesteps`` (transitions), None if unknown.
+        eval_every: ``train.eval_every`` (transitions between candidates), None if unknown.
+        config_key: :func:`config_key` of ``config.yaml``, "" if unknown.
+        n_candidates: Rows of ``eval.csv``.
+        spcp_step: The SPCP's training step, None if unknown.
+        last_step: The last candidate's training step, None if no candidate.
+        gap_se: (SPCP's mean evaluation reward − the last candidate's) / the SPCP's
+            standard error (``std_return / sqrt(n_episodes)``); NaN if unknown.
+        still_improving: True when the SPCP is the last candidate; None when unknown.
+    """
+
+    total_timesteps: int | None = None
+    eval_every: int | None = None
+    config_key: str = ""
+    n_candidates: int = 0
+    spcp_step: int | None = None
+    last_step: int | None = None
+    gap_se: float = math.nan
+    still_improving: bool | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class RunRecord:
+    """One run folder, read once (:func:`read_run`); a field is None when its file is
+    missing or unreadable, and :attr:`problems` says which.
+
+    Attributes:
+        folder: The run folder's paths.
+        case: The case name (``config.yaml``'s ``env.case``, else from the folder path).
+        vut: VUT name (``config.yaml``, else the folder path).
+        seed: Training seed (also the run's SUMO seed), or None if unknown.
+        config: ``config.yaml`` as stored, or None.
+        vut_description: The VUT's description from the catalog in ``config.yaml``.
+        reward: The run's reward configuration, or None.
+        harm_scale: The constants that turn this run's episodes into harm (from the reward
+            and the episode length in ``config.yaml``), or None.
+        eval_curve: The candidate evaluations (``eval.csv``), or None.
+        spcp: The selected SPCP (``spcp.json``), or None.
+        outcome_record: The outcome summary with its settings (``outcome.json``), or None.
+        outcome_table: The outcome episodes (``outcome.csv``), or None.
+        episodes: The outcome episodes reduced to harm, crashes and mobility, or None.
+        ayss: The AYSS samples (``ayss.csv``), or None.
+        versions: Package versions the run used (``versions.json``), or empty.
+        training: Training budget and SPCP state (from ``config.yaml``, ``eval.csv`` and
+            ``spcp.json``).
+        problems: One sentence per missing or unreadable file, each starting with the
+            file's name.
+    """
+
+    folder: RunFolder
+    case: str
+    vut: str
+    seed: int | None
+    config: RunConfig | None = None
+    vut_description: str = ""
+    reward: RewardConfig | None = None
+    harm_scale: HarmScale | None = None
+    eval_curve: EvalCurve | None = None
+    spcp: SpcpChoice | None = None
+    outcome_record: OutcomeRecord | None = None
+    outcome_table: Table | None = None
+    episodes: EpisodeStats | None = None
+    ayss: AyssSamples | None = None
+    versions: Mapping[str, str] = field(default_factory=dict)
+    training: Training = field(default_factory=Training)
+    problems: tuple[str, ...] = ()
+
+    @property
+    def path(self) -> Path:
+        """The run folder."""
+        return self.folder.path
+
+    @property
+    def outcome(self) -> Outcome | None:
+        """The outcome summary (``outcome.json``), or None."""
+        return self.outcome_record.outcome if self.outcome_record is not None else None
+
+    @property
+    def label(self) -> str:
+        """``"pi1 seed 0"``."""
+        return f"{self.vut} seed {self.seed if self.seed is not None else '?'}"
+
+    @cached_property
+    def experiment(self) -> ExperimentConfig:
+        """The run's experiment, rebuilt from ``config.yaml`` (its ``env.vut`` is the run's
+        VUT); for the stages that run the SPCP. Builds no env and imports no user
+        controller (that happens inside ``controller_imports``, when an env is built).
+
+        Raises:
+            CheckpointError: If ``config.yaml`` is missing, unreadable or not a valid
+                experiment; the message names the file.
+        """
+        config = self._stored_config()
+        try:
+            return experiment_from_dict(config.experiment, self.path)
+        except ConfigError as exc:
+            raise CheckpointError(
+                f"{self.folder.config}: invalid run configuration: {exc}"
+            ) from exc
+
+    @property
+    def config_seed(self) -> int:
+        """The training seed in ``config.yaml`` (also the run's SUMO seed).
+
+        Raises:
+            CheckpointError: As :attr:`experiment`, without a readable ``config.yaml``.
+        """
+        return self._stored_config().seed
+
+    def _stored_config(self) -> RunConfig:
+        """:attr:`config`, or the reason there is none as a :class:`CheckpointError`."""
+        if self.config is not None:
+            return self.config
+        if not self.folder.config.is_file():
+            raise CheckpointError(f"{self.path}: not a run folder (no {CONFIG_YAML})")
+        return read_run_config(self.folder.config)  # raises the reader's own message
+
+
+# --------------------------------------------------------------------------- derived views
+
+
+def config_key(config: Mapping[str, Any]) -> str:
+    """A short hash of a resolved ``config.yaml`` without the VUT, seed and catalog."""
+    data = json.loads(json.dumps(config, default=str))
+    for key in _IGNORED_KEYS:
+        node: Any = data
+        for part in key[:-1]:
+            node = node.get(part) if isinstance(node, Mapping) else None
+        if isinstance(node, dict):
+            node.pop(key[-1], None)
+    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:12]
+
+
+def harm_scale_of(reward: RewardConfig, env: Mapping[str, Any]) -> HarmScale:
+    """The harm scale of a run: ``alpha_A ·`` decisions per episode, and ``alpha_C``
+    (decisions = ``env.episode_s / env.decision_period_s``, the env's defaults if unset)."""
+    from sumo_ayss.analysis.harm import HarmScale
+
+    episode_s = float(env.get("episode_s", EnvConfig.episode_s))
+    period_s = float(env.get("decision_period_s", EnvConfig.decision_period_s))
+    decisions = round(episode_s / period_s)
+    return HarmScale(reward.alpha_adversarial * decisions, reward.alpha_collision)
+
+
+def episode_stats(table: Table, scale: HarmScale) -> EpisodeStats:
+    """An outcome table reduced to harm, crashes and mobility (:mod:`~sumo_ayss.analysis.
+    harm`; a table written before ``near_miss_pay`` existed derives it from the return)."""
+    from sumo_ayss.analysis.harm import EpisodeStats, episode_harm
+
+    c = table.columns
+    pay = scale.near_miss_pay(c["near_miss_pay"], c["episode_return"], c["collided"])
+    harm = episode_harm(pay, c["collided"], scale.max_episode_pay)
+    return EpisodeStats.of(harm, c["collided"], c["vut_mean_speed_mps"])
+
+
+def _int_or_none(value: Any) -> int | None:
+    return int(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
+
+
+def _training(
+    config: RunConfig | None, rows: Sequence[Mapping[str, Any]], spcp_step: int | None
+) -> Training:
+    """The :class:`Training` of a run from its config, its ``eval.csv`` rows sorted by step
+    and its SPCP's step."""
+    total = every = None
+    key = ""
+    if config is not None:
+        train = config.experiment.get("train") or {}
+        if isinstance(train, Mapping):
+            total = _int_or_none(train.get("total_timesteps"))
+            every = _int_or_none(train.get("eval_every"))
+        key = config_key(config.as_dict())
+    if not rows or spcp_step is None:
+        return Training(total, every, key, len(rows), spcp_step)
+    last = rows[-1]
+    spcp = next((r for r in rows if int(r["step"]) == spcp_step), None)
+    gap = math.nan
+    if spcp is not None:
+        se = spcp["std_return"] / math.sqrt(spcp["n_episodes"]) if spcp["n_episodes"] > 0 else 0
+        diff = spcp["mean_return"] - last["mean_return"]
+        gap = diff / se if se > 0 else (0.0 if diff == 0 else math.inf)
+    improving = int(last["step"]) == spcp_step
+    return Training(total, every, key, len(rows), spcp_step, int(last["step"]), gap, improving)
+
+
+def _eval_curve(rows: Sequence[Mapping[str, Any]], n_dropped: int) -> EvalCurve:
+    def col(name: str) -> NDArray[np.float64]:
+        return np.array([r[name] for r in rows], dtype=np.float64)
+
+    return EvalCurve(
+        step=col("step"),
+        mean_return=col("mean_return"),
+        crash_rate=col("crash_rate"),
+        lane_change_rate=col("lane_change_rate"),
+        mean_final_headway_m=col("mean_final_headway_m"),
+        n_dropped=n_dropped,
+    )
+
+
+def _ayss_samples(path: Path) -> AyssSamples:
+    table = read_table(path, AYSS_SCHEMA)
+    names = Counter(str(n) for n in table["indicator_name"])
+    return AyssSamples(
+        h=np.asarray(table["h_m"], dtype=np.float64),
+        indicator=np.asarray(table["indicator"], dtype=np.float64),
+        indicator_name=names.most_common(1)[0][0] if names else None,
+    )
+
+
+def _vut_description(env: Mapping[str, Any], vut: str) -> str:
+    vuts = env.get("vuts")
+    entry = vuts.get(vut) if isinstance(vuts, Mapping) else None
+    if not isinstance(entry, Mapping):
+        return ""
+    if entry.get("description"):
+        return str(entry["description"])
+    params = entry.get("params") or {}
+    shown = ", ".join(f"{k}={v}" for k, v in sorted(params.items()) if k in ("minGap", "tau"))
+    return f"{entry.get('model', '?')}" + (f" ({shown})" if shown else "")
+
+
+# --------------------------------------------------------------------------- reading
+
+
+class _Reader:
+    """Reads a run's files, collecting a sentence for each that could not be read."""
+
+    def __init__(self) -> None:
+        self.problems: list[str] = []
+
+    def attempt(
+        self, file: Path, reader: Callable[[Path], _T], *, needed: bool = True
+    ) -> _T | None:
+        """``reader(file)``; None and a sentence when the file is missing (if ``needed``)
+        or unreadable."""
+        if not file.is_file():
+            if needed:
+                self.problems.append(f"{file.name} missing")
+            return None
+        try:
+            return reader(file)
+        except (AyssError, OSError, ValueError) as exc:
+            self.problems.append(f"{file.name} unreadable ({exc})")
+            return None
+
+
+def read_run(path: str | Path) -> RunRecord:
+    """Read one run folder; never raises for missing or unreadable files.
+
+    Args:
+        path: The run folder ``<out>/<case>/<vut>/seed_<k>/``.
+
+    Returns:
+        The :class:`RunRecord`; each file that is missing or cannot be parsed leaves its
+        field None and adds a sentence to :attr:`RunRecord.problems`.
+    """
+    folder = RunFolder(Path(path).resolve())
+    run_dir = folder.path
+    r = _Reader()
+    case, vut, seed = (
+        run_dir.parent.parent.name or "unknown",
+        run_dir.parent.name or "unknown",
+        seed_of_dir(run_dir),
+    )
+    config = description = reward = scale = None
+    if not folder.config.is_file():
+        r.problems.append(f"{CONFIG_YAML} missing (case, VUT and seed taken from the folder path)")
+    else:
+        try:
+            config = read_run_config(folder.config)
+        except AyssError as exc:
+            r.problems.append(f"{CONFIG_YAML} unreadable ({exc})")
+    if config is not None:
+        env = config.experiment["env"]  # a mapping: read_run_config checks it
+        case, vut, seed = str(env.get("case", case)), config.vut, config.seed
+        description = _vut_description(env, vut)
+        try:
+            # Only the reward section is rebuilt: a report does not need the experiment.
+            reward = build(RewardConfig, env.get("reward") or {}, "env.reward", run_dir)
+        except (ConfigError, TypeError) as exc:
+            r.problems.append(f"{CONFIG_YAML}: reward section invalid ({exc})")
+        else:
+            try:
+                scale = harm_scale_of(reward, env)
+            except (ConfigError, TypeError, ValueError) as exc:
+                r.problems.append(f"{CONFIG_YAML}: episode timing invalid ({exc})")
+
+    rows_read = r.attempt(folder.eval_table, lambda p: read_eval_rows(p, skip_bad_rows=True))
+    rows, n_dropped = rows_read if rows_read is not None else ([], 0)
+    rows.sort(key=lambda row: row["step"])
+    curve = _eval_curve(rows, n_dropped) if rows_read is not None else None
+    if n_dropped:
+        r.problems.append(
+            f"{EVAL_CSV}: {n_dropped} candidate row(s) without a finite step or mean_return dropped"
+        )
+    spcp = r.attempt(folder.spcp_json, read_spcp)
+    outcome_record = r.attempt(folder.outcome_json, read_outcome_json)
+    # outcome.csv is the exposure mode's input: its absence is a problem only where the
+    # run could be scored (a harm scale).
+    table = r.attempt(
+        folder.outcome_csv, lambda p: read_table(p, OUTCOME_SCHEMA), needed=scale is not None
+    )
+    episodes = None
+    if table is not None and scale is not None:
+        try:
+            episodes = episode_stats(table, scale)
+        except (AyssError, ValueError) as exc:
+            r.problems.append(f"{folder.outcome_csv.name} unreadable ({exc})")
+    ayss = r.attempt(folder.ayss_csv, _ayss_samples)
+    versions = r.attempt(folder.versions, _read_versions, needed=False)  # optional
+    if curve is not None and len(curve) == 0 and not n_dropped:
+        r.problems.append(f"{EVAL_CSV}: no rows (header only), so no learning curve")
+    if ayss is not None and len(ayss) == 0:
+        r.problems.append(f"{AYSS_CSV}: no rows (header only), so no AYSS sample")
+    if ayss is not None and ayss.indicator_name is not None:
+        expected_case = case_of_indicator(ayss.indicator_name)
+        if expected_case is not None and expected_case != case:
+            r.problems.append(
+                f"{AYSS_CSV}: indicator {ayss.indicator_name!r} belongs to {expected_case}, "
+                f"not {case}"
+            )
+    return RunRecord(
+        folder=folder,
+        case=case,
+        vut=vut,
+        seed=seed,
+        config=config,
+        vut_description=description or "",
+        reward=reward,
+        harm_scale=scale,
+        eval_curve=curve,
+        spcp=spcp,
+        outcome_record=outcome_record,
+        outcome_table=table,
+        episodes=episodes,
+        ayss=ayss,
+        versions=versions or {},
+        training=_training(config, rows, spcp.step if spcp is not None else None),
+        problems=tuple(r.problems),
+    )

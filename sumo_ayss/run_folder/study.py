@@ -1,0 +1,328 @@
+"""The study folder: the files a pipeline or ``rank`` writes beside the case folders.
+
+A study folder ``<out>/`` (a pipeline's ``out``) holds the case folders
+``<out>/<case>/`` (:class:`~.layout.CaseFolder`: cross-play, discriminability) and these
+files, each with one writer and one reader here:
+
+======================  ================================  ====================================
+file                    writer / reader                   what
+======================  ================================  ====================================
+``pipeline.json``       write_/read_pipeline_json         the resolved pipeline configuration
+``ranking.csv``         write_/read_ranking_csv           one row per (case, mode, VUT)
+                        (:data:`RANKING_COLUMNS`)
+``ranking.md``          (``rank``'s own words)            the same rows as a Markdown table
+``order_check.json``    write_/read_order_check           the ranking against a known order
+``measures.csv``        write_/read_measures_csv          one row per (case, measure, VUT)
+                        (:data:`MEASURES_COLUMNS`)
+``report/``             (the report)                      ``report.html``, ``summary.md``
+======================  ================================  ====================================
+
+Every file is written atomically. The CSV readers return the cells as written (strings):
+a script that writes a file back (``scripts/keep_paper_rows.py``) keeps every digit.
+Imports neither SUMO nor torch.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from sumo_ayss.atomic import atomic_write_json
+from sumo_ayss.errors import TableError
+from sumo_ayss.run_folder.csvio import read_csv_rows, write_csv_rows
+from sumo_ayss.run_folder.jsonio import read_json
+from sumo_ayss.run_folder.layout import CaseFolder, case_dir_for
+
+__all__ = [
+    "MEASURES_COLUMNS",
+    "MEASURES_CSV",
+    "ORDER_CHECK_JSON",
+    "PIPELINE_JSON",
+    "RANKING_COLUMNS",
+    "RANKING_CSV",
+    "RANKING_MD",
+    "REPORT_DIR",
+    "OrderCheck",
+    "OrderChecks",
+    "StudyFolder",
+    "read_measures_csv",
+    "read_order_check",
+    "read_pipeline_json",
+    "read_ranking_csv",
+    "write_measures_csv",
+    "write_order_check",
+    "write_pipeline_json",
+    "write_ranking_csv",
+]
+
+PIPELINE_JSON = "pipeline.json"
+"""The resolved pipeline configuration (paths relative to the study folder)."""
+RANKING_CSV = "ranking.csv"
+"""One row per (case, mode, VUT), safest first (:data:`RANKING_COLUMNS`)."""
+RANKING_MD = "ranking.md"
+"""The ranking as a Markdown table, with the known-order check in words."""
+ORDER_CHECK_JSON = "order_check.json"
+"""Per (case, mode), the ranking against a known order (:class:`OrderCheck`)."""
+MEASURES_CSV = "measures.csv"
+"""One row per (case, measure, VUT): the safety measures (:data:`MEASURES_COLUMNS`)."""
+REPORT_DIR = "report"
+"""The HTML and Markdown report."""
+
+RANKING_COLUMNS = (
+    "case",
+    "mode",
+    "rank",
+    "vut",
+    "score",
+    "lo",
+    "hi",
+    "n_seeds",
+    "unit",
+    "p_vs_next",
+    "significant_vs_next",
+    "vs_next",
+    "crash_rate",
+    "crash_lo",
+    "crash_hi",
+    "crashes",
+    "episodes",
+    "mobility_mps",
+    "timid",
+)
+"""``ranking.csv``'s columns. ``score``: harm per episode in cross-play and exposure mode
+(:mod:`sumo_ayss.analysis.harm`, lower = safer), the AYSS safety index in paper mode (higher
+= safer); ``lo``/``hi`` its interval, ``n_seeds`` the seeds or blocks behind it;
+``p_vs_next``, ``significant_vs_next`` and ``vs_next`` (a sentence) compare the VUT with the
+next one. ``crash_rate`` with its Wilson interval ``crash_lo``/``crash_hi`` (fractions),
+``crashes`` of ``episodes``, ``mobility_mps`` (mean VUT speed, m/s) and ``timid`` (mobility
+below 80 % of the median VUT's) describe the same episodes as the score; empty in paper
+mode."""
+
+_RANKING_ADDED = RANKING_COLUMNS[RANKING_COLUMNS.index("crash_rate") :]
+"""The columns a ``ranking.csv`` written before crashes and mobility were recorded lacks."""
+
+MEASURES_COLUMNS = (
+    "case",
+    "pool",
+    "measure",
+    "unit",
+    "higher_is_safer",
+    "vut",
+    "rank",
+    "median",
+    "lo",
+    "hi",
+    "p10",
+    "p90",
+    "share_inf",
+    "n",
+    "n_total",
+    "primary_mode",
+    "primary_rank",
+    "tau_vs_primary",
+)
+"""``measures.csv``'s columns: per (case, measure, VUT) the median with its interval
+(``lo``, ``hi``), the 10th and 90th percentiles, the share of infinite values, ``n`` finite
+of ``n_total`` values, the VUT's ``rank`` by that measure alone, its ``primary_rank`` in the
+``primary_mode``'s ranking and Kendall's τ between the two orders (``tau_vs_primary``);
+``pool`` is ``cross-play`` or ``own SPCPs``; units as in ``unit``."""
+
+
+@dataclass(frozen=True)
+class StudyFolder:
+    """The paths of a study folder's own files.
+
+    Attributes:
+        path: The study folder ``<out>/`` (a pipeline's ``out``).
+    """
+
+    path: Path
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "path", Path(self.path))
+
+    @property
+    def pipeline_json(self) -> Path:
+        """``pipeline.json``."""
+        return self.path / PIPELINE_JSON
+
+    @property
+    def ranking_csv(self) -> Path:
+        """``ranking.csv``."""
+        return self.path / RANKING_CSV
+
+    @property
+    def ranking_md(self) -> Path:
+        """``ranking.md``."""
+        return self.path / RANKING_MD
+
+    @property
+    def order_check_json(self) -> Path:
+        """``order_check.json``."""
+        return self.path / ORDER_CHECK_JSON
+
+    @property
+    def measures_csv(self) -> Path:
+        """``measures.csv``."""
+        return self.path / MEASURES_CSV
+
+    @property
+    def report_dir(self) -> Path:
+        """``report/``."""
+        return self.path / REPORT_DIR
+
+    def case(self, case: str) -> CaseFolder:
+        """The case folder ``<out>/<case>/``."""
+        return CaseFolder(case_dir_for(self.path, case))
+
+
+# --------------------------------------------------------------------------- pipeline.json
+
+
+def write_pipeline_json(path: Path, config: Mapping[str, Any]) -> None:
+    """Write ``pipeline.json``: the resolved pipeline configuration as a JSON object."""
+    atomic_write_json(path, dict(config))
+
+
+def read_pipeline_json(path: Path) -> dict[str, Any]:
+    """Read ``pipeline.json``.
+
+    Raises:
+        TableError: The file is missing, not JSON or not an object (naming the file).
+    """
+    return read_json(path)
+
+
+# --------------------------------------------------------------------------- CSV tables
+
+
+def write_ranking_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
+    """Write ``ranking.csv`` (:data:`RANKING_COLUMNS`; a missing cell is written empty)."""
+    write_csv_rows(path, RANKING_COLUMNS, rows)
+
+
+def read_ranking_csv(path: Path) -> list[dict[str, str]]:
+    """Read ``ranking.csv``: one ``{column: cell}`` per row of :data:`RANKING_COLUMNS`,
+    cells as written. A file written before the crash and mobility columns existed (e.g.
+    ``results/sensitivity_actuator``) has them empty.
+
+    Raises:
+        TableError: The file is missing or unreadable, lacks a column of
+            :data:`RANKING_COLUMNS` up to ``vs_next``, or has a short row (naming the file
+            and the line).
+    """
+    return read_csv_rows(path, RANKING_COLUMNS, optional=_RANKING_ADDED)
+
+
+def write_measures_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
+    """Write ``measures.csv`` (:data:`MEASURES_COLUMNS`)."""
+    write_csv_rows(path, MEASURES_COLUMNS, rows)
+
+
+def read_measures_csv(path: Path) -> list[dict[str, str]]:
+    """Read ``measures.csv``: one ``{column: cell}`` per row, cells as written.
+
+    Raises:
+        TableError: As :func:`read_ranking_csv`, for :data:`MEASURES_COLUMNS`.
+    """
+    return read_csv_rows(path, MEASURES_COLUMNS)
+
+
+# --------------------------------------------------------------------------- order_check.json
+
+
+@dataclass(frozen=True)
+class OrderCheck:
+    """One case's ranking in one mode against a known order (safest first).
+
+    Attributes:
+        case: The case.
+        mode: The ranking mode.
+        order: The ranking, safest first.
+        expected: The known order, safest first.
+        tau: Kendall's τ of ``order`` against ``expected``, in [-1, 1].
+        ends_significant: Whether the expected safest and least safe VUT differ
+            significantly, in the right direction.
+        ends_p: The p-value of that test.
+        significant_adjacent: Adjacent pairs of the ranking that differ significantly.
+        adjacent: Adjacent pairs of the ranking.
+    """
+
+    case: str
+    mode: str
+    order: tuple[str, ...]
+    expected: tuple[str, ...]
+    tau: float
+    ends_significant: bool
+    ends_p: float
+    significant_adjacent: int
+    adjacent: int
+
+
+@dataclass(frozen=True)
+class OrderChecks:
+    """``order_check.json``: the known order and every (case, mode) checked against it."""
+
+    expected: tuple[str, ...]
+    cases: tuple[OrderCheck, ...]
+
+
+_CHECK_KINDS: dict[str, type | tuple[type, ...]] = {
+    "case": str,
+    "mode": str,
+    "order": list,
+    "expected": list,
+    "tau": (int, float),
+    "ends_significant": bool,
+    "ends_p": (int, float),
+    "significant_adjacent": int,
+    "adjacent": int,
+}
+
+
+def write_order_check(path: Path, checks: OrderChecks) -> None:
+    """Write ``order_check.json``."""
+    cases = []
+    for c in checks.cases:
+        data = dataclasses.asdict(c)
+        data["order"], data["expected"] = list(c.order), list(c.expected)
+        cases.append(data)
+    atomic_write_json(path, {"expected": list(checks.expected), "cases": cases})
+
+
+def _names(value: Any, where: str) -> tuple[str, ...]:
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise TableError(f"{where}: expected a list of VUT names, got {value!r}")
+    return tuple(value)
+
+
+def read_order_check(path: Path) -> OrderChecks:
+    """Read ``order_check.json``.
+
+    Raises:
+        TableError: The file is missing, not a JSON object, or a field is missing or of the
+            wrong type; the message names the file and the field.
+    """
+    data = read_json(path)
+    expected = _names(data.get("expected"), f"{path}: expected")
+    items = data.get("cases")
+    if not isinstance(items, list):
+        raise TableError(f"{path}: cases: expected a list, got {items!r}")
+    cases = []
+    for i, item in enumerate(items):
+        at = f"{path}: cases[{i}]"
+        if not isinstance(item, Mapping):
+            raise TableError(f"{at}: expected an object, got {item!r}")
+        for key, kind in _CHECK_KINDS.items():
+            value = item.get(key)
+            wrong_bool = isinstance(value, bool) and kind is not bool
+            if key not in item or wrong_bool or not isinstance(value, kind):
+                raise TableError(f"{at}: {key}: missing or of the wrong type, got {value!r}")
+        fields = {k: item[k] for k in _CHECK_KINDS}
+        fields["order"] = _names(item["order"], f"{at}: order")
+        fields["expected"] = _names(item["expected"], f"{at}: expected")
+        cases.append(OrderCheck(**fields))
+    return OrderChecks(expected, tuple(cases))

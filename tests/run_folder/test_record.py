@@ -1,0 +1,52 @@
+"""The run record: every file of a run folder read once into one frozen record; what a
+stage cannot do without is asked for and refused naming the file."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import pytest
+
+from sumo_ayss.errors import CheckpointError
+from sumo_ayss.run_folder import OUTCOME_CSV, RunRecord, read_run
+from tests.report.test_report import make_run
+
+
+def test_a_complete_run_is_read_into_one_frozen_record(tmp_path: Path) -> None:
+    run = read_run(make_run(tmp_path, "car_following", "pi2", 4))
+    assert isinstance(run, RunRecord) and run.problems == ()
+    assert (run.case, run.vut, run.seed, run.label) == ("car_following", "pi2", 4, "pi2 seed 4")
+    assert run.path == (tmp_path / "car_following" / "pi2" / "seed_4").resolve()
+    assert run.outcome_table is not None and run.episodes is not None
+    assert run.episodes.n == len(run.outcome_table)
+    assert run.outcome is not None and run.outcome_record is not None
+    assert run.harm_scale is not None and run.training.n_candidates == len(run.eval_curve or ())
+    assert run.experiment.env.vut == "pi2" and run.experiment.agent.gamma == 0.8
+    assert run.config_seed == 4
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        run.seed = 5  # type: ignore[misc]
+
+
+def test_missing_files_are_problems_and_the_stages_get_an_error(tmp_path: Path) -> None:
+    bare = tmp_path / "cut_in" / "pi1" / "seed_0"
+    bare.mkdir(parents=True)
+    run = read_run(bare)
+    assert (run.case, run.vut, run.seed) == ("cut_in", "pi1", 0)  # from the folder path
+    assert run.problems[0].startswith("config.yaml missing")
+    assert not any(p.startswith(OUTCOME_CSV) for p in run.problems)  # no harm scale to use
+    with pytest.raises(CheckpointError, match=r"seed_0: not a run folder \(no config\.yaml\)"):
+        run.experiment  # noqa: B018
+    with pytest.raises(CheckpointError, match="not a run folder"):
+        run.config_seed  # noqa: B018
+    (bare / "config.yaml").write_text("seed: 0\nenv: {case: cut_in, vut: pi1}\nagent: {gamma: 7}\n")
+    run = read_run(bare)
+    assert run.config is not None and run.seed == 0
+    assert f"{OUTCOME_CSV} missing" in run.problems  # scorable now, so its absence counts
+    with pytest.raises(CheckpointError, match=r"config\.yaml: invalid run configuration: .*gamma"):
+        run.experiment  # noqa: B018
+    (bare / "config.yaml").write_text("seed: [\n")
+    run = read_run(bare)
+    assert run.config is None and run.problems[0].startswith("config.yaml unreadable")
+    with pytest.raises(CheckpointError, match=r"config\.yaml: unreadable run configuration"):
+        run.experiment  # noqa: B018
