@@ -17,11 +17,11 @@ import time
 
 import numpy as np
 
-from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE
 from sumo_ayss.config import SimConfig
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.sim.network import network_path
 from sumo_ayss.sim.session import SumoSession
+from sumo_ayss.vuts.catalog import BUILTIN_VUTS, POV_TYPE
 
 
 def bench_env(env_cls: type, steps: int) -> float:

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import yaml
 
-from sumo_ayss.vtype_params import MODEL_PARAMS
+from sumo_ayss.vuts.vtype_params import MODEL_PARAMS
 
 STAGES = ("grid", "cross-play", "analysis + report", "ranking")
 

@@ -34,10 +34,10 @@ from pathlib import Path
 
 import yaml
 
-from sumo_ayss.atomic import atomic_write_text
 from sumo_ayss.config.budget import BUDGETS
-from sumo_ayss.paths import PROJECT_ROOT
 from sumo_ayss.run_folder import OrderCheck, StudyFolder, read_adaptive, read_order_check
+from sumo_ayss.util.atomic import atomic_write_text
+from sumo_ayss.util.paths import PROJECT_ROOT
 
 
 def _children_cpu_s() -> float:

@@ -1,6 +1,6 @@
 """A worked example of a user controller as the VUT: ACC with a constant time-gap policy.
 
-The controller follows the protocol of :mod:`sumo_ayss.controllers`: it is built from
+The controller follows the protocol of :mod:`sumo_ayss.vuts.controllers`: it is built from
 keyword arguments, sees only its own speed, the gap and relative speed to its leader, its
 lane and the clock, and returns an acceleration [m/s²] (> 0 forward, < 0 braking).
 
@@ -37,7 +37,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from sumo_ayss.controllers import ControllerInput
+from sumo_ayss.vuts.controllers import ControllerInput
 
 
 @dataclass

@@ -35,7 +35,7 @@ import numpy as np
 
 from sumo_ayss.analysis.seeds import SeedScores, compare_seeds, kendall_tau
 from sumo_ayss.analysis.sequential import looks_of, settle_check
-from sumo_ayss.paths import PROJECT_ROOT
+from sumo_ayss.util.paths import PROJECT_ROOT
 
 LOOKS = looks_of(4, 6)
 

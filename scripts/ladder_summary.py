@@ -29,7 +29,6 @@ import matplotlib as mpl
 mpl.use("Agg")
 from matplotlib.figure import Figure
 
-from sumo_ayss.atomic import atomic_write_text
 from sumo_ayss.report.load import group_runs
 from sumo_ayss.run_folder import (
     StudyFolder,
@@ -38,6 +37,7 @@ from sumo_ayss.run_folder import (
     read_ranking_csv,
     read_run,
 )
+from sumo_ayss.util.atomic import atomic_write_text
 
 
 def _runs(study: Path, case: str) -> dict[str, list]:

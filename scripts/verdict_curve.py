@@ -54,8 +54,6 @@ import numpy as np
 from sumo_ayss.analysis.crossplay import crossplay_matrix, rank_crossplay
 from sumo_ayss.analysis.harm import episode_harm
 from sumo_ayss.analysis.seeds import kendall_tau
-from sumo_ayss.atomic import atomic_write_text
-from sumo_ayss.paths import PROJECT_ROOT, portable_path
 from sumo_ayss.run_folder import (
     MODEL_ZIP,
     RunFolder,
@@ -65,6 +63,8 @@ from sumo_ayss.run_folder import (
     read_order_check,
     read_run,
 )
+from sumo_ayss.util.atomic import atomic_write_text
+from sumo_ayss.util.paths import PROJECT_ROOT, portable_path
 
 CELL_COLUMNS = (
     "vut",
@@ -88,7 +88,7 @@ BUDGET_STEP = 10_000
 
 def spcp_steps(run: RunRecord) -> dict[int, int]:
     """Budget B -> step of the candidate the run selects among those at steps <= B."""
-    from sumo_ayss.selection import select_spcp
+    from sumo_ayss.training.selection import select_spcp
 
     criterion = run.experiment.train.selection
     rows = read_eval_rows(run.folder.eval_table)[0]

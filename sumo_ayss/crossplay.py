@@ -33,9 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.analysis.crossplay import BLOCKS
-from sumo_ayss.catalog import controller_imports
 from sumo_ayss.cli import prog
-from sumo_ayss.errors import AyssError, CheckpointError, TableError
 from sumo_ayss.run_folder import (
     CROSSPLAY_SCHEMA,
     OUTCOME_SCHEMA,
@@ -57,6 +55,8 @@ from sumo_ayss.run_folder import (
     write_crossplay_json,
     write_table,
 )
+from sumo_ayss.util.errors import AyssError, CheckpointError, TableError
+from sumo_ayss.vuts.catalog import controller_imports
 
 logger = logging.getLogger(__name__)
 

@@ -49,7 +49,6 @@ from sumo_ayss.config import (
     load_pipeline,
     read_yaml,
 )
-from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.run_folder import (
     CaseFolder,
     DiscriminabilityStage,
@@ -57,6 +56,7 @@ from sumo_ayss.run_folder import (
     read_discriminability_json,
     write_discriminability,
 )
+from sumo_ayss.util.errors import AyssError, ConfigError
 
 logger = logging.getLogger(__name__)
 

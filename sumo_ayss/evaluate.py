@@ -33,13 +33,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.catalog import controller_imports
 from sumo_ayss.cli import prog
 from sumo_ayss.config import DEFAULT_AYSS_SEED, AyssConfig, to_dict
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.errors import AyssError, CheckpointError
-from sumo_ayss.paths import portable_path
+from sumo_ayss.grid.threads import set_torch_threads
 from sumo_ayss.run_folder import (
     AyssStage,
     OutcomeStage,
@@ -54,7 +52,9 @@ from sumo_ayss.run_folder import (
 from sumo_ayss.scenarios.ayss import run_ayss
 from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_N, DEFAULT_OUTCOME_SEED, run_outcome
 from sumo_ayss.scenarios.rollout import Policy
-from sumo_ayss.threads import set_torch_threads
+from sumo_ayss.util.errors import AyssError, CheckpointError
+from sumo_ayss.util.paths import portable_path
+from sumo_ayss.vuts.catalog import controller_imports
 
 __all__ = ["EvaluationResult", "evaluate_run", "load_spcp", "main"]
 

@@ -43,7 +43,7 @@ IDM car at standstill closer than ``DISTANCE_WANTED`` backs away). A SUMO vehicl
 drive backwards, so :func:`bicycle_step` floors the speed at ``min_speed_mps`` (0 by
 default, set it to −40 for highway-env's bound where no SUMO vehicle is involved).
 
-The state, the bicycle and the collision test live in :mod:`sumo_ayss.hwenv_kinematics`.
+The state, the bicycle and the collision test live in :mod:`sumo_ayss.vuts.hwenv_kinematics`.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from sumo_ayss.hwenv_kinematics import KinematicState, bicycle_step, not_zero
+from sumo_ayss.vuts.hwenv_kinematics import KinematicState, bicycle_step, not_zero
 
 __all__ = [
     "HIGHWAY_ENV_IDM_TARGET",
@@ -181,7 +181,7 @@ class HighwayEnvIDM:
       :meth:`advance`: ``substeps`` explicit-Euler steps of the exact law per SUMO step,
       each re-evaluated against the POV's state at that sub-instant (highway-env's 15 Hz
       inside a 5 Hz decision);
-    * as a plain :class:`~sumo_ayss.controllers.Controller` (:meth:`acceleration`, one
+    * as a plain :class:`~sumo_ayss.vuts.controllers.Controller` (:meth:`acceleration`, one
       evaluation per SUMO step from the sensed bumper-to-bumper gap), e.g. by code that
       only knows the controller protocol.
 
@@ -336,9 +336,9 @@ class HighwayEnvIDM:
             out.append(s)
         return out
 
-    # The Controller protocol (sumo_ayss.controllers), one evaluation per call.
+    # The Controller protocol (sumo_ayss.vuts.controllers), one evaluation per call.
     def acceleration(self, state: object) -> float:
-        """:class:`~sumo_ayss.controllers.Controller` form: one evaluation from the sensed
+        """:class:`~sumo_ayss.vuts.controllers.Controller` form: one evaluation from the sensed
         bumper-to-bumper gap (centre distance = gap + half of both lengths) [m/s²]."""
         speed = float(state.speed_mps)  # type: ignore[attr-defined]
         gap = float(state.gap_m)  # type: ignore[attr-defined]

@@ -19,10 +19,10 @@ Ray tasks. Every stage writes atomically and is skipped when its output exists a
 from the same inputs, so rerunning after a crash or Ctrl-C continues where it stopped. A
 failing job is retried once, then reported with its log; it never costs the other jobs.
 
-Where things live: the sections below in :mod:`sumo_ayss.config.pipeline`; one job
-(:class:`~sumo_ayss.jobs.JobSpec`, :func:`~sumo_ayss.jobs.run_job`) in :mod:`sumo_ayss.jobs`;
-the local process pool in :mod:`sumo_ayss.grid_local`; Ray in :mod:`sumo_ayss.ray_backend`.
-This module plans the grid (each case's experiment parsed once), runs it and the report.
+Where things live: the sections below in :mod:`sumo_ayss.config.pipeline`; running the grid
+in :mod:`sumo_ayss.grid` (its plan, one job :class:`~sumo_ayss.grid.jobs.JobSpec`, the local
+process pool, Ray, progress, adaptive seeding). This module runs the grid, the stages after
+it and the report.
 
 Pipeline YAML (every key optional)::
 
@@ -60,14 +60,14 @@ from sumo_ayss.config import (
     to_dict,
 )
 from sumo_ayss.config.budget import BUDGET_CHOICES, BUDGET_HELP
-from sumo_ayss.errors import AyssError
-from sumo_ayss.folder_lock import output_lock
-from sumo_ayss.grid_local import run_grid_local
-from sumo_ayss.jobs import JobSpec
+from sumo_ayss.grid.folder_lock import output_lock
+from sumo_ayss.grid.jobs import JobSpec
+from sumo_ayss.grid.local import run_grid_local
+from sumo_ayss.grid.plan import plan_jobs, plan_seed
+from sumo_ayss.grid.progress import JobStatus
 from sumo_ayss.modes import get_mode
-from sumo_ayss.plan import plan_jobs, plan_seed
-from sumo_ayss.progress import JobStatus
 from sumo_ayss.run_folder import RunRecord, StudyFolder, write_pipeline_json
+from sumo_ayss.util.errors import AyssError
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
@@ -157,7 +157,7 @@ def final_messages(result: PipelineResult) -> list[str]:
         seeds = fewest_seeds((r.case, r.vut) for r in result.runs)
         lines += [f"WARNING: {w}" for w in trust_warnings(runs, seeds)]
     if result.cfg is not None:
-        from sumo_ayss.adaptive import summary_lines
+        from sumo_ayss.grid.adaptive import summary_lines
 
         lines += summary_lines(result.cfg)
     if result.report is not None:
@@ -176,8 +176,8 @@ def run_pipeline(
     """Run the grid, then load every finished job's run folder, analyse each case once and
     write the report; return the statuses, the report, the loaded runs and the analyses.
 
-    The output folder is locked while it runs (:func:`sumo_ayss.folder_lock.output_lock`):
-    a second pipeline on it is refused with a :class:`~sumo_ayss.errors.LockError` naming
+    The output folder is locked while it runs (:func:`sumo_ayss.grid.folder_lock.output_lock`):
+    a second pipeline on it is refused with a :class:`~sumo_ayss.util.errors.LockError` naming
     the holder's PID.
 
     ``live``: show a live table when standard output is a terminal (``console``: the
@@ -209,7 +209,7 @@ def _run_locked(
 
     def run_jobs(todo: list[JobSpec]) -> list[JobStatus]:
         if backend == "ray":
-            from sumo_ayss.ray_backend import run_grid_ray
+            from sumo_ayss.grid.ray_backend import run_grid_ray
 
             return run_grid_ray(todo, cfg.retries, address, after=after)
         return run_grid_local(
@@ -224,7 +224,7 @@ def _run_locked(
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
     if not finished:
         return PipelineResult(statuses, None, [], [], cfg)
-    from sumo_ayss.adaptive import is_adaptive, run_adaptive
+    from sumo_ayss.grid.adaptive import is_adaptive, run_adaptive
     from sumo_ayss.report.document import load_runs, write_report_for
     from sumo_ayss.report.load import analyse_runs
 
@@ -248,7 +248,7 @@ def stages_after_grid(cfg: PipelineConfig) -> list[str]:
     stages = ["discriminability"] if several else []
     if several and get_mode(cfg.report.mode).runs_crossplay:
         stages.append("cross-play")
-    from sumo_ayss.adaptive import is_adaptive
+    from sumo_ayss.grid.adaptive import is_adaptive
 
     if is_adaptive(cfg):
         stages.append(f"adaptive seeding (up to {cfg.max_seeds} seeds)")
@@ -274,7 +274,7 @@ def run_crossplay_stage(
     if len(cfg.grid.vuts) < 2:
         logger.info("cross-play skipped: the grid has one VUT (cross-play compares two or more)")
         return []
-    from sumo_ayss.adaptive import case_seeds
+    from sumo_ayss.grid.adaptive import case_seeds
 
     by_path = {r.path: r for r in runs}
     written = []
@@ -324,7 +324,7 @@ def write_discriminability(cfg: PipelineConfig) -> None:
     if len(cfg.grid.vuts) < 2:
         return
     from sumo_ayss import discriminability
-    from sumo_ayss.errors import AyssError
+    from sumo_ayss.util.errors import AyssError
 
     for case in cfg.grid.cases:
         logger.info(

@@ -40,7 +40,6 @@ from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.seeds import kendall_tau
-from sumo_ayss.errors import AyssError, ConfigError
 from sumo_ayss.modes import Mode, get_mode, mode_names, registered_modes
 from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.run_folder import (
@@ -53,6 +52,7 @@ from sumo_ayss.run_folder import (
     write_order_check,
     write_ranking_csv,
 )
+from sumo_ayss.util.errors import AyssError, ConfigError
 
 if TYPE_CHECKING:
     from sumo_ayss.config.report import ReportOptions
@@ -206,7 +206,7 @@ def write_ranking(
     """``ranking.csv`` and ``ranking.md`` in the study folder ``out`` (written atomically),
     and with a known order, ``order_check.json`` (see :func:`order_check`;
     :mod:`sumo_ayss.run_folder.study`)."""
-    from sumo_ayss.atomic import atomic_write_text
+    from sumo_ayss.util.atomic import atomic_write_text
 
     study = StudyFolder(out)
     write_ranking_csv(study.ranking_csv, rows)

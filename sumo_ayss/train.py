@@ -58,7 +58,6 @@ import torch as th
 from sumo_ayss.agents import sb3_adapter
 from sumo_ayss.agents.dqn import AyssDQN
 from sumo_ayss.agents.hparams import DQNHyperParams
-from sumo_ayss.atomic import atomic_copy
 from sumo_ayss.cli import prog
 from sumo_ayss.config import (
     ExperimentConfig,
@@ -69,7 +68,6 @@ from sumo_ayss.config import (
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.envs.vec_env import PairVecEnv
-from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
 from sumo_ayss.run_folder import (
     EVAL_COLUMNS,
     MODEL_ZIP,
@@ -82,7 +80,6 @@ from sumo_ayss.run_folder import (
     write_spcp,
 )
 from sumo_ayss.scenarios.rollout import summarize
-from sumo_ayss.selection import select_spcp
 from sumo_ayss.training import checkpoint
 from sumo_ayss.training.callback import CandidateCallback
 from sumo_ayss.training.collectors import (
@@ -95,6 +92,9 @@ from sumo_ayss.training.collectors import (
 )
 from sumo_ayss.training.config_check import check_same_config
 from sumo_ayss.training.run_metadata import write_metadata
+from sumo_ayss.training.selection import select_spcp
+from sumo_ayss.util.atomic import atomic_copy
+from sumo_ayss.util.errors import AyssError, CheckpointError, ConfigError
 
 __all__ = [
     "Trainer",
@@ -114,7 +114,7 @@ class Trainer:
     The concerns live in :mod:`sumo_ayss.training`: run metadata (``run_metadata``),
     checkpoints (``checkpoint``), the training env(s) (``collectors``: one env or N pairs,
     behind one interface) and the step callback (``callback``); SPCP selection is
-    :func:`~sumo_ayss.selection.select_spcp`. Every run-folder file is written and read
+    :func:`~sumo_ayss.training.selection.select_spcp`. Every run-folder file is written and read
     through :mod:`sumo_ayss.run_folder`; SB3's private state is touched through
     :mod:`sumo_ayss.agents.sb3_adapter` only.
     """

@@ -20,8 +20,8 @@ import pytest
 import yaml
 
 from sumo_ayss.config import EnvConfig, SimConfig, load_experiment, read_yaml
-from sumo_ayss.controllers import ControllerError, bound_acceleration
-from sumo_ayss.errors import ActionError, AyssError, CheckpointError, ConfigError
+from sumo_ayss.util.errors import ActionError, AyssError, CheckpointError, ConfigError
+from sumo_ayss.vuts.controllers import ControllerError, bound_acceleration
 from tests.helpers import TINY_AGENT
 
 # ------------------------------------------------------------------------------ helpers
@@ -199,7 +199,7 @@ def test_spcp_selection_without_signal_warns_naming_the_run(
     caplog: pytest.LogCaptureFixture,
 ) -> None:
     """A cut-in ODD that pins the VUT at 0 m/s: every candidate scores 0 (no signal)."""
-    from sumo_ayss.selection import select_spcp
+    from sumo_ayss.training.selection import select_spcp
 
     rows = [{"step": s, "mean_return": 0.0, "crash_rate": 0.0} for s in (200, 400, 600)]
     with caplog.at_level("WARNING"):
@@ -369,7 +369,7 @@ def test_controller_numbers_of_numpy_and_int_types_are_accepted() -> None:
 
 def test_a_controller_target_is_checked_before_it_is_called(tmp_path: Path) -> None:
     """Not a class, or a class without ``acceleration``: refused before anything runs."""
-    from sumo_ayss.catalog import ControllerSpec
+    from sumo_ayss.vuts.catalog import ControllerSpec
 
     marker = tmp_path / "ran"
     module = tmp_path / "odd_controllers.py"
@@ -393,7 +393,7 @@ def test_a_controller_target_is_checked_before_it_is_called(tmp_path: Path) -> N
             spec.build("env.vuts.mine.controller")
         message = _one_line(info.value)
         assert message.startswith(f"env.vuts.mine.controller.target {target!r}"), message
-        assert expected in message and "(see sumo_ayss.controllers.Controller)" in message
+        assert expected in message and "(see sumo_ayss.vuts.controllers.Controller)" in message
         assert not marker.exists(), target  # nothing was called
 
 
@@ -413,8 +413,8 @@ class Raises:
 
 
 def _controller_env(target: str) -> Any:
-    from sumo_ayss.catalog import ControllerSpec, VehicleType
     from sumo_ayss.envs.car_following import CarFollowingEnv
+    from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
 
     spec = ControllerSpec(target=target, max_accel_mps2=3.0, max_decel_mps2=6.0)
     vt = VehicleType(controller=spec)
@@ -998,9 +998,9 @@ def test_rank_no_run_warns_on_the_console_naming_a_damaged_file(
 
 
 def test_a_garbled_table_or_json_file_is_a_table_error_naming_it(tmp_path: Path) -> None:
-    from sumo_ayss.errors import TableError
     from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, read_table
     from sumo_ayss.run_folder.jsonio import read_json
+    from sumo_ayss.util.errors import TableError
 
     path = tmp_path / "crossplay.csv"
     _garble(path)
@@ -1071,7 +1071,7 @@ def test_a_stale_lock_is_taken_over_with_a_log_line(
     import subprocess
     import sys
 
-    from sumo_ayss.folder_lock import output_lock
+    from sumo_ayss.grid.folder_lock import output_lock
 
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
     dead.wait()
@@ -1095,11 +1095,11 @@ def test_two_processes_one_lock_released_on_a_signal(tmp_path: Path, signum: str
     import subprocess
     import sys
 
-    from sumo_ayss.errors import LockError
-    from sumo_ayss.folder_lock import output_lock
+    from sumo_ayss.grid.folder_lock import output_lock
+    from sumo_ayss.util.errors import LockError
 
     code = (
-        "import sys, time\nfrom sumo_ayss.folder_lock import output_lock\n"
+        "import sys, time\nfrom sumo_ayss.grid.folder_lock import output_lock\n"
         "with output_lock(sys.argv[1]):\n    print('held', flush=True)\n    time.sleep(60)\n"
     )
     proc = subprocess.Popen(

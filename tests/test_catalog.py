@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from sumo_ayss.catalog import BUILTIN_VUTS, MODEL_PARAMS, POV_TYPE, VehicleType, vtypes_xml
 from sumo_ayss.config import PROJECT_ROOT
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.sim.network import write_vtypes_file
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.vuts.catalog import BUILTIN_VUTS, MODEL_PARAMS, POV_TYPE, VehicleType, vtypes_xml
 
 
 def test_paper_vuts() -> None:

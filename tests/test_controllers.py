@@ -1,7 +1,7 @@
 """A user controller as the VUT: the protocol without SUMO, then driven through SUMO.
 
 The SUMO tests step a :class:`~sumo_ayss.sim.pair.VehiclePair` by hand (session + pair +
-:class:`~sumo_ayss.controllers.ControlledVut`), the way the env's controller law
+:class:`~sumo_ayss.vuts.controllers.ControlledVut`), the way the env's controller law
 (:class:`~sumo_ayss.laws.controller.ControllerVut`) does before each SUMO step, so they do
 not depend on :class:`~sumo_ayss.envs.pair_env.PairEnv`.
 """
@@ -19,9 +19,12 @@ from typing import Any
 import pytest
 
 from examples.acc_controller import TimeGapACC
-from sumo_ayss.catalog import POV_TYPE, ControllerSpec, VehicleType
 from sumo_ayss.config import PROJECT_ROOT, EnvConfig, SimConfig, env_config_from_mapping
-from sumo_ayss.controllers import (
+from sumo_ayss.envs import make_env
+from sumo_ayss.sim.pair import VutSensing
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.vuts.catalog import POV_TYPE, ControllerSpec, VehicleType
+from sumo_ayss.vuts.controllers import (
     ControlledVut,
     Controller,
     ControllerError,
@@ -29,9 +32,6 @@ from sumo_ayss.controllers import (
     bound_acceleration,
     commanded_speed,
 )
-from sumo_ayss.envs import make_env
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.sim.pair import VutSensing
 
 ACC = "examples.acc_controller:TimeGapACC"
 ACC_FILE = str(PROJECT_ROOT / "examples" / "acc_controller.py") + ":TimeGapACC"

@@ -14,8 +14,8 @@ import yaml
 from sumo_ayss import discriminability as disc
 from sumo_ayss.analysis.discriminability import BoxGrid
 from sumo_ayss.config import PROJECT_ROOT
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.run_folder import CaseFolder
+from sumo_ayss.util.errors import ConfigError
 
 pytestmark = pytest.mark.sumo
 

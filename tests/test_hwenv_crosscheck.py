@@ -57,7 +57,6 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from sumo_ayss.catalog import POV_TYPE, VehicleType
 from sumo_ayss.config import ActuatorConfig, EnvConfig, OddConfig, SimConfig
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.car_following import target_speed_mps as cf_target
@@ -65,6 +64,7 @@ from sumo_ayss.envs.cut_in import LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import VUT_START_POS_M
 from sumo_ayss.sim.network import LANE_WIDTH_M, SPEED_LIMIT_MPS
+from sumo_ayss.vuts.catalog import POV_TYPE, VehicleType
 
 try:
     import highway_env  # noqa: F401

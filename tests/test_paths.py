@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from sumo_ayss.config import PROJECT_ROOT
-from sumo_ayss.paths import portable_path
+from sumo_ayss.util.paths import portable_path
 
 
 def test_paths_below_the_repository_become_relative() -> None:

@@ -16,8 +16,8 @@ import pytest
 import yaml
 
 from sumo_ayss.config import PROJECT_ROOT, AyssConfig, ExperimentConfig
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.pipeline import load_pipeline, plan_jobs, run_pipeline
+from sumo_ayss.util.errors import ConfigError
 from tests.helpers import TINY_AGENT
 
 

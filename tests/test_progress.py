@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 
 from sumo_ayss.config import ExperimentConfig, TrainConfig
-from sumo_ayss.progress import GridProgress, JobStatus, format_duration
+from sumo_ayss.grid.progress import GridProgress, JobStatus, format_duration
 from sumo_ayss.run_folder import (
     PROGRESS_JSON,
     RunFolder,

@@ -93,7 +93,7 @@ def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, mon
     import sumo_ayss.report.load as load_mod
     import sumo_ayss.run_folder.crossplay as crossplay_mod
     import sumo_ayss.run_folder.record as record_mod
-    from sumo_ayss.progress import JobStatus
+    from sumo_ayss.grid.progress import JobStatus
 
     dirs = _three_vuts(tmp_path / "runs", monkeypatch)
     expected = ["cautious", "pi2", "pi1"]

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
+from sumo_ayss.grid.ray_backend import pack, unpack
 from sumo_ayss.pipeline import load_pipeline, run_pipeline
-from sumo_ayss.ray_backend import pack, unpack
 from tests.test_pipeline import write_configs
 
 
@@ -36,7 +36,7 @@ def test_grid_on_a_local_ray_instance(tmp_path: Path, caplog: pytest.LogCaptureF
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     try:
         cfg = load_pipeline(write_configs(tmp_path, [0]))
-        with caplog.at_level("INFO", logger="sumo_ayss.ray_backend"):
+        with caplog.at_level("INFO", logger="sumo_ayss.grid.ray_backend"):
             statuses, report, *_ = run_pipeline(cfg, backend="ray", live=False)
     finally:
         ray.shutdown()

@@ -6,8 +6,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.selection import select_spcp
+from sumo_ayss.training.selection import select_spcp
+from sumo_ayss.util.errors import ConfigError
 
 
 def rows(returns, crashes=None):

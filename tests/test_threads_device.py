@@ -10,9 +10,9 @@ import pytest
 import torch as th
 
 from sumo_ayss.config import TrainConfig, load_experiment
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.threads import THREAD_ENV_VARS, set_torch_threads, single_thread_env
+from sumo_ayss.grid.threads import THREAD_ENV_VARS, set_torch_threads, single_thread_env
 from sumo_ayss.train import check_device, train
+from sumo_ayss.util.errors import ConfigError
 from tests.training.test_train import tiny_config
 
 
@@ -92,7 +92,7 @@ def test_pipeline_workers_start_torch_with_one_thread(monkeypatch: pytest.Monkey
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    from sumo_ayss.grid_local import _worker_init
+    from sumo_ayss.grid.local import _worker_init
 
     for name in THREAD_ENV_VARS:
         monkeypatch.delenv(name, raising=False)

@@ -16,16 +16,16 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from sumo_ayss.catalog import (
+from sumo_ayss.config import EnvConfig
+from sumo_ayss.envs.odd import InitialCondition
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.vuts.catalog import (
     COMMON_PARAMS,
     MODEL_PARAMS,
     PARAM_SPECS,
     REQUIRED_PARAMS,
     VehicleType,
 )
-from sumo_ayss.config import EnvConfig
-from sumo_ayss.envs.odd import InitialCondition
-from sumo_ayss.errors import ConfigError
 
 ALL_PARAMS = COMMON_PARAMS.union(*MODEL_PARAMS.values())
 MODELS = sorted(MODEL_PARAMS)

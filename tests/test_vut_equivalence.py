@@ -28,18 +28,18 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from sumo_ayss.catalog import ControllerSpec, VehicleType
 from sumo_ayss.config import EnvConfig, SimConfig
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.cut_in import LANE_CHANGE
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.envs.vec_env import PairVecEnv
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.scenarios.crossplay import Opponent, diagonal_check, run_crossplay
 from sumo_ayss.scenarios.outcome import run_outcome
 from sumo_ayss.scenarios.rollout import EpisodeResult, run_episodes
 from sumo_ayss.training.collectors import evaluate_on_vec
-from sumo_ayss.vtype_params import ALWAYS_RANDOM_MODELS, MODEL_PARAMS
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
+from sumo_ayss.vuts.vtype_params import ALWAYS_RANDOM_MODELS, MODEL_PARAMS
 
 pytestmark = pytest.mark.sumo
 

@@ -12,8 +12,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.validation import check_int, check_keys, check_number
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.util.validation import check_int, check_keys, check_number
 
 _DEFAULT_PREFIX = "agent"
 _ARCH_FIELDS = ("feature_net_arch", "value_net_arch", "advantage_net_arch")

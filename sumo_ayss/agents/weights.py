@@ -21,7 +21,7 @@ from stable_baselines3.common.torch_layers import FlattenExtractor
 from sumo_ayss.agents.greedy import GreedyPolicy
 from sumo_ayss.agents.hparams import DQNHyperParams
 from sumo_ayss.agents.policies import DuelingQNetwork
-from sumo_ayss.errors import CheckpointError
+from sumo_ayss.util.errors import CheckpointError
 
 #: The state dict entry of SB3's saved zip, and the online network's prefix in it.
 POLICY_ENTRY = "policy.pth"

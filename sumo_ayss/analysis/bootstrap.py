@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sumo_ayss.analysis.validate import check_level, finite_1d
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = ["RngLike", "binned_mean_bootstrap", "bootstrap_ci", "hierarchical_bootstrap"]
 

@@ -36,8 +36,8 @@ from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex, rank, safety_inde
 from sumo_ayss.analysis.seeds import SeedComparison, SeedRankRow, SeedScores, rank_seeds
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
 from sumo_ayss.cases import Case, case_info
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.modes import CROSSPLAY, EXPOSURE, PAPER, get_mode
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
     "CaseAnalysis",

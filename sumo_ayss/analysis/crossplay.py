@@ -41,7 +41,7 @@ import numpy.typing as npt
 
 from sumo_ayss.analysis.harm import HARM_RANGE
 from sumo_ayss.analysis.seeds import SeedComparison, SeedRankRow, SeedScores, rank_seeds
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
     "BLOCKS",

@@ -23,8 +23,8 @@ import numpy as np
 import numpy.typing as npt
 
 from sumo_ayss.analysis.metrics import ttc_longitudinal
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.validation import check_range
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.util.validation import check_range
 
 __all__ = [
     "DEFAULT_THRESHOLD_MPS2",

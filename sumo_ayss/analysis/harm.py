@@ -41,7 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from sumo_ayss.analysis.stats import wilson_interval
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = ["HARM_RANGE", "MOBILITY_FLOOR", "HarmScale", "episode_harm", "mobility_flags"]
 

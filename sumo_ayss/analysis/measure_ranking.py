@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 from sumo_ayss.analysis.r157 import r157_share
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.analysis.stats import wilson_interval
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
     "MEASURES",

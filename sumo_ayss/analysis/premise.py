@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sumo_ayss.analysis.seed_intervals import UNBOUNDED, Bounds, seed_mean_ci
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = ["PREMISE_METRICS", "Premise", "PremiseMetric", "PremiseMetricSpec", "premise_check"]
 

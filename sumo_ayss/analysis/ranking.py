@@ -17,7 +17,7 @@ from sumo_ayss.analysis.safety_index import (
     safety_index,
 )
 from sumo_ayss.analysis.verdict import Verdict, compare
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
     "DELTA_V_BAR",

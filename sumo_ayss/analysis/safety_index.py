@@ -29,7 +29,7 @@ from sumo_ayss.analysis.validate import check_level
 from sumo_ayss.cases import Indicator  # naming records live with their cases; re-exported
 from sumo_ayss.cases.car_following import POV_ACCELERATION
 from sumo_ayss.cases.cut_in import DELTA_V_BAR
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = ["DELTA_V_BAR", "POV_ACCELERATION", "Indicator", "SafetyIndex", "safety_index"]
 

@@ -59,7 +59,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sumo_ayss.analysis.metrics import time_to_collision
 from sumo_ayss.analysis.r157 import R157_INTRUSION_DEPTH_M, must_avoid
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
     "MEASURE_NAMES",

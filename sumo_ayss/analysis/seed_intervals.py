@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sumo_ayss.analysis.stats import BinnedStats, binned_mean_ci, mean_ci
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
     "MIN_SEEDS_FOR_INTERVAL",

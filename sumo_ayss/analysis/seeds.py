@@ -30,7 +30,7 @@ import numpy as np
 
 from sumo_ayss.analysis.seed_intervals import UNBOUNDED, Bounds, seed_mean_ci
 from sumo_ayss.analysis.stats import check_level, student_t_sf, t_quantile
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
     "SeedComparison",

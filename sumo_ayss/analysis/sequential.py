@@ -44,7 +44,7 @@ from scipy import stats as _scipy_stats
 
 from sumo_ayss.analysis.seeds import SeedScores, compare_seeds
 from sumo_ayss.analysis.validate import check_level
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
     "CALIBRATION_REPS",

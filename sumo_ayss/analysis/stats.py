@@ -23,7 +23,7 @@ from scipy import stats as _scipy_stats
 
 from sumo_ayss.analysis.bootstrap import RngLike, bootstrap_ci, hierarchical_bootstrap
 from sumo_ayss.analysis.validate import check_level, finite_1d, is_real
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
     "BinnedStats",

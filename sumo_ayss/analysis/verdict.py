@@ -16,7 +16,7 @@ from sumo_ayss.analysis.bootstrap import bootstrap_ci
 from sumo_ayss.analysis.safety_index import Indicator, SafetyIndex
 from sumo_ayss.analysis.stats import cohens_d, welch_t_test
 from sumo_ayss.analysis.validate import check_level
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = ["Verdict", "compare"]
 

@@ -10,7 +10,7 @@ branching on case names.
 Two levels, because of the layering (config → sim → envs → … → analysis → report):
 
 * **Data** — a :class:`Case` is a frozen record of plain values. This package imports only
-  the standard library, :mod:`sumo_ayss.errors` and :mod:`sumo_ayss.validation`, so the
+  the standard library, :mod:`sumo_ayss.util.errors` and :mod:`sumo_ayss.util.validation`, so the
   configuration (which validates ``env.case`` against it), the analysis and the report read
   it without loading torch, libsumo, SB3 or matplotlib.
 * **Bindings** — the env class and the AYSS row builder live in the layers that may import
@@ -26,7 +26,7 @@ Adding a case: write its env (and AYSS row builder) and one module here that cal
 ``ayss.csv`` schema, fixed when :mod:`sumo_ayss.run_folder` is imported, accepts the
 indicator columns of the cases registered by then.
 
-Lookups: :func:`get_case` (raises :class:`~sumo_ayss.errors.ConfigError` naming the
+Lookups: :func:`get_case` (raises :class:`~sumo_ayss.util.errors.ConfigError` naming the
 registered cases), :func:`case_names`, :func:`registered_cases`, :func:`case_info` (lenient:
 a generic record for a run folder of an unknown case), :func:`case_of_indicator`.
 """

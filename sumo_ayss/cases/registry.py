@@ -1,6 +1,6 @@
 """The case record, its registry and the naming records it holds (see :mod:`sumo_ayss.cases`).
 
-Standard library, :mod:`sumo_ayss.errors` and :mod:`sumo_ayss.validation` only.
+Standard library, :mod:`sumo_ayss.util.errors` and :mod:`sumo_ayss.util.validation` only.
 """
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.validation import require, suggest
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.util.validation import require, suggest
 
 __all__ = [
     "BASE_OBSERVATION",

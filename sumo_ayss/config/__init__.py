@@ -1,8 +1,8 @@
 """Typed, validated configuration: defaults in code, YAML holds overrides.
 
 Every section is a frozen dataclass checked in ``__post_init__``; a bad value raises
-:class:`~sumo_ayss.errors.ConfigError` naming the dotted field and the allowed values
-(the idiom of :mod:`sumo_ayss.validation`). YAML files are merged over the defaults by
+:class:`~sumo_ayss.util.errors.ConfigError` naming the dotted field and the allowed values
+(the idiom of :mod:`sumo_ayss.util.validation`). YAML files are merged over the defaults by
 :func:`build`; unknown keys are rejected with a suggestion, relative paths resolve against
 the YAML file's folder.
 
@@ -58,7 +58,7 @@ from sumo_ayss.config.pipeline import (
 )
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.config.yaml_io import read_yaml, safe_load_yaml, write_yaml
-from sumo_ayss.validation import SEED_MAX, check_out_dir, check_seed, check_sumo_network
+from sumo_ayss.util.validation import SEED_MAX, check_out_dir, check_seed, check_sumo_network
 
 __all__ = [
     "DEFAULT_AYSS_SEED",

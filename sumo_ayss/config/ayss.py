@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from sumo_ayss.config.env import OddConfig
-from sumo_ayss.validation import check_int, check_number, check_range, check_seed
+from sumo_ayss.util.validation import check_int, check_number, check_range, check_seed
 
 #: Default Monte Carlo seed, shared by every SPCP (common random numbers across VUTs).
 DEFAULT_AYSS_SEED = 4242

@@ -7,7 +7,7 @@ every experiment's ``train`` section as its file says (the behaviour before budg
 * ``verdict`` (the default): 20,000 transitions per run, a candidate every 5,000, four
   training seeds per VUT to start with and **adaptive seeding** up to six (a case whose
   cross-play ranking has not settled gets one more seed per VUT at a time,
-  :mod:`sumo_ayss.adaptive`), 20,000 AYSS draws. Chosen from the verdict's learning curve
+  :mod:`sumo_ayss.grid.adaptive`), 20,000 AYSS draws. Chosen from the verdict's learning curve
   (docs/performance.md, ``scripts/verdict_curve.py``): on the braking and ACC ladders (six
   seeds each, every 4-seed subset) the cross-play ranking had Kendall τ = 1 with significant
   ends in both cases at 20,000 transitions with four seeds, at under a third of the
@@ -48,7 +48,7 @@ class Budget:
             ``evaluate.ayss.n_samples`` is given; None: the AYSS section's default (100,000).
         max_seeds: Adaptive seeding's cap when the budget also chose the seeds: a case
             whose cross-play ranking has not settled gets one more seed per VUT at a time,
-            up to this many (:mod:`sumo_ayss.adaptive`); None: a fixed grid of ``seeds``.
+            up to this many (:mod:`sumo_ayss.grid.adaptive`); None: a fixed grid of ``seeds``.
     """
 
     total_timesteps: int

@@ -1,7 +1,7 @@
 """The environment's sections: ``env`` and its ``sim``, ``actuator``, ``odd`` and ``reward``.
 
 Every section is a frozen dataclass checked in ``__post_init__``; a bad value raises
-:class:`~sumo_ayss.errors.ConfigError` naming the dotted field and the allowed values.
+:class:`~sumo_ayss.util.errors.ConfigError` naming the dotted field and the allowed values.
 
 Units: lengths m, speeds m/s, accelerations m/s², times s. Sign convention: accelerations
 are positive forward, braking is negative (the POV actuator bounds are ``[-6, 6]`` m/s²).
@@ -16,10 +16,10 @@ from pathlib import Path
 from typing import ClassVar, Literal
 
 from sumo_ayss.cases import DEFAULT_CASE, ROAD_EDGE, case_names, get_case
-from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE, VehicleType
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.frozen import FrozenMap
-from sumo_ayss.validation import check_choice, check_range, check_sumo_network, require
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.util.frozen import FrozenMap
+from sumo_ayss.util.validation import check_choice, check_range, check_sumo_network, require
+from sumo_ayss.vuts.catalog import BUILTIN_VUTS, POV_TYPE, VehicleType
 
 #: A registered case name (:mod:`sumo_ayss.cases`); checked against the registry.
 Case = str

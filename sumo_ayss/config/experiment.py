@@ -19,8 +19,8 @@ from sumo_ayss.agents.hparams import DQNHyperParams
 from sumo_ayss.config.env import EnvConfig
 from sumo_ayss.config.mapping import build, to_dict
 from sumo_ayss.config.yaml_io import read_yaml
-from sumo_ayss.selection import CRITERIA
-from sumo_ayss.validation import check_choice, check_seed, require
+from sumo_ayss.training.selection import CRITERIA
+from sumo_ayss.util.validation import check_choice, check_seed, require
 
 
 @dataclass(frozen=True)
@@ -38,7 +38,7 @@ class TrainConfig:
     eval_seed: int = 2024
     """Seed of the evaluation scenarios: the same for every VUT and training seed."""
     selection: str = "mean_reward"
-    """SPCP criterion, one of :data:`sumo_ayss.selection.CRITERIA`."""
+    """SPCP criterion, one of :data:`sumo_ayss.training.selection.CRITERIA`."""
     torch_threads: int = 1
     """PyTorch intra-op threads; 1 lets parallel runs share cores without contention."""
     progress_bar: bool = True

@@ -17,10 +17,10 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Literal
 
-from sumo_ayss.catalog import ControllerSpec, VehicleType
 from sumo_ayss.config.env import EnvConfig
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.validation import check_choice, unknown_key
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.util.validation import check_choice, unknown_key
+from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
 
 
 def _anchor_controller(spec: ControllerSpec, base_dir: Path) -> ControllerSpec:

@@ -11,15 +11,15 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from sumo_ayss.cases import case_names
-from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config.ayss import AyssConfig
 from sumo_ayss.config.budget import BUDGETS, DEFAULT_BUDGET
 from sumo_ayss.config.env import PROJECT_ROOT, Case
 from sumo_ayss.config.mapping import build
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.config.yaml_io import read_yaml
-from sumo_ayss.frozen import FrozenMap
-from sumo_ayss.validation import check_choice, check_seed, require, suggest
+from sumo_ayss.util.frozen import FrozenMap
+from sumo_ayss.util.validation import check_choice, check_seed, require, suggest
+from sumo_ayss.vuts.catalog import VehicleType
 
 
 @dataclass(frozen=True)
@@ -101,7 +101,7 @@ class PipelineConfig:
     max_seeds: int | None = None
     """Adaptive seeding: a case whose cross-play ranking has not settled after ``grid.seeds``
     gets one more seed per VUT at a time (the next integer after the last seed), up to this
-    many seeds per VUT (:mod:`sumo_ayss.adaptive`). None: the budget's cap when the budget
+    many seeds per VUT (:mod:`sumo_ayss.grid.adaptive`). None: the budget's cap when the budget
     also chose the seeds (``verdict``: 6), else ``len(grid.seeds)``, a fixed grid."""
     evaluate: EvaluateConfig = field(default_factory=EvaluateConfig)
     vuts: Mapping[str, VehicleType] = field(default_factory=dict)

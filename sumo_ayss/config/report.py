@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Literal
 
 from sumo_ayss.modes import DEFAULT_MODE, mode_names
-from sumo_ayss.validation import check_choice, check_int, check_number, require
+from sumo_ayss.util.validation import check_choice, check_int, check_number, require
 
 if TYPE_CHECKING:
     import numpy as np

@@ -8,7 +8,7 @@ from typing import Any
 
 import yaml
 
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 
 def read_yaml(path: str | Path) -> dict[str, Any]:
@@ -71,6 +71,6 @@ def safe_load_yaml(text: str, name: str) -> Any:
 
 def write_yaml(path: Path, data: Any) -> None:
     """Write YAML atomically (temp file + rename), so a kill never leaves half a file."""
-    from sumo_ayss.atomic import atomic_write_text
+    from sumo_ayss.util.atomic import atomic_write_text
 
     atomic_write_text(path, yaml.safe_dump(data, sort_keys=False))

@@ -99,9 +99,9 @@ from sumo_ayss.envs.pair_env import (
     PairKinematics,
 )
 from sumo_ayss.envs.rewards import adversarial_reward
-from sumo_ayss.errors import ActionError
 from sumo_ayss.laws import VehicleLaws
 from sumo_ayss.sim.pair import PairPlacement
+from sumo_ayss.util.errors import ActionError
 
 #: Action index of the lane change.
 LANE_CHANGE = 0

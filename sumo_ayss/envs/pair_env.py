@@ -24,16 +24,16 @@ import numpy as np
 import numpy.typing as npt
 from gymnasium import spaces
 
-from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_condition
 from sumo_ayss.envs.rewards import total_reward
-from sumo_ayss.errors import ActionError, ConfigError
 from sumo_ayss.laws import VehicleLaws, build_laws
 from sumo_ayss.sim.network import ROAD_EDGE, ROAD_LENGTH_M, network_path
 from sumo_ayss.sim.pair import PairPlacement, VehiclePair
 from sumo_ayss.sim.session import SumoSession
-from sumo_ayss.validation import check_sumo_seed
+from sumo_ayss.util.errors import ActionError, ConfigError
+from sumo_ayss.util.validation import check_sumo_seed
+from sumo_ayss.vuts.catalog import VehicleType
 
 #: Front-bumper position of the VUT at the start of every episode [m].
 VUT_START_POS_M = 150.0

@@ -76,11 +76,11 @@ from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv, session_vtypes, sumo_seed_of
 from sumo_ayss.envs.protocol import EpisodePhases, StepResult
-from sumo_ayss.errors import ActionError, ConfigError
 from sumo_ayss.sim.network import build_parallel_network, parallel_road_edge
 from sumo_ayss.sim.pair import VehiclePair
 from sumo_ayss.sim.session import SumoSession
-from sumo_ayss.validation import check_sumo_seed
+from sumo_ayss.util.errors import ActionError, ConfigError
+from sumo_ayss.util.validation import check_sumo_seed
 
 #: A batch policy: observations ``(n, obs_dim)`` -> actions ``(n,)``.
 Policy = Callable[[npt.NDArray[np.float32]], npt.ArrayLike]

@@ -24,8 +24,8 @@ from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from typing import NamedTuple
 
-from sumo_ayss.hwenv_kinematics import KinematicState
 from sumo_ayss.sim.pair import VehiclePair
+from sumo_ayss.vuts.hwenv_kinematics import KinematicState
 
 __all__ = ["PovLaw", "VehicleLaw", "VehicleLaws", "VutLaw"]
 

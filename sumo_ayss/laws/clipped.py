@@ -9,10 +9,10 @@ with a constant lateral speed over ``env.sim.lanechange_duration_s``.
 from __future__ import annotations
 
 from sumo_ayss.config import ActuatorConfig, EnvConfig
-from sumo_ayss.hwenv_kinematics import KinematicState
 from sumo_ayss.laws.base import PovLaw
 from sumo_ayss.sim.actuator import next_speed, pov_acceleration
 from sumo_ayss.sim.pair import VehiclePair
+from sumo_ayss.vuts.hwenv_kinematics import KinematicState
 
 __all__ = ["LATERAL_EPS", "ClippedPov"]
 

@@ -1,11 +1,11 @@
-"""The VUT driven by a user controller (:mod:`sumo_ayss.controllers`), once per SUMO step."""
+"""The VUT driven by a user controller (:mod:`sumo_ayss.vuts.controllers`), once per SUMO step."""
 
 from __future__ import annotations
 
 from sumo_ayss.config import EnvConfig
-from sumo_ayss.controllers import ControlledVut
 from sumo_ayss.laws.base import PovLaw, VutLaw
 from sumo_ayss.sim.pair import VehiclePair
+from sumo_ayss.vuts.controllers import ControlledVut
 
 __all__ = ["ControllerVut"]
 
@@ -13,7 +13,7 @@ __all__ = ["ControllerVut"]
 class ControllerVut(VutLaw):
     """Before every SUMO step the controller sees what the VUT's sensors see and returns an
     acceleration [m/s²]; SUMO drives the bounded speed exactly (speed mode 0). The
-    execution semantics are :class:`~sumo_ayss.controllers.ControlledVut`'s.
+    execution semantics are :class:`~sumo_ayss.vuts.controllers.ControlledVut`'s.
 
     Args:
         driver: The controller with its declared limits and the step length.

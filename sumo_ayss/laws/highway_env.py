@@ -23,10 +23,10 @@ from collections.abc import Sequence
 from typing import Any
 
 from sumo_ayss.config import ActuatorConfig, EnvConfig
-from sumo_ayss.hwenv_kinematics import KinematicState, collision_check
 from sumo_ayss.hwenv_laws import HighwayEnvPov, LateralParams
 from sumo_ayss.laws.base import PovLaw, VutLaw
 from sumo_ayss.sim.pair import VehiclePair
+from sumo_ayss.vuts.hwenv_kinematics import KinematicState, collision_check
 
 __all__ = ["HighwayEnvIdmVut", "HighwayEnvPovLaw"]
 

@@ -1,7 +1,7 @@
 """The ranking-mode record, its registry and the uniform standing a mode ranks by (see
 :mod:`sumo_ayss.modes`).
 
-Standard library, :mod:`sumo_ayss.errors` and :mod:`sumo_ayss.validation` only: the
+Standard library, :mod:`sumo_ayss.util.errors` and :mod:`sumo_ayss.util.validation` only: the
 configuration validates ``report.mode`` against this registry without loading numpy.
 """
 
@@ -12,8 +12,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.validation import require, suggest
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.util.validation import require, suggest
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis

@@ -8,7 +8,6 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from sumo_ayss.cli import prog
-from sumo_ayss.errors import AyssError
 from sumo_ayss.replay.playback import (
     POSITION_TOL_M,
     REPLAYED_FILE,
@@ -17,6 +16,7 @@ from sumo_ayss.replay.playback import (
     replay_in_gui,
 )
 from sumo_ayss.replay.record import export_scenario
+from sumo_ayss.util.errors import AyssError
 
 __all__ = ["main"]
 

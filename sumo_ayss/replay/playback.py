@@ -12,8 +12,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.errors import ConfigError, SimulationError
 from sumo_ayss.sim import export
+from sumo_ayss.util.errors import ConfigError, SimulationError
 
 __all__ = [
     "GUI_FILE",

@@ -14,14 +14,10 @@ from typing import Any, Literal
 
 import numpy as np
 
-from sumo_ayss.atomic import atomic_copy, atomic_write_text
-from sumo_ayss.catalog import controller_imports, vtypes_xml
 from sumo_ayss.config import EnvConfig, to_dict
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.errors import CheckpointError, ConfigError, SimulationError
-from sumo_ayss.paths import portable_path
 from sumo_ayss.replay.playback import (
     GUI_FILE,
     NET_FILE,
@@ -45,6 +41,10 @@ from sumo_ayss.run_folder import (
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.sim import export
 from sumo_ayss.sim.network import network_path
+from sumo_ayss.util.atomic import atomic_copy, atomic_write_text
+from sumo_ayss.util.errors import CheckpointError, ConfigError, SimulationError
+from sumo_ayss.util.paths import portable_path
+from sumo_ayss.vuts.catalog import controller_imports, vtypes_xml
 
 __all__ = ["ExportResult", "export_scenario"]
 

@@ -34,19 +34,19 @@ from typing import Any
 
 import numpy as np
 
-from sumo_ayss.atomic import atomic_write_text, atomic_write_with
-from sumo_ayss.catalog import controller_imports
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.errors import ConfigError, SimulationError
-from sumo_ayss.paths import portable_path
 from sumo_ayss.replay.record import Kind, _initial_condition, _load_policy, _row
 from sumo_ayss.run_folder import read_run
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.scenarios.trajectory import body_width_m, trajectory_from_infos
 from sumo_ayss.sim.network import network_path
+from sumo_ayss.util.atomic import atomic_write_text, atomic_write_with
+from sumo_ayss.util.errors import ConfigError, SimulationError
+from sumo_ayss.util.paths import portable_path
+from sumo_ayss.vuts.catalog import controller_imports
 
 __all__ = ["OVERHANG_M", "XODR_FILE", "XOSC_FILE", "XoscResult", "export_xosc"]
 

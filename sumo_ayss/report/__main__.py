@@ -19,10 +19,10 @@ from pathlib import Path
 
 from sumo_ayss.cli import prog
 from sumo_ayss.config import check_out_dir
-from sumo_ayss.errors import AyssError
 from sumo_ayss.report.checks import input_problems
 from sumo_ayss.report.document import DEFAULT_TITLE, ReportOptions, load_runs, write_report_for
 from sumo_ayss.report.load import analyse_runs
+from sumo_ayss.util.errors import AyssError
 
 #: ``--strict``'s help, also quoted by ``rank --strict``.
 STRICT_HELP = (

@@ -28,7 +28,6 @@ from pathlib import Path
 from sumo_ayss.analysis.case import CaseAnalysis, analyse_case, vut_safety_index
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
 from sumo_ayss.config.report import ReportOptions
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.modes import get_mode
 from sumo_ayss.modes.paper import significance_rule
 from sumo_ayss.report.blocks import (
@@ -50,6 +49,7 @@ from sumo_ayss.report.sections.case import case_blocks, verdict_lines
 from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.inputs import inputs_blocks
 from sumo_ayss.run_folder import CONFIG_YAML, RunRecord, find_run_dirs, read_run
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
     "DEFAULT_TITLE",
@@ -265,7 +265,7 @@ def write_report_for(
         logger.warning("%s", warning)
     report = build_report(runs, out_dir, title=title, options=options, analyses=analyses)
     html_path = out_dir / HTML_NAME
-    from sumo_ayss.atomic import atomic_write_text
+    from sumo_ayss.util.atomic import atomic_write_text
 
     atomic_write_text(html_path, render_html(report))
     atomic_write_text(out_dir / MARKDOWN_NAME, render_markdown(report, out_dir))

@@ -94,7 +94,7 @@ def style() -> Iterator[None]:
 
 
 def save(fig: Figure, path: Path) -> Path:
-    from sumo_ayss.atomic import atomic_write_with
+    from sumo_ayss.util.atomic import atomic_write_with
 
     # A bare Figure renders PNG with Agg; no pyplot state. Atomic: a reader never sees half.
     atomic_write_with(path, lambda tmp: fig.savefig(tmp, dpi=DPI))

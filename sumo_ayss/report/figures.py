@@ -102,7 +102,7 @@ def _draw_reward_shapes(cfg: RewardConfig, path: Path) -> Path:
         "and ends the episode",
         fontsize=10,
     )
-    from sumo_ayss.atomic import atomic_write_with
+    from sumo_ayss.util.atomic import atomic_write_with
 
     atomic_write_with(path, lambda tmp: fig.savefig(tmp, dpi=120))
     return path

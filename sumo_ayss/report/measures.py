@@ -30,9 +30,9 @@ from sumo_ayss.analysis.measure_ranking import (
     measure_rankings,
     r157_rows,
 )
-from sumo_ayss.errors import AyssError
 from sumo_ayss.modes import CROSSPLAY, EXPOSURE
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, StudyFolder, read_table, write_measures_csv
+from sumo_ayss.util.errors import AyssError
 
 __all__ = ["CaseMeasures", "case_measures", "write_measures"]
 

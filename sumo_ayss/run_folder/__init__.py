@@ -47,7 +47,7 @@ that record is handed on; a case's cross-play table is read by :func:`load_cross
 Whether a stage is done with the inputs asked for now is one contract for every stage
 (:mod:`.stage`: :func:`fingerprint`, :class:`Stage`, :func:`is_done`).
 
-Every file is written atomically (:mod:`sumo_ayss.atomic`). No other module spells one of
+Every file is written atomically (:mod:`sumo_ayss.util.atomic`). No other module spells one of
 these names or parses one of these files. Imports neither SUMO nor torch.
 """
 

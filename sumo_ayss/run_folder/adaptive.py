@@ -1,6 +1,6 @@
 """``<out>/<case>/adaptive.json``: the looks of adaptive seeding at one case, and its seeds.
 
-Written by the pipeline after every look (:mod:`sumo_ayss.adaptive`); read by the pipeline
+Written by the pipeline after every look (:mod:`sumo_ayss.grid.adaptive`); read by the pipeline
 when it resumes (the seeds already added are part of the grid) and by ``rank --no-run``.
 The statistics of a look are :class:`sumo_ayss.analysis.sequential.SettleCheck`; this module
 stores them as plain records.
@@ -14,8 +14,8 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.errors import TableError
 from sumo_ayss.run_folder.jsonio import read_json, write_json
+from sumo_ayss.util.errors import TableError
 
 __all__ = ["ADAPTIVE_FORMAT", "AdaptiveLook", "AdaptiveRecord", "read_adaptive", "write_adaptive"]
 

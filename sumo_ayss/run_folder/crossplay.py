@@ -31,11 +31,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from sumo_ayss.errors import ConfigError, TableError
 from sumo_ayss.run_folder.jsonio import read_json, write_json
 from sumo_ayss.run_folder.layout import CaseFolder
 from sumo_ayss.run_folder.schemas import CROSSPLAY_SCHEMA
 from sumo_ayss.run_folder.table import read_table
+from sumo_ayss.util.errors import ConfigError, TableError
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.crossplay import CrossplayInput, CrossplayMatrix

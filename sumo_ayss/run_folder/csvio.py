@@ -14,8 +14,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.atomic import atomic_write_text
-from sumo_ayss.errors import TableError
+from sumo_ayss.util.atomic import atomic_write_text
+from sumo_ayss.util.errors import TableError
 
 __all__ = ["read_csv_rows", "write_csv_rows"]
 

@@ -15,11 +15,11 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.atomic import atomic_write_json
-from sumo_ayss.errors import TableError
 from sumo_ayss.run_folder.csvio import write_csv_rows
 from sumo_ayss.run_folder.jsonio import read_json
 from sumo_ayss.run_folder.layout import CaseFolder
+from sumo_ayss.util.atomic import atomic_write_json
+from sumo_ayss.util.errors import TableError
 
 __all__ = [
     "DISCRIMINABILITY_COLUMNS",

@@ -27,8 +27,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.atomic import atomic_write_text
-from sumo_ayss.errors import CheckpointError
+from sumo_ayss.util.atomic import atomic_write_text
+from sumo_ayss.util.errors import CheckpointError
 
 __all__ = ["EVAL_COLUMNS", "read_eval_rows", "read_eval_table", "write_eval_table"]
 

@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from sumo_ayss.atomic import atomic_write_text
-from sumo_ayss.errors import TableError
+from sumo_ayss.util.atomic import atomic_write_text
+from sumo_ayss.util.errors import TableError
 
 __all__ = ["read_json", "write_json"]
 

@@ -11,7 +11,7 @@
 ``progress.json``           :func:`write_progress` / :func:`read_progress`
 ==========================  =============================================================
 
-Readers raise :class:`~sumo_ayss.errors.CheckpointError` naming the file and the field;
+Readers raise :class:`~sumo_ayss.util.errors.CheckpointError` naming the file and the field;
 callers that tolerate a missing or broken file (the report, the progress display) catch it.
 Imports neither SUMO nor torch.
 """
@@ -29,10 +29,10 @@ from typing import Any
 
 import yaml
 
-from sumo_ayss.atomic import atomic_write_json, atomic_write_text
 from sumo_ayss.config import EnvConfig, check_seed, safe_load_yaml, write_yaml
-from sumo_ayss.errors import CheckpointError, ConfigError
 from sumo_ayss.run_folder.layout import PROGRESS_JSON
+from sumo_ayss.util.atomic import atomic_write_json, atomic_write_text
+from sumo_ayss.util.errors import CheckpointError, ConfigError
 
 __all__ = [
     "RunConfig",
@@ -244,7 +244,7 @@ def write_spcp(path: Path, selection: Any, checkpoint: str, row: Mapping[str, An
 
     Args:
         path: ``<run>/spcp.json``.
-        selection: A :class:`sumo_ayss.selection.Selection` (a dataclass).
+        selection: A :class:`sumo_ayss.training.selection.Selection` (a dataclass).
         checkpoint: The candidate's model, relative to the run folder.
         row: The candidate's ``eval.csv`` row.
     """

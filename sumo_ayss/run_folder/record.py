@@ -9,7 +9,7 @@ analysis needs), replay and the scripts. No other module builds its own view of 
 Reading never raises for a missing or unreadable file: the field stays None and
 :attr:`RunRecord.problems` gets a sentence naming the file, so a report on a run that has
 not been evaluated yet says what is missing. A stage that cannot do without a file asks the
-record for it and gets a :class:`~sumo_ayss.errors.CheckpointError` naming the file
+record for it and gets a :class:`~sumo_ayss.util.errors.CheckpointError` naming the file
 (:attr:`RunRecord.experiment`).
 
 Imports neither SUMO nor torch; the harm reduction (:mod:`sumo_ayss.analysis.harm`, numpy
@@ -33,7 +33,6 @@ from numpy.typing import NDArray
 
 from sumo_ayss.cases import case_of_indicator
 from sumo_ayss.config import EnvConfig, ExperimentConfig, RewardConfig, build, experiment_from_dict
-from sumo_ayss.errors import AyssError, CheckpointError, ConfigError
 from sumo_ayss.run_folder.eval_table import read_eval_rows
 from sumo_ayss.run_folder.layout import AYSS_CSV, CONFIG_YAML, EVAL_CSV, RunFolder, seed_of_dir
 from sumo_ayss.run_folder.metadata import RunConfig, SpcpChoice, read_run_config, read_spcp
@@ -41,6 +40,7 @@ from sumo_ayss.run_folder.metadata import read_versions as _read_versions
 from sumo_ayss.run_folder.schemas import AYSS_SCHEMA, OUTCOME_SCHEMA
 from sumo_ayss.run_folder.summaries import Outcome, OutcomeRecord, read_outcome_json
 from sumo_ayss.run_folder.table import Table, read_table
+from sumo_ayss.util.errors import AyssError, CheckpointError, ConfigError
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.harm import EpisodeStats, HarmScale

@@ -38,14 +38,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from sumo_ayss.atomic import atomic_write_json
 from sumo_ayss.config import AyssConfig, EnvConfig, ExperimentConfig, experiment_from_dict, to_dict
-from sumo_ayss.errors import CheckpointError, ConfigError, TableError
 from sumo_ayss.run_folder.crossplay import CrossplayRecord, read_crossplay_json
 from sumo_ayss.run_folder.discriminability import read_discriminability_json
 from sumo_ayss.run_folder.layout import CaseFolder, RunFolder
 from sumo_ayss.run_folder.metadata import read_json_object, read_run_config
 from sumo_ayss.run_folder.summaries import read_ayss_json, read_outcome_json
+from sumo_ayss.util.atomic import atomic_write_json
+from sumo_ayss.util.errors import CheckpointError, ConfigError, TableError
 
 __all__ = [
     "DISPLAY_FIELDS",

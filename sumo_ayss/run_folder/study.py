@@ -30,11 +30,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.atomic import atomic_write_json
-from sumo_ayss.errors import TableError
 from sumo_ayss.run_folder.csvio import read_csv_rows, write_csv_rows
 from sumo_ayss.run_folder.jsonio import read_json
 from sumo_ayss.run_folder.layout import CaseFolder, case_dir_for
+from sumo_ayss.util.atomic import atomic_write_json
+from sumo_ayss.util.errors import TableError
 
 __all__ = [
     "MEASURES_COLUMNS",

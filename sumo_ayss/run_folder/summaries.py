@@ -32,8 +32,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.errors import TableError
 from sumo_ayss.run_folder.jsonio import read_json, write_json
+from sumo_ayss.util.errors import TableError
 
 __all__ = [
     "AyssRecord",

@@ -14,7 +14,7 @@ Every column has a name, a dtype, a unit and a meaning (:class:`Column`);
 :func:`write_table` writes atomically (temporary file in the same folder, then
 :func:`os.replace`), so a reader never sees half a table. :func:`read_table` checks the header
 (missing and extra columns), every cell's dtype, NaN / inf where they are not allowed, and
-the choices, and raises :class:`~sumo_ayss.errors.TableError` naming the file, column and row.
+the choices, and raises :class:`~sumo_ayss.util.errors.TableError` naming the file, column and row.
 
 The schemas of the run folder's tables are in :mod:`sumo_ayss.run_folder.schemas`.
 """
@@ -32,8 +32,8 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from sumo_ayss.atomic import atomic_write_text
-from sumo_ayss.errors import TableError
+from sumo_ayss.util.atomic import atomic_write_text
+from sumo_ayss.util.errors import TableError
 
 __all__ = [
     "Column",

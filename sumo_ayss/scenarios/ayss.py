@@ -56,7 +56,6 @@ from sumo_ayss.envs.car_following import target_speed_mps as cf_target_speed_mps
 from sumo_ayss.envs.cut_in import LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.errors import ActionError, SimulationError
 from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     INDICATOR_ACCEL,
@@ -66,6 +65,7 @@ from sumo_ayss.run_folder import (
 from sumo_ayss.scenarios.outcome import MeanInterval
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.sim.actuator import pov_acceleration
+from sumo_ayss.util.errors import ActionError, SimulationError
 
 __all__ = [
     "INDICATOR_ACCEL",

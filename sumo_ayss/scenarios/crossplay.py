@@ -42,9 +42,9 @@ from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.errors import ConfigError, DiagonalMismatchError
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, DiagonalCheck, Table, table_from_rows
 from sumo_ayss.scenarios.rollout import Policy, run_episodes
+from sumo_ayss.util.errors import ConfigError, DiagonalMismatchError
 
 __all__ = ["DIAGONAL_COLUMNS", "Opponent", "check_diagonal", "diagonal_check", "run_crossplay"]
 

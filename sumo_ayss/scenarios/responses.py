@@ -7,7 +7,7 @@ back: the VUT's speed change over those SUMO steps divided by their duration [m/
 (SUMO's ``vehicle.getAcceleration`` of each step, averaged; for one step it *is* the speed
 change over the step length). Because it is the env's own code, placement, SUMO options,
 the cut-in's lane-change motion and user-controller VUTs (driven through
-:class:`~sumo_ayss.controllers.ControlledVut`, as in training) are exactly those of the
+:class:`~sumo_ayss.vuts.controllers.ControlledVut`, as in training) are exactly those of the
 training and evaluation episodes.
 
 What the POV does while the response is measured (``RESPONSE_ACTION`` of the case's env
@@ -47,7 +47,7 @@ from sumo_ayss.cases import get_case
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.vec_env import PairVecEnv
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 __all__ = ["DEFAULT_N_PAIRS", "VutResponses", "measure_responses"]
 

@@ -28,8 +28,8 @@ from typing import Any
 import numpy as np
 
 from sumo_ayss.analysis.safety_measures import EpisodeMeasures, PairTrajectory, episode_measures
-from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config import EnvConfig
+from sumo_ayss.vuts.catalog import VehicleType
 
 __all__ = ["SUMO_DEFAULT_WIDTH_M", "body_width_m", "measures_of", "trajectory_from_infos"]
 

@@ -34,11 +34,11 @@ from xml.sax.saxutils import quoteattr
 
 import libsumo
 
-from sumo_ayss.atomic import atomic_write_text
 from sumo_ayss.config import SimConfig
-from sumo_ayss.errors import SimulationError
 from sumo_ayss.sim.network import sumo_binary, sumo_home
 from sumo_ayss.sim.session import SUMO_ERRORS
+from sumo_ayss.util.atomic import atomic_write_text
+from sumo_ayss.util.errors import SimulationError
 
 __all__ = [
     "INSERTION_POS_M",

@@ -14,9 +14,9 @@ from pathlib import Path
 
 from sumo_ayss.cases import ROAD_EDGE as ROAD_EDGE  # the only edge of every built-in network
 from sumo_ayss.cases import get_case, registered_cases
-from sumo_ayss.catalog import BUILTIN_VUTS, POV_TYPE, vtypes_xml
 from sumo_ayss.config import PROJECT_ROOT, Case
-from sumo_ayss.errors import SimulationError
+from sumo_ayss.util.errors import SimulationError
+from sumo_ayss.vuts.catalog import BUILTIN_VUTS, POV_TYPE, vtypes_xml
 
 NETWORK_DIR = PROJECT_ROOT / "networks"
 

@@ -22,8 +22,8 @@ from typing import NamedTuple
 import libsumo
 from libsumo import _libsumo
 
-from sumo_ayss.errors import SimulationError
 from sumo_ayss.sim.session import SUMO_ERRORS, SumoSession
+from sumo_ayss.util.errors import SimulationError
 
 # Hot-path getters bound once to libsumo's compiled functions. The public ``libsumo.vehicle``
 # methods are Python wrappers around these; in a 30 µs step the wrapper calls and attribute
@@ -323,7 +323,7 @@ class VehiclePair:
 
         From now on the VUT drives exactly the speed given to :meth:`command_vut_speed`
         before each step: no safe-speed, acceleration, deceleration or speed-limit check.
-        Its limits are the controller's (:mod:`sumo_ayss.controllers`). Call after
+        Its limits are the controller's (:mod:`sumo_ayss.vuts.controllers`). Call after
         :meth:`place`, before the episode's first step.
         """
         try:

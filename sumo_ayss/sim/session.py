@@ -17,10 +17,10 @@ from typing import Any, ClassVar
 import libsumo
 from libsumo import _libsumo
 
-from sumo_ayss.catalog import VehicleType, vtypes_xml
 from sumo_ayss.config import SimConfig
-from sumo_ayss.errors import SimulationError
 from sumo_ayss.sim.network import sumo_binary
+from sumo_ayss.util.errors import SimulationError
+from sumo_ayss.vuts.catalog import VehicleType, vtypes_xml
 
 logger = logging.getLogger(__name__)
 

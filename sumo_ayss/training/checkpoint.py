@@ -26,8 +26,6 @@ from stable_baselines3.common.vec_env import VecEnv
 
 from sumo_ayss.agents.dqn import AyssDQN
 from sumo_ayss.agents.weights import read_policy_state
-from sumo_ayss.atomic import atomic_write_with, remove_stale_temporaries
-from sumo_ayss.errors import CheckpointError
 from sumo_ayss.run_folder import (
     CHECKPOINTS_DIR,
     LATEST_JSON,
@@ -40,6 +38,8 @@ from sumo_ayss.run_folder import (
     read_latest,
     write_checkpoint_state,
 )
+from sumo_ayss.util.atomic import atomic_write_with, remove_stale_temporaries
+from sumo_ayss.util.errors import CheckpointError
 
 logger = logging.getLogger(__name__)
 

@@ -10,9 +10,9 @@ stored and requested value.
 from __future__ import annotations
 
 from sumo_ayss.config import ExperimentConfig, to_dict
-from sumo_ayss.errors import CheckpointError
 from sumo_ayss.run_folder import RunFolder, stored_experiment
 from sumo_ayss.run_folder.stage import DISPLAY_FIELDS, flat_config
+from sumo_ayss.util.errors import CheckpointError
 
 __all__ = ["check_same_config", "config_differences"]
 

@@ -13,7 +13,6 @@ from collections.abc import Sequence
 from importlib import metadata
 
 from sumo_ayss.config import ExperimentConfig
-from sumo_ayss.paths import portable_python
 from sumo_ayss.run_folder import (
     RunConfig,
     RunFolder,
@@ -23,6 +22,7 @@ from sumo_ayss.run_folder import (
     write_seeds,
     write_versions,
 )
+from sumo_ayss.util.paths import portable_python
 
 #: The training entry point, as ``command.txt`` names it (``python -m <this>``).
 ENTRY_MODULE = "sumo_ayss.train"

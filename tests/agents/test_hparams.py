@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from sumo_ayss.agents.hparams import DQNHyperParams
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 
 def test_defaults_are_the_papers() -> None:

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from stable_baselines3.common.utils import set_random_seed  # seeds numpy's global RNG
 
 from sumo_ayss.agents.replay import PrioritizedReplayBuffer, SumTree
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 OBS_SPACE = spaces.Box(-1e6, 1e6, (2,), np.float32)
 ACT_SPACE = spaces.Discrete(4)

@@ -12,7 +12,7 @@ from sumo_ayss.agents.greedy import GreedyPolicy
 from sumo_ayss.agents.hparams import DQNHyperParams
 from sumo_ayss.agents.weights import load_greedy_policy
 from sumo_ayss.envs.cut_in import CutInEnv
-from sumo_ayss.errors import CheckpointError
+from sumo_ayss.util.errors import CheckpointError
 
 
 @pytest.mark.parametrize("dueling", [True, False], ids=["dueling", "plain"])

@@ -10,8 +10,8 @@ import pytest
 
 from sumo_ayss.analysis.crossplay import crossplay_matrix, rank_crossplay
 from sumo_ayss.analysis.seeds import compare_seeds, kendall_tau
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.modes.crossplay import crossplay_sentence
+from sumo_ayss.util.errors import ConfigError
 
 VUTS = ("v0", "v1", "v2", "v3")
 

@@ -15,7 +15,7 @@ from sumo_ayss.analysis.discriminability import (
     differ_mask,
     lowest_differing_headway,
 )
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 
 def test_differ_mask_is_strictly_above_threshold() -> None:

@@ -24,7 +24,7 @@ from sumo_ayss.analysis.harm import (
 )
 from sumo_ayss.analysis.seeds import compare_seeds
 from sumo_ayss.config import PROJECT_ROOT
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 MAX_PAY = 25.0  # alpha_A = 1, 25 decisions
 ALPHA_C = 10.0

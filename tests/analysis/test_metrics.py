@@ -15,7 +15,7 @@ from sumo_ayss.analysis.metrics import (
     time_to_collision,
     ttc_longitudinal,
 )
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 coord = st.floats(-200.0, 200.0, allow_nan=False, allow_infinity=False)
 speed = st.floats(-50.0, 50.0, allow_nan=False, allow_infinity=False)

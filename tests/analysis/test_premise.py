@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from sumo_ayss.analysis.premise import premise_check
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 
 def test_equal_outcomes_meet_the_premise():

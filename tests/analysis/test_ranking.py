@@ -17,7 +17,7 @@ from sumo_ayss.analysis.ranking import (
     rank,
     safety_index,
 )
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 from tests.helpers import loaded_among
 
 

@@ -19,7 +19,7 @@ from sumo_ayss.analysis.safety_measures import (
     intrusion,
     ttc_2d,
 )
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 
 def traj(**kw: object) -> PairTrajectory:

@@ -16,7 +16,7 @@ from sumo_ayss.analysis.seed_intervals import (
     seed_mean_ci,
 )
 from sumo_ayss.analysis.seeds import SeedScores, rank_seeds
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 
 def test_two_seeds_give_no_interval_and_say_so() -> None:

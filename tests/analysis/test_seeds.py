@@ -9,7 +9,7 @@ import pytest
 
 from sumo_ayss.analysis.seeds import SeedScores, compare_seeds, kendall_tau, rank_seeds
 from sumo_ayss.analysis.stats import welch_t_test
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 SEEDS = (0, 1, 2)
 

@@ -15,7 +15,7 @@ from sumo_ayss.analysis.sequential import (
     omnibus_p,
     settle_check,
 )
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 LOOKS = (4, 5, 6)
 

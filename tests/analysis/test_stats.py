@@ -17,7 +17,7 @@ from sumo_ayss.analysis.stats import (
     t_quantile,
     welch_t_test,
 )
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 # --------------------------------------------------------------------------- t quantile
 

@@ -33,8 +33,8 @@ from sumo_ayss.config import (
     PipelineConfig,
     SimConfig,
 )
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.run_folder import AYSS_SCHEMA, RunFolder, Table, write_table
+from sumo_ayss.util.errors import ConfigError
 
 BUILTIN = ("car_following", "cut_in")
 
@@ -93,8 +93,8 @@ def test_the_case_package_is_a_leaf() -> None:
         "sumo_ayss.cases.car_following",
         "sumo_ayss.cases.cut_in",
         "sumo_ayss.cases.registry",
-        "sumo_ayss.errors",
-        "sumo_ayss.validation",
+        "sumo_ayss.util.errors",
+        "sumo_ayss.util.validation",
     }
 
 

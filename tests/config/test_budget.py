@@ -9,9 +9,9 @@ import yaml
 
 from sumo_ayss.config import load_pipeline
 from sumo_ayss.config.budget import BUDGETS, DEFAULT_BUDGET
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.paths import PROJECT_ROOT
 from sumo_ayss.pipeline import plan_jobs
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.util.paths import PROJECT_ROOT
 
 
 def _yaml(tmp_path: Path, **data: object) -> Path:

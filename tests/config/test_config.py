@@ -6,7 +6,6 @@ from pathlib import Path
 
 import pytest
 
-from sumo_ayss.catalog import BUILTIN_VUTS
 from sumo_ayss.config import (
     EnvConfig,
     OddConfig,
@@ -14,7 +13,8 @@ from sumo_ayss.config import (
     read_yaml,
     to_dict,
 )
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.vuts.catalog import BUILTIN_VUTS
 
 
 def test_defaults_are_the_paper() -> None:

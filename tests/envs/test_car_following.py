@@ -13,7 +13,7 @@ import sumo_ayss  # noqa: F401  (registers the env ids)
 from sumo_ayss.config import EnvConfig, OddConfig
 from sumo_ayss.envs.car_following import N_ACTIONS, CarFollowingEnv, target_speed_mps
 from sumo_ayss.envs.odd import InitialCondition
-from sumo_ayss.errors import ActionError
+from sumo_ayss.util.errors import ActionError
 
 pytestmark = pytest.mark.sumo
 

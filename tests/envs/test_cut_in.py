@@ -35,8 +35,8 @@ from sumo_ayss.envs.cut_in import (
 )
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.rewards import adversarial_reward
-from sumo_ayss.errors import ActionError
 from sumo_ayss.sim.network import LANE_WIDTH_M, SPEED_LIMIT_MPS
+from sumo_ayss.util.errors import ActionError
 
 pytestmark = pytest.mark.sumo
 

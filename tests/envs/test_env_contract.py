@@ -12,12 +12,12 @@ import gc
 import numpy as np
 import pytest
 
-from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.cut_in import CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
+from sumo_ayss.vuts.catalog import VehicleType
 
 pytestmark = pytest.mark.sumo
 

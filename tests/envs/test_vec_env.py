@@ -30,7 +30,6 @@ from sumo_ayss.envs import make_env
 from sumo_ayss.envs.cut_in import LANE_CHANGE
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
 from sumo_ayss.envs.vec_env import PairVecEnv
-from sumo_ayss.errors import ActionError, ConfigError
 from sumo_ayss.run_folder import read_eval_table
 from sumo_ayss.scenarios.rollout import run_episodes
 from sumo_ayss.sim.network import (
@@ -40,6 +39,7 @@ from sumo_ayss.sim.network import (
     parallel_road_edge,
 )
 from sumo_ayss.train import Trainer, evaluate_on_vec, hparams_for_n_envs, train
+from sumo_ayss.util.errors import ActionError, ConfigError
 from tests.helpers import TINY_AGENT
 
 pytestmark = pytest.mark.sumo

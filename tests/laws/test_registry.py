@@ -9,9 +9,7 @@ from pathlib import Path
 import pytest
 
 from examples.acc_controller import TimeGapACC
-from sumo_ayss.catalog import BUILTIN_VUTS, ControllerSpec, VehicleType
 from sumo_ayss.config import ActuatorConfig, ActuatorMode, EnvConfig
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.hwenv_laws import HIGHWAY_ENV_IDM_TARGET, HighwayEnvIDM
 from sumo_ayss.laws import build_laws
 from sumo_ayss.laws.clipped import ClippedPov
@@ -19,6 +17,8 @@ from sumo_ayss.laws.controller import ControllerVut
 from sumo_ayss.laws.highway_env import HighwayEnvIdmVut, HighwayEnvPovLaw
 from sumo_ayss.laws.registry import INTEGRATED_CONTROLLERS, POV_LAWS
 from sumo_ayss.laws.sumo_model import SumoModelVut
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.vuts.catalog import BUILTIN_VUTS, ControllerSpec, VehicleType
 
 ACC = VehicleType(
     controller=ControllerSpec("examples.acc_controller:TimeGapACC", 3.0, 6.0, params={})
@@ -89,7 +89,7 @@ ENVS = Path(__file__).resolve().parents[2] / "sumo_ayss" / "envs"
 def test_the_envs_know_no_law_by_name() -> None:
     """The envs import the laws' interface only: no law module, no highway-env law, no
     controller, no actuator math; and they check no law's type."""
-    forbidden = ("sumo_ayss.hwenv", "sumo_ayss.controllers", "sumo_ayss.sim.actuator")
+    forbidden = ("sumo_ayss.hwenv", "sumo_ayss.vuts.controllers", "sumo_ayss.sim.actuator")
     for path in sorted(ENVS.glob("*.py")):
         tree = ast.parse(path.read_text(encoding="utf-8"))
         for node in ast.walk(tree):

@@ -9,7 +9,6 @@ import sys
 import pytest
 
 from sumo_ayss.config.report import ReportOptions
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.modes import (
     CROSSPLAY,
     DEFAULT_MODE,
@@ -21,6 +20,7 @@ from sumo_ayss.modes import (
     unregister_mode,
 )
 from sumo_ayss.rank import analyse, ranking_rows
+from sumo_ayss.util.errors import ConfigError
 from tests.report.test_report import make_run
 
 

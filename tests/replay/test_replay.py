@@ -20,7 +20,6 @@ import pytest
 import yaml
 
 from sumo_ayss.config import AyssConfig, load_experiment
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.evaluate import evaluate_run
 from sumo_ayss.replay import (
     POSITION_TOL_M,
@@ -32,6 +31,7 @@ from sumo_ayss.replay import (
 from sumo_ayss.run_folder import AYSS_SCHEMA, OUTCOME_SCHEMA, read_table
 from sumo_ayss.sim.export import read_fcd
 from sumo_ayss.train import train
+from sumo_ayss.util.errors import ConfigError
 from tests.helpers import tiny_experiment
 
 pytestmark = pytest.mark.sumo

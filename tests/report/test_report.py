@@ -16,7 +16,6 @@ import pytest
 from sumo_ayss.analysis.crossplay import CrossplayGap
 from sumo_ayss.analysis.ranking import POV_ACCELERATION, SafetyIndex
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
-from sumo_ayss.catalog import BUILTIN_VUTS
 from sumo_ayss.config import RewardConfig, to_dict
 from sumo_ayss.modes import headline_text
 from sumo_ayss.modes.crossplay import crossplay_gap_text
@@ -51,7 +50,8 @@ from sumo_ayss.run_folder import (
     write_versions,
 )
 from sumo_ayss.scenarios.outcome import MeanInterval, OutcomeSummary, Proportion
-from sumo_ayss.selection import Selection
+from sumo_ayss.training.selection import Selection
+from sumo_ayss.vuts.catalog import BUILTIN_VUTS
 from tests.helpers import modules_loaded_by
 
 #: Mean indicator offset per VUT: pi2's SPCPs are clearly more aggressive (more negative).

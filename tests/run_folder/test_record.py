@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from sumo_ayss.errors import CheckpointError
 from sumo_ayss.run_folder import OUTCOME_CSV, RunRecord, read_run
+from sumo_ayss.util.errors import CheckpointError
 from tests.report.test_report import make_run
 
 

@@ -12,9 +12,7 @@ import pytest
 import yaml
 
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
-from sumo_ayss.catalog import BUILTIN_VUTS
 from sumo_ayss.config import RewardConfig, to_dict
-from sumo_ayss.errors import CheckpointError, TableError
 from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     CROSSPLAY_SCHEMA,
@@ -61,7 +59,9 @@ from sumo_ayss.run_folder import (
     write_versions,
 )
 from sumo_ayss.scenarios.outcome import MeanInterval, OutcomeSummary, Proportion
-from sumo_ayss.selection import Selection
+from sumo_ayss.training.selection import Selection
+from sumo_ayss.util.errors import CheckpointError, TableError
+from sumo_ayss.vuts.catalog import BUILTIN_VUTS
 from tests.helpers import loaded_among
 
 

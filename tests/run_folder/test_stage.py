@@ -12,7 +12,6 @@ import pytest
 from sumo_ayss import discriminability as disc
 from sumo_ayss.analysis.discriminability import BoxGrid
 from sumo_ayss.config import AyssConfig, EnvConfig, ExperimentConfig, TrainConfig, load_pipeline
-from sumo_ayss.errors import CheckpointError, TableError
 from sumo_ayss.run_folder import (
     AyssStage,
     CaseFolder,
@@ -35,6 +34,7 @@ from sumo_ayss.run_folder import (
     write_outcome_json,
 )
 from sumo_ayss.training.run_metadata import write_metadata
+from sumo_ayss.util.errors import CheckpointError, TableError
 
 ROOT = Path(__file__).resolve().parents[2]
 

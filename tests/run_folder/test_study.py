@@ -8,7 +8,6 @@ from pathlib import Path
 
 import pytest
 
-from sumo_ayss.errors import TableError
 from sumo_ayss.run_folder import (
     MEASURES_COLUMNS,
     RANKING_COLUMNS,
@@ -27,6 +26,7 @@ from sumo_ayss.run_folder import (
     write_pipeline_json,
     write_ranking_csv,
 )
+from sumo_ayss.util.errors import TableError
 
 ROOT = Path(__file__).resolve().parents[2]
 

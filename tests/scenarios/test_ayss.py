@@ -13,7 +13,6 @@ from sumo_ayss.config import ActuatorConfig, AyssConfig
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.cut_in import FIRST_SPEED_ACTION, LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
-from sumo_ayss.errors import ActionError, ConfigError
 from sumo_ayss.run_folder import AYSS_SCHEMA, read_table, write_table
 from sumo_ayss.scenarios.ayss import (
     car_following_indicator,
@@ -24,6 +23,7 @@ from sumo_ayss.scenarios.ayss import (
     ttc_s,
 )
 from sumo_ayss.sim.actuator import pov_acceleration
+from sumo_ayss.util.errors import ActionError, ConfigError
 
 # --------------------------------------------------------------------------- hand cases
 

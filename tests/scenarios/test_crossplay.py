@@ -13,7 +13,6 @@ import yaml
 from sumo_ayss.config import AyssConfig, EnvConfig, OddConfig, load_experiment
 from sumo_ayss.crossplay import main, read_matrix
 from sumo_ayss.envs.car_following import CarFollowingEnv
-from sumo_ayss.errors import CheckpointError, ConfigError, DiagonalMismatchError
 from sumo_ayss.evaluate import evaluate_run
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, read_run, table_from_rows
 from sumo_ayss.scenarios.crossplay import (
@@ -25,6 +24,7 @@ from sumo_ayss.scenarios.crossplay import (
 )
 from sumo_ayss.scenarios.outcome import run_outcome
 from sumo_ayss.train import train
+from sumo_ayss.util.errors import CheckpointError, ConfigError, DiagonalMismatchError
 from tests.helpers import tiny_experiment
 from tests.scenarios.test_outcome import BRAKE, HOLD, constant
 

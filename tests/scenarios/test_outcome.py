@@ -16,7 +16,6 @@ from sumo_ayss.analysis.stats import wilson_interval
 from sumo_ayss.config import AyssConfig, load_experiment
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.odd import sample_initial_conditions
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.evaluate import evaluate_run, main
 from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
@@ -32,6 +31,7 @@ from sumo_ayss.scenarios.outcome import (
 )
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.train import train
+from sumo_ayss.util.errors import ConfigError
 from tests.helpers import tiny_experiment
 
 #: Car-following actions: k = 0 asks for a stop (target 0), k = 2 holds the POV's speed.

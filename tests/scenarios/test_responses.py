@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 from examples.acc_controller import TimeGapACC
-from sumo_ayss.catalog import ControllerSpec, VehicleType
 from sumo_ayss.config import PROJECT_ROOT, EnvConfig, load_experiment
-from sumo_ayss.controllers import ControllerInput, bound_acceleration, commanded_speed
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.odd import InitialCondition
-from sumo_ayss.errors import ConfigError
 from sumo_ayss.scenarios.responses import measure_responses
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
+from sumo_ayss.vuts.controllers import ControllerInput, bound_acceleration, commanded_speed
 
 pytestmark = pytest.mark.sumo
 

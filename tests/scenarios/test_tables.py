@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
-from sumo_ayss.errors import AyssError, TableError
 from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     OUTCOME_SCHEMA,
@@ -22,6 +21,7 @@ from sumo_ayss.run_folder import (
     write_json,
     write_table,
 )
+from sumo_ayss.util.errors import AyssError, TableError
 
 
 def outcome_rows() -> list[dict[str, object]]:

@@ -17,12 +17,12 @@ import libsumo
 import pytest
 import sumo
 
-from sumo_ayss.catalog import VehicleType
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.vec_env import PairVecEnv
 from sumo_ayss.sim.network import network_path
+from sumo_ayss.vuts.catalog import VehicleType
 
 pytestmark = pytest.mark.sumo
 

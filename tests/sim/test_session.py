@@ -8,7 +8,7 @@ import pytest
 
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.car_following import CarFollowingEnv
-from sumo_ayss.errors import ConfigError, SimulationError
+from sumo_ayss.util.errors import ConfigError, SimulationError
 
 pytestmark = pytest.mark.sumo
 

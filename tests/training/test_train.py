@@ -15,10 +15,10 @@ import pytest
 import yaml
 
 from sumo_ayss.config import load_experiment
-from sumo_ayss.errors import CheckpointError
 from sumo_ayss.run_folder import read_eval_table
-from sumo_ayss.selection import select_spcp
 from sumo_ayss.train import train
+from sumo_ayss.training.selection import select_spcp
+from sumo_ayss.util.errors import CheckpointError
 from tests.helpers import TINY_AGENT
 
 pytestmark = pytest.mark.sumo

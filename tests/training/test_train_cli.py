@@ -15,10 +15,10 @@ from pathlib import Path
 import pytest
 
 from sumo_ayss.config import ExperimentConfig, to_dict
-from sumo_ayss.errors import CheckpointError
 from sumo_ayss.run_folder import RunConfig, RunFolder, write_run_config
 from sumo_ayss.train import main
 from sumo_ayss.training.config_check import check_same_config, config_differences
+from sumo_ayss.util.errors import CheckpointError
 from tests.training.test_train import tiny_config
 
 

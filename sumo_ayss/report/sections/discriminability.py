@@ -24,11 +24,11 @@ from matplotlib.figure import Figure
 
 from sumo_ayss.analysis.discriminability import PairDiscriminability
 from sumo_ayss.cases import case_info
-from sumo_ayss.errors import TableError
 from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.report import figstyle
 from sumo_ayss.report.blocks import Block, FigureBlock, Heading, Paragraph, Table
 from sumo_ayss.run_folder import CaseFolder, read_discriminability_json
+from sumo_ayss.util.errors import TableError
 
 logger = logging.getLogger(__name__)
 

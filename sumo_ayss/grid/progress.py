@@ -26,8 +26,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
-from sumo_ayss.errors import CheckpointError
 from sumo_ayss.run_folder import RunFolder, read_eval_rows, read_latest, read_progress
+from sumo_ayss.util.errors import CheckpointError
 
 STATES = ("queued", "running", "done", "failed", "interrupted", "cancelled")
 
@@ -47,7 +47,7 @@ class JobStatus:
     """What the pipeline knows about one job.
 
     Attributes:
-        spec: The job (:class:`sumo_ayss.jobs.JobSpec`).
+        spec: The job (:class:`sumo_ayss.grid.jobs.JobSpec`).
         state: One of :data:`STATES`; ``running`` only while a worker holds the job;
             ``interrupted`` / ``cancelled`` after a Ctrl-C (running / still queued then).
         attempts: Tries started so far.
@@ -145,7 +145,7 @@ class GridProgress:
         self.t0 = time.time()
 
     def finished(self, s: JobStatus, result: dict[str, Any]) -> str:
-        """Record a finished try (``result``: :func:`sumo_ayss.jobs.run_job`'s); event."""
+        """Record a finished try (``result``: :func:`sumo_ayss.grid.jobs.run_job`'s); event."""
         s.state, s.stage = "done", "done"
         s.wall_s, s.stages = float(result["wall_s"]), dict(result["stages"])
         s.train_s, s.evaluate_s = result.get("train_s"), result.get("evaluate_s")

@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 logger = logging.getLogger(__name__)
 

@@ -10,9 +10,9 @@ import dataclasses
 from typing import Any
 
 from sumo_ayss.config import ExperimentConfig, PipelineConfig, load_experiment
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.jobs import JobSpec
-from sumo_ayss.validation import suggest
+from sumo_ayss.grid.jobs import JobSpec
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.util.validation import suggest
 
 __all__ = ["plan_jobs", "plan_seed"]
 
@@ -22,9 +22,9 @@ def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
 
     Each case's experiment file is parsed once; a job receives that frozen record with its
     VUT set (workers never parse it again). A case's seeds are ``grid.seeds`` plus those
-    adaptive seeding already added (:func:`sumo_ayss.adaptive.case_seeds`).
+    adaptive seeding already added (:func:`sumo_ayss.grid.adaptive.case_seeds`).
     """
-    from sumo_ayss.adaptive import case_seeds
+    from sumo_ayss.grid.adaptive import case_seeds
 
     jobs = []
     for case in cfg.grid.cases:

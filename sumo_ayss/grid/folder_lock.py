@@ -3,7 +3,7 @@
 Two pipelines on one output folder would both run every job (twice the CPU) and race on the
 same files. :func:`output_lock` creates ``<out>/pipeline.lock`` atomically
 (``O_CREAT | O_EXCL``) with the PID of the process that holds it, refuses a second writer
-with a :class:`~sumo_ayss.errors.LockError` naming the holder's PID, and removes the file
+with a :class:`~sumo_ayss.util.errors.LockError` naming the holder's PID, and removes the file
 when the block ends: normally, on an exception, on Ctrl-C (SIGINT) and on SIGTERM (handled
 as a Ctrl-C while the lock is held in the main thread).
 
@@ -26,7 +26,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.errors import LockError
+from sumo_ayss.util.errors import LockError
 
 __all__ = ["LOCK_NAME", "output_lock"]
 

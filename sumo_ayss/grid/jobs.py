@@ -1,8 +1,8 @@
 """One pipeline job, (case, VUT, seed): its definition and its execution in a worker.
 
 :class:`JobSpec` is what a worker process (or a Ray task) receives; :func:`run_job` trains
-(or resumes, or skips) and evaluates it. The local scheduler (:mod:`sumo_ayss.grid_local`),
-the Ray backend (:mod:`sumo_ayss.ray_backend`) and the pipeline (:mod:`sumo_ayss.pipeline`)
+(or resumes, or skips) and evaluates it. The local scheduler (:mod:`sumo_ayss.grid.local`),
+the Ray backend (:mod:`sumo_ayss.grid.ray_backend`) and the pipeline (:mod:`sumo_ayss.pipeline`)
 import this module; it imports none of them.
 """
 
@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.config import AyssConfig, ExperimentConfig
-from sumo_ayss.errors import ControllerError
 from sumo_ayss.run_folder import (
     EvaluateStage,
     RunFolder,
@@ -25,6 +24,7 @@ from sumo_ayss.run_folder import (
     run_dir_for,
     write_progress,
 )
+from sumo_ayss.util.errors import ControllerError
 
 logger = logging.getLogger("sumo_ayss.pipeline")
 
@@ -78,7 +78,7 @@ class JobSpec:
 def run_job(spec: JobSpec) -> dict[str, Any]:
     """Train (or resume, or skip) and evaluate one job. Runs in a worker process."""
     from sumo_ayss.evaluate import evaluate_run
-    from sumo_ayss.threads import set_torch_threads
+    from sumo_ayss.grid.threads import set_torch_threads
     from sumo_ayss.train import train
 
     folder = spec.folder

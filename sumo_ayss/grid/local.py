@@ -18,8 +18,8 @@ from collections.abc import Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
-from sumo_ayss.jobs import NOT_RETRIED, JobSpec, run_job
-from sumo_ayss.progress import GridProgress, JobStatus
+from sumo_ayss.grid.jobs import NOT_RETRIED, JobSpec, run_job
+from sumo_ayss.grid.progress import GridProgress, JobStatus
 
 logger = logging.getLogger("sumo_ayss.pipeline")
 
@@ -36,7 +36,7 @@ def _worker_init() -> None:
     """
     import signal
 
-    from sumo_ayss.threads import single_thread_env
+    from sumo_ayss.grid.threads import single_thread_env
 
     single_thread_env()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -87,7 +87,7 @@ def run_grid_local(
     propagates to the caller within seconds. Every job event is logged (one line each, with
     the grid's counts and ETA); ``live`` (a :class:`rich.console.Console`, or None for
     none) also shows a table of every job that refreshes twice a second. ``after`` names
-    what follows the grid outside the ETA (:class:`~sumo_ayss.progress.GridProgress`).
+    what follows the grid outside the ETA (:class:`~sumo_ayss.grid.progress.GridProgress`).
     """
     import signal
 

@@ -1,12 +1,12 @@
 """Vehicle types: the VUT catalog, the POV type, their validation and their SUMO XML form.
 
 A vehicle type is a SUMO car-following model plus its parameters, or a user's controller
-(a Python object that returns an acceleration, see :mod:`sumo_ayss.controllers`) driving a
+(a Python object that returns an acceleration, see :mod:`sumo_ayss.vuts.controllers`) driving a
 SUMO vehicle body. Validation happens here, in Python, before any SUMO simulation starts,
 so that a typo or an out-of-range value gives an error that names the field, the allowed
 values and their unit instead of a libsumo traceback (or, worse, SUMO silently ignoring the
 attribute: SUMO drops a vType attribute the chosen model does not read without a word).
-Which model reads which parameter, and their ranges: :mod:`sumo_ayss.vtype_params`.
+Which model reads which parameter, and their ranges: :mod:`sumo_ayss.vuts.vtype_params`.
 
 A user controller is checked for form when a config is read; it is imported (its code run)
 only when an env that drives it is built (:meth:`ControllerSpec.build`).
@@ -30,10 +30,10 @@ from pathlib import Path
 from typing import Any
 from xml.sax.saxutils import quoteattr
 
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.frozen import FrozenMap
-from sumo_ayss.validation import check_keys, suggest
-from sumo_ayss.vtype_params import (
+from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.util.frozen import FrozenMap
+from sumo_ayss.util.validation import check_keys, suggest
+from sumo_ayss.vuts.vtype_params import (
     COMMON_PARAMS,
     CONTROLLED_BODY_PARAMS,
     MODEL_PARAMS,
@@ -55,7 +55,7 @@ class ControllerSpec:
 
     The object named by ``target`` is called with ``params`` as keyword arguments and must
     return an object with an ``acceleration(state) -> float`` method (and optionally
-    ``reset()``), see :class:`sumo_ayss.controllers.Controller`. The testbed bounds every
+    ``reset()``), see :class:`sumo_ayss.vuts.controllers.Controller`. The testbed bounds every
     command to ``[-max_decel_mps2, max_accel_mps2]`` and the speed to
     ``[0, max_speed_mps]``.
 
@@ -156,7 +156,7 @@ class ControllerSpec:
             )
             raise ConfigError(
                 f"{where}.target {self.target!r} is {what} acceleration(state) method (see "
-                "sumo_ayss.controllers.Controller)"
+                "sumo_ayss.vuts.controllers.Controller)"
             )
         return obj
 
@@ -174,7 +174,7 @@ class ControllerSpec:
         if not callable(getattr(controller, "acceleration", None)):
             raise ConfigError(
                 f"{where}.target {self.target!r} built {type(controller).__name__}, which has "
-                "no acceleration(state) method (see sumo_ayss.controllers.Controller)"
+                "no acceleration(state) method (see sumo_ayss.vuts.controllers.Controller)"
             )
         reset = getattr(controller, "reset", None)
         if reset is not None and not callable(reset):
@@ -357,7 +357,7 @@ class VehicleType:
 
     def random_draws(self) -> tuple[str, ...]:
         """Why SUMO draws random numbers for this vehicle (empty: none; a controller VUT is
-        the controller's business). See :func:`sumo_ayss.vtype_params.random_draws`."""
+        the controller's business). See :func:`sumo_ayss.vuts.vtype_params.random_draws`."""
         if self.controller is not None:
             return ()
         return random_draws(self.model, self.params)

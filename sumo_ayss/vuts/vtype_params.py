@@ -1,5 +1,5 @@
 """SUMO vehicle-type parameters: their units, meanings and allowed ranges, and which
-car-following model reads which (the data behind :mod:`sumo_ayss.catalog`'s validation).
+car-following model reads which (the data behind :mod:`sumo_ayss.vuts.catalog`'s validation).
 
 Which parameters each model reads was checked on SUMO 1.28 itself: a vType carrying every
 candidate attribute was loaded per model and the attributes SUMO kept were read back from a
@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any, Literal
 
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 Source = Literal["SUMO", "SUMO schema", "ours"]
 

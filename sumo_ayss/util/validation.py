@@ -1,9 +1,9 @@
 """The one validation idiom of every configuration section: checks that raise
-:class:`~sumo_ayss.errors.ConfigError` naming the dotted field, the allowed values and what
+:class:`~sumo_ayss.util.errors.ConfigError` naming the dotted field, the allowed values and what
 was given (``env.sim.step_length_s must be > 0, got 0``), and the one "did you mean"
 suggester.
 
-A leaf module (standard library and :mod:`sumo_ayss.errors` only), so that the catalog, the
+A leaf module (standard library and :mod:`sumo_ayss.util.errors` only), so that the catalog, the
 configuration sections, the agent's hyper-parameters and the report options can all use it
 without importing one another.
 """
@@ -17,7 +17,7 @@ from collections.abc import Collection, Iterable
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError
 
 #: Seeds are passed to SUMO's ``--seed`` (a C int), numpy and torch: the common range.
 SEED_MAX = 2**31 - 1

@@ -26,9 +26,9 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.errors import ConfigError
-from sumo_ayss.jobs import NOT_RETRIED, JobSpec, run_job
-from sumo_ayss.progress import GridProgress, JobStatus
+from sumo_ayss.grid.jobs import NOT_RETRIED, JobSpec, run_job
+from sumo_ayss.grid.progress import GridProgress, JobStatus
+from sumo_ayss.util.errors import ConfigError
 
 logger = logging.getLogger(__name__)
 
@@ -76,7 +76,7 @@ def run_grid_ray(
 
     Every job event is logged like the local backend's (started, done with its stages and
     times, failed, retried, each line with the grid's counts and ETA,
-    :class:`~sumo_ayss.progress.GridProgress`); a task's run folder is remote until it
+    :class:`~sumo_ayss.grid.progress.GridProgress`); a task's run folder is remote until it
     ends, so there are no events in between. ``after``: what follows the grid, outside
     the ETA.
     """

@@ -23,9 +23,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from sumo_ayss.config import PipelineConfig
-from sumo_ayss.errors import AyssError
-from sumo_ayss.jobs import JobSpec
-from sumo_ayss.progress import JobStatus
+from sumo_ayss.grid.jobs import JobSpec
+from sumo_ayss.grid.progress import JobStatus
 from sumo_ayss.run_folder import (
     AdaptiveLook,
     AdaptiveRecord,
@@ -36,8 +35,9 @@ from sumo_ayss.run_folder import (
     read_adaptive,
     write_adaptive,
 )
+from sumo_ayss.util.errors import AyssError
 
-logger = logging.getLogger("sumo_ayss.adaptive")
+logger = logging.getLogger("sumo_ayss.grid.adaptive")
 
 __all__ = ["case_seeds", "is_adaptive", "read_record", "run_adaptive", "summary_lines"]
 

@@ -41,7 +41,7 @@ every policy decision of the POV. At the start of an episode the first state is 
 initial condition itself (the state after placement, before the first step).
 
 **Configuration.** A VUT entry of ``env.vuts`` names the controller
-(:class:`~sumo_ayss.catalog.ControllerSpec`)::
+(:class:`~sumo_ayss.vuts.catalog.ControllerSpec`)::
 
     acc_tg2:
       description: constant time-gap ACC, T = 2 s
@@ -60,9 +60,9 @@ import math
 import numbers
 from typing import Any, NamedTuple, Protocol, runtime_checkable
 
-from sumo_ayss.catalog import ControllerSpec, VehicleType
-from sumo_ayss.errors import ControllerError
 from sumo_ayss.sim.pair import VehiclePair, VutSensing
+from sumo_ayss.util.errors import ControllerError
+from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
 
 __all__ = [
     "ControlledVut",
