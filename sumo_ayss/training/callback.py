@@ -3,15 +3,31 @@
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import Any, Protocol
 
 from stable_baselines3.common.callbacks import BaseCallback
 
 from sumo_ayss.agents import sb3_adapter
+from sumo_ayss.config import ExperimentConfig
 from sumo_ayss.run_folder import write_progress
+from sumo_ayss.training.collectors import Collector, Rollout
 
-if TYPE_CHECKING:
-    from sumo_ayss.train import Trainer
+
+class Trainer(Protocol):
+    """What the callback asks of the training loop (:class:`sumo_ayss.train.Trainer`)."""
+
+    run_dir: Path
+    cfg: ExperimentConfig
+    next_eval: int
+    collector: Collector
+
+    def save_checkpoint(self) -> None: ...
+
+    def record_actions(self, actions: Any) -> None: ...
+
+    def candidate(self, rollout: Rollout | None = None) -> None: ...
+
 
 PROGRESS_EVERY_S = 2.0
 """Seconds between two rewrites of a run's ``progress.json`` during training."""
