@@ -268,7 +268,7 @@ def test_adaptive_seeding_adds_seeds_until_the_cap_and_extends_crossplay(
     cfg = load_pipeline(path)
     assert cfg.added_seeds == (2,)
     with caplog.at_level(logging.INFO):
-        statuses, _report, runs, *_ = run_pipeline(cfg, live=False)
+        statuses, report, runs, *_ = run_pipeline(cfg, live=False)
     assert "cross-play of 2 new SPCPs (the table of the other 4 is kept)" in caplog.text
     assert "adaptive seeding, car_following: not settled at 2 seeds per VUT" in caplog.text
     assert sorted((s.spec.vut, s.spec.seed) for s in statuses) == [
@@ -279,6 +279,10 @@ def test_adaptive_seeding_adds_seeds_until_the_cap_and_extends_crossplay(
     record = read_adaptive(case / "adaptive.json")
     assert record.seeds == (0, 1, 2) and [x.n_seeds for x in record.looks] == [2, 3]
     assert not record.settled and record.looks[0].gate_level > 0
+    assert report is not None
+    text = report.read_text(encoding="utf-8")  # the report shows every look
+    assert "Adaptive seeding: each look at this case" in text
+    assert "had not settled at the cap of 3 seeds per VUT" in text
     crossplay = json.loads((case / "crossplay.json").read_text())
     assert [(o["vut"], o["seed"]) for o in crossplay["opponents"]] == [
         ("pi1", 0),

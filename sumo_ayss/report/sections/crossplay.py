@@ -27,6 +27,8 @@ from sumo_ayss.report.sections.common import (
     mobility_cell,
     pairs_table,
 )
+from sumo_ayss.run_folder import CaseFolder, read_adaptive
+from sumo_ayss.util.errors import TableError
 
 __all__ = ["crossplay_blocks"]
 
@@ -55,6 +57,7 @@ def crossplay_blocks(
         )
     )
     blocks.append(_diagonal_block(a))
+    blocks += _adaptive_blocks(a)
     m = a.crossplay
     if m is None or not a.crossplay_rows:
         gap = a.crossplay_gap
@@ -154,3 +157,56 @@ def _diagonal_block(a: CaseAnalysis) -> Block:
         "episodes equal): cross-play drove the same vehicles the SPCPs were trained and "
         "scored against."
     )
+
+
+def _adaptive_blocks(a: CaseAnalysis) -> list[Block]:
+    """Adaptive seeding's looks at this case (``adaptive.json`` beside the cross-play table),
+    when the pipeline added seeds adaptively; nothing for a fixed grid."""
+    if a.crossplay_path is None:
+        return []
+    path = CaseFolder(a.crossplay_path.parent).adaptive_json
+    if not path.is_file():
+        return []
+    try:
+        record = read_adaptive(path)
+    except TableError as exc:
+        return [Callout("Adaptive seeding record unreadable", (str(exc),), "warning")]
+    if not record.looks:
+        return []
+    rows = tuple(
+        (
+            str(x.n_seeds),
+            fmt_p(x.omnibus_p),
+            f"{x.gate_level:.3g}",
+            f"{x.safest} vs {x.least_safe}",
+            fmt_p(x.ends_p),
+            "settled" if x.settled else "not settled",
+        )
+        for x in record.looks
+    )
+    last = record.looks[-1]
+    if last.settled:
+        end = f"The ranking settled at {last.n_seeds} seeds per VUT."
+    elif last.n_seeds >= record.max_seeds:
+        end = (
+            f"The ranking had not settled at the cap of {record.max_seeds} seeds per VUT: "
+            "its ends are not established at the procedure's level."
+        )
+    else:
+        end = "Adaptive seeding stopped before the cap (a job or the cross-play stage failed)."
+    return [
+        Paragraph(
+            f"Adaptive seeding: the grid started with {len(record.first_seeds)} seeds per VUT "
+            f"and adds one at a time, up to {record.max_seeds}, while the ranking has not "
+            "settled: settled means the F test over all VUTs (VUT × seed block) is below a "
+            "level calibrated so that the sequence of looks claims a settled ranking in "
+            f"{100 * record.alpha:g} % of grids of equally safe VUTs, and the paired t of the "
+            f"current ends is below {record.alpha:g}. {end}"
+        ),
+        Table(
+            "Adaptive seeding: each look at this case",
+            ("seeds per VUT", "F gate p", "gate level", "ends", "ends p", "verdict"),
+            rows,
+            (True, True, True, False, True, False),
+        ),
+    ]
