@@ -11,7 +11,7 @@ that settled are not touched again.
 
 Every look is written to ``<out>/<case>/adaptive.json`` (:mod:`sumo_ayss.run_folder.adaptive`)
 *before* the next seed's jobs start, so a pipeline killed mid-look resumes with the seeds it
-had added (:func:`case_seeds`, used by :func:`sumo_ayss.pipeline.plan_jobs`) and a rerun of
+had added (:func:`case_seeds`, used by :func:`sumo_ayss.grid.plan.plan_jobs`) and a rerun of
 a finished grid repeats the same looks on the same tables.
 """
 
