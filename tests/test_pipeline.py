@@ -310,6 +310,16 @@ def test_adaptive_seeding_adds_seeds_until_the_cap_and_extends_crossplay(
     assert len(again.statuses) == 6
     assert read_adaptive(case / "adaptive.json").looks == record.looks
     assert (case / "crossplay.csv").read_bytes() == kept
+    # Another level is another schedule: the record starts over, and a level every grid
+    # passes settles at the first look with the grid's own seeds (no job added).
+    data = yaml.safe_load(path.read_text())
+    data["report"] = {"welch_alpha": 0.99}
+    path.write_text(yaml.safe_dump(data))
+    settled = run_pipeline(load_pipeline(path), live=False)
+    assert len(settled.statuses) == 4
+    again_record = read_adaptive(case / "adaptive.json")
+    assert [x.n_seeds for x in again_record.looks] == [2] and again_record.settled
+    assert again_record.seeds == (0, 1)
 
 
 def test_a_resumed_adaptive_grid_plans_the_seeds_its_record_added(tmp_path: Path) -> None:
