@@ -239,8 +239,26 @@ def _settings(data: Mapping[str, Any]) -> Any:
     return json.loads(json.dumps(data))  # tuples -> lists, as stored
 
 
+class _SettingsStage:
+    """A stage whose done marker is the settings its output file records: done when they
+    are the settings asked for now (``settings()`` against ``stored()``)."""
+
+    def settings(self) -> Any:
+        raise NotImplementedError
+
+    def stored(self) -> Any:
+        raise NotImplementedError
+
+    def key(self) -> str:
+        return fingerprint(self.settings())
+
+    def recorded(self) -> str | None:
+        stored = self.stored()
+        return None if stored is None else fingerprint(stored)
+
+
 @dataclass(frozen=True)
-class OutcomeStage:
+class OutcomeStage(_SettingsStage):
     """The outcome episodes alone (``python -m sumo_ayss.evaluate``): ``outcome.json``
     records its settings, ``{"n": episodes, "seed": scenario seed}``."""
 
@@ -266,16 +284,9 @@ class OutcomeStage:
         path = self.folder.outcome_json
         return read_outcome_json(path).settings if path.is_file() else None
 
-    def key(self) -> str:
-        return fingerprint(self.settings())
-
-    def recorded(self) -> str | None:
-        stored = self.stored()
-        return None if stored is None else fingerprint(stored)
-
 
 @dataclass(frozen=True)
-class AyssStage:
+class AyssStage(_SettingsStage):
     """The AYSS Monte Carlo alone (``python -m sumo_ayss.evaluate``): ``ayss.json`` records
     its settings (the :class:`~sumo_ayss.config.AyssConfig`)."""
 
@@ -299,13 +310,6 @@ class AyssStage:
         """
         path = self.folder.ayss_json
         return read_ayss_json(path).settings if path.is_file() else None
-
-    def key(self) -> str:
-        return fingerprint(self.settings())
-
-    def recorded(self) -> str | None:
-        stored = self.stored()
-        return None if stored is None else fingerprint(stored)
 
 
 # --------------------------------------------------------------------------- case stages
