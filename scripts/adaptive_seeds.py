@@ -11,7 +11,9 @@
    degrees of freedom).
 2. **Synthetic ladders** (VUT i's true score ``i * delta``, noise sd 1): how often the rule
    settles, at how many seeds, and how often it settles with the ends the wrong way round.
-3. **Real ladders**: the per-seed cross-play blocks at the verdict budget (20,000
+3. **First looks**: every fresh-seed validation ladder-case of session 6 (seeds 401-404,
+   ``runs/verdict``) at its first look: would the rule stop at 4 seeds, with what order.
+4. **Real ladders**: the per-seed cross-play blocks at the verdict budget (20,000
    transitions, 200 outcome scenarios) of the ladders with 6 seeds: braking and ACC
    time-gap (from the verdict curve's cells, ``runs/verdict_curve``) and minGap
    car-following on fresh seeds 401-406 (``runs/verdict/min_gap``). Every order of the 6
@@ -38,6 +40,7 @@ from sumo_ayss.analysis.sequential import looks_of, settle_check
 from sumo_ayss.util.paths import PROJECT_ROOT
 
 LOOKS = looks_of(4, 6)
+PARTS = ("real", "first", "synthetic")
 
 
 def _scores(x: np.ndarray, names: list[str] | None = None) -> list[SeedScores]:
@@ -157,24 +160,55 @@ def _cells_blocks() -> dict[str, tuple[list[str], np.ndarray]]:
     return out
 
 
-def _folder_blocks() -> dict[str, tuple[list[str], np.ndarray]]:
+def _run_blocks(study: str, case: str) -> tuple[list[str], np.ndarray, list[int]] | None:
+    """A fresh-seed validation run's per-seed cross-play blocks (``runs/verdict``), VUTs in
+    the known order; None where the run folders are not here."""
     from sumo_ayss.crossplay import read_matrix
-    from sumo_ayss.run_folder import find_run_dirs
+    from sumo_ayss.run_folder import find_run_dirs, read_run
 
-    out = {}
-    study = PROJECT_ROOT / "runs" / "verdict" / "min_gap"
-    case = study / "car_following"
-    if not (case / "crossplay.csv").is_file():
-        return out
-    order = json.loads((study / "order_check.json").read_text())["expected"]
-    m = read_matrix(find_run_dirs([case]))
+    folder = PROJECT_ROOT / "runs" / "verdict" / study
+    if not (folder / case / "crossplay.csv").is_file():
+        return None
+    order = json.loads((folder / "order_check.json").read_text())["expected"]
+    m = read_matrix([read_run(d) for d in find_run_dirs([folder / case])])
     by = {s.name: s for s in m.scores("seed")}
-    x = np.array([by[v].array for v in order])
-    out[f"min_gap car_following (seeds {by[order[0]].seeds[0]}-{by[order[0]].seeds[-1]}, runs)"] = (
-        order,
-        x,
-    )
-    return out
+    return order, np.array([by[v].array for v in order]), list(by[order[0]].seeds)
+
+
+def _folder_blocks() -> dict[str, tuple[list[str], np.ndarray]]:
+    found = _run_blocks("min_gap", "car_following")
+    if found is None:
+        return {}
+    order, x, seeds = found
+    return {f"min_gap car_following (seeds {seeds[0]}-{seeds[-1]}, runs)": (order, x)}
+
+
+def first_looks() -> list[dict]:
+    """The first look (4 seeds) at every fresh-seed validation ladder-case of session 6
+    (seeds 401-404, verdict budget): would adaptive seeding stop there, and with what order?"""
+    rows = []
+    for study in ("braking", "acc_time_gap", "reaction", "min_gap"):
+        for case in ("car_following", "cut_in"):
+            found = _run_blocks(study, case)
+            if found is None:
+                continue
+            order, x, _ = found
+            check = settle_check(_scores(x[:, :4], order), LOOKS)
+            ranked = [order[i] for i in np.argsort(x[:, :4].mean(axis=1), kind="stable")]
+            rows.append(
+                {
+                    "ladder": study,
+                    "case": case,
+                    "ranking": " > ".join(ranked),
+                    "kendall_tau": kendall_tau(ranked, order),
+                    "f_gate_p": float(f"{check.omnibus_p:.3g}"),
+                    "gate_level": round(check.gate_level, 4),
+                    "ends_p": float(f"{check.ends_p:.3g}"),
+                    "settled_at_4": check.settled,
+                }
+            )
+            print(rows[-1], flush=True)
+    return rows
 
 
 def real_ladders() -> list[dict]:
@@ -221,12 +255,23 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--reps", type=int, default=4000)
     p.add_argument("--out", type=Path, default=PROJECT_ROOT / "results" / "adaptive_seeds")
+    p.add_argument(
+        "--parts",
+        nargs="+",
+        choices=PARTS,
+        default=list(PARTS),
+        help="which tables to write (default: all)",
+    )
     a = p.parse_args()
     a.out.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(2026)
-    _write(a.out / "real_ladders.csv", real_ladders())
-    _write(a.out / "synthetic_nulls.csv", synthetic_nulls(a.reps, rng))
-    _write(a.out / "synthetic_ladders.csv", synthetic_ladders(a.reps, rng))
+    if "real" in a.parts:
+        _write(a.out / "real_ladders.csv", real_ladders())
+    if "first" in a.parts:
+        _write(a.out / "first_looks.csv", first_looks())
+    if "synthetic" in a.parts:  # the nulls, then the ladders, from one random stream
+        _write(a.out / "synthetic_nulls.csv", synthetic_nulls(a.reps, rng))
+        _write(a.out / "synthetic_ladders.csv", synthetic_ladders(a.reps, rng))
     print(f"wrote {a.out}")
 
 

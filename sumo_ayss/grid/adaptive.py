@@ -21,12 +21,12 @@ import dataclasses
 import logging
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from sumo_ayss.config import PipelineConfig
 from sumo_ayss.grid.jobs import JobSpec
 from sumo_ayss.grid.progress import JobStatus
 from sumo_ayss.run_folder import (
-    AdaptiveLook,
     AdaptiveRecord,
     CaseFolder,
     RunRecord,
@@ -36,6 +36,9 @@ from sumo_ayss.run_folder import (
     write_adaptive,
 )
 from sumo_ayss.util.errors import AyssError
+
+if TYPE_CHECKING:
+    from sumo_ayss.analysis.sequential import SettleCheck
 
 logger = logging.getLogger("sumo_ayss.grid.adaptive")
 
@@ -90,22 +93,21 @@ def case_seeds(cfg: PipelineConfig, case: str) -> tuple[int, ...]:
     return cfg.seeds if record is None else record.seeds
 
 
-def _look(cfg: PipelineConfig, case: str, runs: Sequence[RunRecord]) -> AdaptiveLook:
+def _look(cfg: PipelineConfig, case: str, runs: Sequence[RunRecord]) -> SettleCheck:
     """One look at a case from its cross-play table."""
     from sumo_ayss.analysis.sequential import looks_of, settle_check
     from sumo_ayss.crossplay import read_matrix
 
     assert cfg.max_seeds is not None
     matrix = read_matrix(runs)
-    check = settle_check(
+    return settle_check(
         matrix.scores("seed"),  # seed blocks: the independent replications
         looks_of(len(cfg.seeds), cfg.max_seeds),
         cfg.report.welch_alpha,
     )
-    return AdaptiveLook(**dataclasses.asdict(check))
 
 
-def _describe(case: str, look: AdaptiveLook) -> str:
+def _describe(case: str, look: SettleCheck) -> str:
     verdict = "settled" if look.settled else "not settled"
     return (
         f"adaptive seeding, {case}: {verdict} at {look.n_seeds} seeds per VUT (F gate p "
@@ -176,7 +178,7 @@ def run_adaptive(
     return statuses, [by_path[Path(p).resolve()] for p in order]
 
 
-def _record_look(cfg: PipelineConfig, case: str, look: AdaptiveLook) -> AdaptiveRecord:
+def _record_look(cfg: PipelineConfig, case: str, look: SettleCheck) -> AdaptiveRecord:
     """Append ``look`` to the case's record (replacing a look at the same seed count: a
     rerun repeats it) and write it."""
     assert cfg.max_seeds is not None

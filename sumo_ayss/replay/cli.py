@@ -53,30 +53,22 @@ def _export_main(argv: Sequence[str]) -> int:
         "with its OpenDRIVE road",
     )
     args = parser.parse_args(argv)
+    row = {
+        "ayss_row": args.ayss_row,
+        "outcome_row": args.outcome_row,
+        "decisions": args.decisions,
+        "trust_controller": args.trust_controller,
+    }
     if args.format == "xosc":
         from sumo_ayss.replay.xosc import export_xosc
 
-        x = export_xosc(
-            args.run_dir,
-            args.out,
-            ayss_row=args.ayss_row,
-            outcome_row=args.outcome_row,
-            decisions=args.decisions,
-            trust_controller=args.trust_controller,
-        )
+        x = export_xosc(args.run_dir, args.out, **row)
         print(
             f"wrote {x.xosc} and {x.xodr}: {x.info['decisions']} decision(s), collision "
             f"{x.info['collided']}, reproduces the row: {x.info['reproduces_row']}"
         )
         return 0
-    result = export_scenario(
-        args.run_dir,
-        args.out,
-        ayss_row=args.ayss_row,
-        outcome_row=args.outcome_row,
-        decisions=args.decisions,
-        trust_controller=args.trust_controller,
-    )
+    result = export_scenario(args.run_dir, args.out, **row)
     info = result.info
     print(
         f"wrote {result.out}: {len(info['decisions'])} decision(s), collision "

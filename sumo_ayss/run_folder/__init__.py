@@ -54,7 +54,6 @@ these names or parses one of these files. Imports neither SUMO nor torch.
 from __future__ import annotations
 
 from sumo_ayss.run_folder.adaptive import (
-    AdaptiveLook,
     AdaptiveRecord,
     read_adaptive,
     write_adaptive,
@@ -256,7 +255,6 @@ __all__ = [
     "TB_DIR",
     "TORCH_RNG_PT",
     "VERSIONS_JSON",
-    "AdaptiveLook",
     "AdaptiveRecord",
     "AyssRecord",
     "AyssSamples",

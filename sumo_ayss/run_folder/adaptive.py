@@ -2,8 +2,8 @@
 
 Written by the pipeline after every look (:mod:`sumo_ayss.grid.adaptive`); read by the pipeline
 when it resumes (the seeds already added are part of the grid) and by ``rank --no-run``.
-The statistics of a look are :class:`sumo_ayss.analysis.sequential.SettleCheck`; this module
-stores them as plain records.
+A look is the analysis's own record, :class:`sumo_ayss.analysis.sequential.SettleCheck`,
+stored field by field.
 """
 
 from __future__ import annotations
@@ -12,31 +12,18 @@ import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.run_folder.jsonio import read_json, write_json
+
+if TYPE_CHECKING:
+    from sumo_ayss.analysis.sequential import SettleCheck
 from sumo_ayss.util.errors import TableError
 
-__all__ = ["ADAPTIVE_FORMAT", "AdaptiveLook", "AdaptiveRecord", "read_adaptive", "write_adaptive"]
+__all__ = ["ADAPTIVE_FORMAT", "AdaptiveRecord", "read_adaptive", "write_adaptive"]
 
 ADAPTIVE_FORMAT = 1
 """Version of the file's layout."""
-
-
-@dataclass(frozen=True)
-class AdaptiveLook:
-    """One look (see :class:`sumo_ayss.analysis.sequential.SettleCheck` for the fields):
-    seeds per VUT, the F gate's p and level, the current ends and their paired-t p and level,
-    and whether the ranking counted as settled."""
-
-    n_seeds: int
-    omnibus_p: float
-    gate_level: float
-    safest: str
-    least_safe: str
-    ends_p: float
-    alpha: float
-    settled: bool
 
 
 @dataclass(frozen=True)
@@ -55,7 +42,7 @@ class AdaptiveRecord:
     max_seeds: int
     alpha: float
     seeds: tuple[int, ...]
-    looks: tuple[AdaptiveLook, ...]
+    looks: tuple[SettleCheck, ...]
 
     @property
     def settled(self) -> bool:
@@ -88,6 +75,8 @@ def read_adaptive(path: str | Path) -> AdaptiveRecord:
     Raises:
         TableError: If the file is missing, unreadable or not in this layout.
     """
+    from sumo_ayss.analysis.sequential import SettleCheck
+
     data = read_json(path)
     try:
         if data.get("format") != ADAPTIVE_FORMAT:
@@ -99,7 +88,7 @@ def read_adaptive(path: str | Path) -> AdaptiveRecord:
             alpha=float(data["alpha"]),
             seeds=tuple(int(s) for s in data["seeds"]),
             looks=tuple(
-                AdaptiveLook(
+                SettleCheck(
                     n_seeds=int(x["n_seeds"]),
                     omnibus_p=_float(x["omnibus_p"]),
                     gate_level=float(x["gate_level"]),

@@ -314,9 +314,10 @@ def test_run_folder_imports_neither_torch_nor_libsumo() -> None:
 def test_adaptive_record_round_trips_and_refuses_another_layout(tmp_path: Path) -> None:
     import math
 
-    from sumo_ayss.run_folder import AdaptiveLook, AdaptiveRecord, read_adaptive, write_adaptive
+    from sumo_ayss.analysis.sequential import SettleCheck
+    from sumo_ayss.run_folder import AdaptiveRecord, read_adaptive, write_adaptive
 
-    look = AdaptiveLook(4, math.nan, 0.027, "a", "b", 0.11, 0.05, False)
+    look = SettleCheck(4, math.nan, 0.027, "a", "b", 0.11, 0.05, False)
     record = AdaptiveRecord((0, 1, 2, 3), 6, 0.05, (0, 1, 2, 3, 4), (look,))
     path = tmp_path / "adaptive.json"
     write_adaptive(path, record)
