@@ -33,6 +33,7 @@ the bootstrap only in paper mode) and never runs cross-play.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -128,9 +129,18 @@ def _rows(a: CaseAnalysis, mode: Mode) -> list[dict[str, Any]]:
                 "episodes": o.episodes if o else "",
                 "mobility_mps": o.mobility if o else "",
                 "timid": o.timid if o else "",
+                "p_vs_next_adjusted": s.p_adjusted if s.p_adjusted is not None else "",
+                "margin_vs_next": _finite_or_empty(s.margin),
+                "margin_lo": _finite_or_empty(s.margin_lo),
+                "margin_hi": _finite_or_empty(s.margin_hi),
             }
         )
     return rows
+
+
+def _finite_or_empty(x: float) -> float | str:
+    """A number for a ``ranking.csv`` cell; "" for NaN (no value)."""
+    return x if math.isfinite(x) else ""
 
 
 def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:

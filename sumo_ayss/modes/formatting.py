@@ -15,6 +15,7 @@ __all__ = [
     "fmt_interval",
     "fmt_num",
     "fmt_p",
+    "fmt_p_family",
     "fmt_prob",
     "ranking_line",
     "seed_interval_text",
@@ -78,6 +79,27 @@ def fmt_p(p: float | None, *, cap_high: bool = False, undefined: str = "n/a") ->
     if cap_high and p > 0.999:
         return "> 0.999"
     return f"= {p:.3f}"
+
+
+def fmt_p_family(
+    p: float | None, p_family: float | None, family_size: int, *, undefined: str = "n/a"
+) -> str:
+    """A raw p with its family-adjusted p beside it: ``"p = 0.017, adjusted p = 0.034 (Holm,
+    2 adjacent claims)"``; the raw p alone where no adjustment applies (no family, or a
+    family of one test whose adjusted p is the raw one).
+
+    Args:
+        p: The test's own p.
+        p_family: Its p adjusted for the ranking's family of claims
+            (:mod:`sumo_ayss.analysis.multiplicity`); None outside a family.
+        family_size: Tests in the family.
+        undefined: The text for an undefined p.
+    """
+    raw = f"p {fmt_p(p, undefined=undefined)}"
+    if p_family is None or (family_size <= 1 and (p_family == p or not _finite(p))):
+        return raw
+    claims = f"{family_size} adjacent claim{'s' if family_size != 1 else ''}"
+    return f"{raw}, adjusted p {fmt_p(p_family, undefined=undefined)} (Holm, {claims})"
 
 
 def fmt_prob(p: float | None) -> str:

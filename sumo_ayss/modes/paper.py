@@ -85,10 +85,15 @@ def _safer_sentence(v: Verdict, pct: str, where: str) -> str:
 def pair_sentence(pair: PairVerdict) -> str:
     """One quotable sentence stating a verdict under the report's significance rule."""
     v = pair.verdict
+    adjusted = (
+        f", adjusted p {fmt_p(pair.p_family)} (Holm over the ranking's adjacent claims)"
+        if pair.p_family is not None and pair.p_family != v.p_seed_welch
+        else ""
+    )
     if v.significant and not pair.significant:
         neutral = verdict_sentence(dataclasses.replace(v, safer=None, significant=False))
         why = (
-            f"the seed-level Welch test gives p {fmt_p(v.p_seed_welch)} "
+            f"the seed-level Welch test gives p {fmt_p(v.p_seed_welch)}{adjusted} "
             f"(needs < {pair.welch_alpha:g})"
             if math.isfinite(v.p_seed_welch)
             else "the seed-level Welch test is undefined (it needs two seeds per VUT with spread)"
@@ -102,6 +107,8 @@ def pair_sentence(pair: PairVerdict) -> str:
         if math.isfinite(v.p_seed_welch)
         else "undefined (it needs two seeds per VUT with spread)"
     )
+    if math.isfinite(v.p_seed_welch):
+        welch += adjusted
     return f"{verdict_sentence(v)} Seed-level Welch test: {welch}."
 
 
@@ -151,8 +158,12 @@ def _standings(a: CaseAnalysis) -> list[Standing]:
                 n_seeds=ranked.n_seeds,
                 next_vut=nxt,
                 significant=pair.significant if pair else None,
-                ranked_apart=bool(ranked.significant_vs_next),
+                ranked_apart=bool(pair.significant) if pair else False,
                 p=pair.verdict.p_seed_welch if pair else None,
+                p_adjusted=pair.p_family if pair else None,
+                margin=pair.verdict.difference if pair else math.nan,
+                margin_lo=pair.verdict.diff_lo if pair else math.nan,
+                margin_hi=pair.verdict.diff_hi if pair else math.nan,
                 test="Welch t" if pair else "",
                 # Tagged like the seed-level modes' sentences ("[exposure mode] ...").
                 vs_next=f"[{NAME} mode] {pair_sentence(pair)}" if pair else "",
