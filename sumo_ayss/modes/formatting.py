@@ -17,6 +17,7 @@ __all__ = [
     "fmt_p",
     "fmt_p_family",
     "fmt_prob",
+    "rank_labels",
     "ranking_line",
     "seed_interval_text",
 ]
@@ -123,22 +124,48 @@ def seed_interval_text(lo: float, hi: float, n_seeds: int, digits: int = 2) -> s
     return f"{n_seeds} seed{'s' if n_seeds != 1 else ''}: no interval"
 
 
+def _tie_groups(n: int, significant_next: Sequence[bool]) -> list[list[int]]:
+    """Positions 0..n-1 grouped where the ranking does not separate neighbours."""
+    if n == 0:
+        return []
+    if len(significant_next) != n - 1:
+        raise ValueError(f"{len(significant_next)} verdicts for {n} VUTs")
+    groups: list[list[int]] = [[0]]
+    for i, sig in enumerate(significant_next, start=1):
+        if sig:
+            groups.append([i])
+        else:
+            groups[-1].append(i)
+    return groups
+
+
 def ranking_line(names: Sequence[str], significant_next: Sequence[bool]) -> str:
     """``"a > b ≈ c"``: ``>`` where a VUT differs significantly from the next, ``≈`` where
-    not. VUTs joined by ``≈`` are listed by name, so that a tie reads the same in every
-    mode (the order inside it is not a finding).
+    not. Names keep the ranking's order inside a tie too, so that the first VUT named is
+    the leaderboard's first row everywhere (the order inside a tie is not a finding: the
+    ``≈`` and the leaderboard's shared rank, :func:`rank_labels`, say so).
 
     Args:
         names: VUTs safest first.
         significant_next: Per VUT but the last, whether it differs significantly from the
             next one.
     """
-    if not names:
-        return ""
-    groups: list[list[str]] = [[names[0]]]
-    for sig, name in zip(significant_next, names[1:], strict=True):
-        if sig:
-            groups.append([name])
-        else:
-            groups[-1].append(name)
-    return " > ".join(" ≈ ".join(sorted(g)) for g in groups)
+    groups = _tie_groups(len(names), significant_next)
+    return " > ".join(" ≈ ".join(names[i] for i in g) for g in groups)
+
+
+def rank_labels(significant_next: Sequence[bool]) -> list[str]:
+    """Each VUT's rank as a leaderboard shows it: ``"1"``, or ``"2–3"`` for every VUT of a
+    tie (neighbours the ranking does not separate) spanning ranks 2 to 3.
+
+    Args:
+        significant_next: Per VUT but the last, whether it differs significantly from the
+            next one (so ``len + 1`` VUTs).
+    """
+    n = len(significant_next) + 1
+    labels = [""] * n
+    for g in _tie_groups(n, significant_next):
+        text = str(g[0] + 1) if len(g) == 1 else f"{g[0] + 1}–{g[-1] + 1}"
+        for i in g:
+            labels[i] = text
+    return labels
