@@ -11,7 +11,7 @@ from sumo_ayss.cases import OUTCOME_COLUMNS
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import EXPOSURE
 from sumo_ayss.modes.exposure import exposure_sentence
-from sumo_ayss.modes.formatting import fmt_num, fmt_p, seed_interval_text
+from sumo_ayss.modes.formatting import fmt_num, seed_interval_text
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -27,6 +27,7 @@ from sumo_ayss.report.sections.common import (
     fmt_est,
     mobility_cell,
     pairs_table,
+    test_cell,
 )
 from sumo_ayss.report.seed_figure import seed_scores_figure
 from sumo_ayss.run_folder import Outcome
@@ -219,7 +220,7 @@ def exposure_blocks(
                 f"{fmt_num(r.mean, 3)} ({ci})",
                 per_seed,
                 str(r.n_seeds),
-                f"{nxt.test}, p {fmt_p(nxt.p)}" if nxt else "—",
+                test_cell(nxt),
                 ("yes" if nxt.significant else "no") if nxt else "—",
                 crash_cell(o),
                 mobility_cell(o),
