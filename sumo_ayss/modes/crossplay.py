@@ -151,8 +151,13 @@ CROSSPLAY = register_mode(
             "difference between two VUTs is read within each opponent, so the search noise "
             "of one SPCP cancels; two VUTs are compared by a paired t-test over "
             "training-seed blocks (block s = the mean over seed s's opponents; "
-            "report.crossplay_blocks: opponent makes every opponent a block); significant "
-            "when p < alpha. Crash rate and mobility (mean VUT speed) stand beside the "
+            "or one block per opponent where the study's configuration asks for it). A VUT "
+            "is called safer than the next when that test's p, adjusted by Holm over the "
+            "ranking's adjacent pairs, is below the significance level (0.05 unless "
+            "configured: the claims of one leaderboard are then wrong together with "
+            "probability at most 5 %); else the two are tied. With few "
+            "blocks the test has few degrees of freedom (blocks − 1) and needs a difference "
+            "consistent across them. Crash rate and mobility (mean VUT speed) stand beside the "
             "score; a VUT far slower than the others is flagged TIMID."
         ),
         score_name="cross-play harm H per episode (lower = safer)",

@@ -120,7 +120,8 @@ def significance_rule(options: SignificanceOptions) -> str:
         "only when "
         f"BOTH the {pct} hierarchical-bootstrap interval of the difference of their safety "
         "indices excludes 0 AND the seed-level Welch t-test on the per-seed indices gives "
-        f"p < {options.welch_alpha:g}. With only a few seeds per VUT the bootstrap alone is "
+        f"p < {options.welch_alpha:g}, that p adjusted by Holm over the ranking's adjacent "
+        "pairs. With only a few seeds per VUT the bootstrap alone is "
         "anti-conservative (resampling a few seeds understates the seed-to-seed spread), so the "
         "Welch test, which treats each seed's SPCP as one observation, must agree."
     )
