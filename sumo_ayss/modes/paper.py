@@ -24,7 +24,15 @@ if TYPE_CHECKING:
     from sumo_ayss.analysis.significance import PairVerdict, SignificanceOptions
     from sumo_ayss.analysis.verdict import Verdict
 
-__all__ = ["PAPER", "pair_sentence", "paper_headline", "significance_rule", "verdict_sentence"]
+__all__ = [
+    "MIN_SEEDS_FOR_INTERVAL",
+    "PAPER",
+    "diff_interval",
+    "pair_sentence",
+    "paper_headline",
+    "significance_rule",
+    "verdict_sentence",
+]
 
 NAME = "paper"
 
@@ -46,6 +54,21 @@ def _fmt_h_range(h_range: tuple[float, float]) -> str:
     return f"h ≤ {hi:g} m" if lo == 0.0 else f"{lo:g} m ≤ h ≤ {hi:g} m"
 
 
+#: Fewest seeds per VUT for a printed bootstrap interval (as for the seed-level
+#: t-intervals: resampling two seeds cannot show the seed-to-seed spread).
+MIN_SEEDS_FOR_INTERVAL = 3
+
+
+def diff_interval(v: Verdict, lo: float | None = None, hi: float | None = None) -> str:
+    """The interval of a paired verdict's difference (``lo``/``hi``: the oriented bounds,
+    default ``diff_lo``/``diff_hi``), or "no interval with n seeds" under
+    :data:`MIN_SEEDS_FOR_INTERVAL` seeds on either side."""
+    n = min(v.n_seeds_a, v.n_seeds_b)
+    if n < MIN_SEEDS_FOR_INTERVAL:
+        return f"no interval with {n} seed{'s' if n != 1 else ''}"
+    return fmt_interval(v.diff_lo if lo is None else lo, v.diff_hi if hi is None else hi)
+
+
 def verdict_sentence(v: Verdict) -> str:
     """One quotable sentence stating a pairwise verdict and its statistics."""
     pct = f"{100.0 * v.level:g} %"
@@ -56,7 +79,7 @@ def verdict_sentence(v: Verdict) -> str:
             f"{v.name_b}: over {where}, the mean {v.indicator.name} of "
             f"{v.name_b}'s SPCPs minus {v.name_a}'s is "
             f"{v.indicator.amount(v.difference)} ({pct} CI "
-            f"{fmt_interval(v.diff_lo, v.diff_hi)}; "
+            f"{diff_interval(v)}; "
             f"P({v.name_a} safer) {fmt_p(v.p_a_safer, cap_high=True)}; "
             f"{v.n_seeds_a} vs {v.n_seeds_b} seeds)."
         )
@@ -77,7 +100,7 @@ def _safer_sentence(v: Verdict, pct: str, where: str) -> str:
     n_s, n_o = (v.n_seeds_a, v.n_seeds_b) if a_safer else (v.n_seeds_b, v.n_seeds_a)
     return (
         f"{v.safer} is safer than {other}: its SPCPs {v.indicator.phrase(diff)} on "
-        f"average over {where} ({pct} CI {fmt_interval(lo, hi)}; "
+        f"average over {where} ({pct} CI {diff_interval(v, lo, hi)}; "
         f"P({v.safer} safer) {fmt_p(p, cap_high=True)}; {n_s} vs {n_o} seeds)."
     )
 

@@ -131,7 +131,13 @@ def crossplay_blocks(
         blocks.append(Callout("Timid VUT", (TIMID_NOTE,), "warning"))
     blocks.append(pairs_table(a.crossplay_pairs, "H", pct, options.welch_alpha))
     blocks.append(
-        BulletList(tuple(crossplay_sentence(c, a.crossplay_blocks) for c in a.crossplay_pairs))
+        BulletList(
+            tuple(
+                crossplay_sentence(r.vs_next, a.crossplay_blocks)
+                for r in a.crossplay_rows
+                if r.vs_next is not None
+            ),
+        )
     )
     return blocks
 

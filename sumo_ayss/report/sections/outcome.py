@@ -248,5 +248,9 @@ def exposure_blocks(
     if any(o.timid for o in outcomes.values()):
         blocks.append(Callout("Timid VUT", (TIMID_NOTE,), "warning"))
     blocks.append(pairs_table(a.exposure_pairs, "harm", pct, options.welch_alpha))
-    blocks.append(BulletList(tuple(exposure_sentence(c) for c in a.exposure_pairs)))
+    blocks.append(
+        BulletList(
+            tuple(exposure_sentence(r.vs_next) for r in a.exposure_rows if r.vs_next is not None),
+        )
+    )
     return blocks
