@@ -62,7 +62,11 @@ def verdict_sentence(
     """
     pct = f"{100 * c.level:g} %"
     if c.test == "paired t":
-        how = f"paired t-test over {c.n_a} shared seeds"
+        df = c.n_a - 1
+        how = (
+            f"paired t-test over {c.n_a} shared seeds ({df} degree{'s' if df != 1 else ''} "
+            "of freedom)"
+        )
     elif c.test == "Welch t":
         how = f"Welch t-test, {c.n_a} vs {c.n_b} seeds"
     else:
@@ -71,9 +75,16 @@ def verdict_sentence(
     # stated amount: of B - A when B scores higher, of A - B otherwise.
     b_higher = c.difference < 0
     lo, hi = (-c.hi, -c.lo) if b_higher else (c.lo, c.hi)
-    ci = fmt_interval(lo, hi, digits, missing="interval undefined")
+    ci = fmt_interval(lo, hi, digits)
+    n = min(c.n_a, c.n_b)
+    if ci:
+        ci = f"{pct} CI {ci}"
+    elif n < 3:  # :data:`sumo_ayss.analysis.seed_intervals.MIN_SEEDS_FOR_INTERVAL`
+        ci = f"no interval with {n} seed{'s' if n != 1 else ''}"
+    else:
+        ci = "interval undefined"
     p = fmt_p_family(c.p, c.p_family, c.family_size, undefined="undefined")
-    stats = f"{pct} CI {ci}; {how}, {p}"
+    stats = f"{ci}; {how}, {p}"
     amount = fmt_num(abs(c.difference), digits, minus="-", missing="nan")
     amount += f" {unit}" if unit else ""
     what = score.format(amount=amount, more_less="more" if b_higher else "less")

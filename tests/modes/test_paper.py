@@ -142,7 +142,10 @@ def test_pair_sentence_under_the_rule() -> None:
 
 def test_significance_rule_names_the_level_and_alpha() -> None:
     rule = significance_rule(ReportOptions(level=0.9, welch_alpha=0.01))
-    assert "BOTH the 90 % hierarchical-bootstrap interval" in rule and "p < 0.01, that p adjusted by Holm" in rule
+    assert (
+        "BOTH the 90 % hierarchical-bootstrap interval" in rule
+        and "p < 0.01, that p adjusted by Holm" in rule
+    )
 
 
 def test_paper_headline_words_the_verdict_record() -> None:

@@ -1,0 +1,135 @@
+"""A generated report, scanned whole: no interval past what its quantity can take, none
+where the seeds cannot support one, and each table once (issue 35)."""
+
+from __future__ import annotations
+
+import re
+from collections import Counter
+from pathlib import Path
+
+import pytest
+
+from sumo_ayss.report import write_report
+from tests.report.test_report import FAST, make_crossplay, make_run
+
+VUTS = ("pi1", "pi2", "pi1_again")
+
+NUM = r"[−-]?\d+(?:\.\d+)?"
+INTERVAL = re.compile(rf"\(({NUM}) ?%?(?:–| to )({NUM}) ?%?\)")
+
+
+def _report(root: Path, seeds: int) -> str:
+    for vut in VUTS:
+        for seed in range(seeds):
+            make_run(root, "car_following", vut, seed)
+    make_crossplay(root / "car_following", list(VUTS), range(seeds))
+    write_report([root], options=FAST)
+    return (root / "report" / "summary.md").read_text(encoding="utf-8")
+
+
+@pytest.fixture(scope="module")
+def reports(tmp_path_factory: pytest.TempPathFactory) -> dict[int, str]:
+    return {n: _report(tmp_path_factory.mktemp(f"runs{n}"), n) for n in (2, 4)}
+
+
+def _tables(md: str) -> list[tuple[str, list[str], list[list[str]]]]:
+    """``(caption, header, rows)`` of every Markdown table (caption: the bold line above)."""
+    out = []
+    lines = md.splitlines()
+    i = 0
+    while i < len(lines):
+        if lines[i].startswith("|") and i + 1 < len(lines) and lines[i + 1].startswith("|---"):
+            caption = next(
+                (lines[j] for j in range(i - 1, max(i - 4, -1), -1) if lines[j].startswith("**")),
+                "",
+            )
+            header = [c.strip() for c in lines[i].strip("|").split(" | ")]
+            rows = []
+            i += 2
+            while i < len(lines) and lines[i].startswith("|"):
+                rows.append([c.strip() for c in lines[i].strip("|").split(" | ")])
+                i += 1
+            out.append((caption, header, rows))
+        else:
+            i += 1
+    return out
+
+
+def _value(text: str) -> float:
+    return float(text.replace("−", "-"))
+
+
+def _bounds(header: str, row_label: str) -> tuple[float, float] | None:
+    """What the column's (or, in the premise table, the row's) quantity can take."""
+    h = header.lower()
+    if "crash rate" in h or row_label.startswith("crash rate"):
+        return 0.0, 100.0
+    if "−" in header and ("harm" in h or re.search(r"\bH_", header)):
+        return -1.0, 1.0  # a difference of two harms in [0, 1]
+    if "margin" in h:
+        return -1.0, 1.0  # the leaderboard's margin: a difference of harms here
+    if "harm" in h or re.match(r"H \(", header):
+        return 0.0, 1.0
+    if "final headway" in row_label:
+        return 0.0, float("inf")
+    return None
+
+
+def _seed_level(header: str, caption: str) -> bool:
+    """Whether a column's intervals are over training seeds (none with two)."""
+    h = header.lower()
+    return (
+        (
+            ("harm" in h or bool(re.match(r"H \(", header)) or "margin" in h or "index" in h)
+            and "crash" not in h
+        )
+        or "premise" in caption.lower()
+        or "outcome of the spcps per vut" in caption.lower()
+    )
+
+
+@pytest.mark.parametrize("seeds", [2, 4])
+def test_no_interval_past_what_the_quantity_can_take(reports: dict[int, str], seeds: int) -> None:
+    checked = 0
+    for caption, header, rows in _tables(reports[seeds]):
+        for row in rows:
+            for col, cell in zip(header, row, strict=False):
+                for lo, hi in INTERVAL.findall(cell):
+                    lo_v, hi_v = _value(lo), _value(hi)
+                    assert lo_v <= hi_v, (caption, col, cell)
+                    bounds = _bounds(col, row[0])
+                    if bounds is not None:
+                        checked += 1
+                        assert bounds[0] <= lo_v and hi_v <= bounds[1], (caption, col, cell)
+    assert checked > 10  # the scan saw the report's intervals
+
+
+def test_two_seeds_print_no_interval_over_seeds(reports: dict[int, str]) -> None:
+    md = reports[2]
+    seen = 0
+    for caption, header, rows in _tables(md):
+        for row in rows:
+            for col, cell in zip(header, row, strict=False):
+                if _seed_level(col, caption) and INTERVAL.search(cell) and col != "seed":
+                    pytest.fail(f"an interval over 2 seeds: {caption} / {col}: {cell}")
+                seen += "no interval" in cell
+    assert seen >= 6
+    # ... nor in the verdict sentences: a difference over 2 seed blocks has no interval.
+    for line in md.splitlines():
+        if "training seeds (blocks of opponents)" in line or "shared seeds" in line:
+            assert "% CI" not in line, line
+
+
+def test_four_seeds_print_the_intervals(reports: dict[int, str]) -> None:
+    board = reports[4].split("## Leaderboard")[1].split("## Verdicts")[0]
+    assert INTERVAL.search(board)
+    assert "no interval" not in board
+
+
+@pytest.mark.parametrize("seeds", [2, 4])
+def test_each_table_appears_once(reports: dict[int, str], seeds: int) -> None:
+    bodies = Counter(
+        "\n".join(" | ".join(r) for r in rows) for _, _, rows in _tables(reports[seeds]) if rows
+    )
+    repeated = [b.splitlines()[0] for b, n in bodies.items() if n > 1]
+    assert not repeated, repeated
