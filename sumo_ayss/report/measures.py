@@ -50,7 +50,10 @@ class CaseMeasures:
         rankings: One per measure (:func:`~sumo_ayss.analysis.measure_ranking.
             measure_rankings`).
         r157: The R157 cut-in share per VUT (cut-in only, else empty).
-        values: ``{measure column: {vut: finite values}}`` for the figure.
+        values: ``{measure column: {vut: defined values}}`` for the figure (∞ kept: the
+            medians count it).
+        primary_apart: Per adjacent pair of ``primary_order``, whether the primary mode's
+            family-adjusted test separates them (a tie where not).
     """
 
     case: str
@@ -61,6 +64,7 @@ class CaseMeasures:
     rankings: tuple[MeasureRanking, ...]
     r157: tuple[R157Row, ...]
     values: dict[str, dict[str, np.ndarray]]
+    primary_apart: tuple[bool, ...] = ()
 
 
 def _primary(a: CaseAnalysis) -> tuple[str, tuple[str, ...]]:
@@ -129,12 +133,19 @@ def case_measures(a: CaseAnalysis, *, level: float = 0.95) -> CaseMeasures | str
             )
         )
     values = {
-        m.column: {
-            v: cols[m.column][(cols["vut"] == v) & np.isfinite(cols[m.column])] for v in vuts
-        }
+        m.column: {v: cols[m.column][(cols["vut"] == v) & ~np.isnan(cols[m.column])] for v in vuts}
         for m in MEASURES
     }
-    return CaseMeasures(a.case, pool, vuts, mode, order, tuple(rankings), r157, values)
+    return CaseMeasures(
+        a.case, pool, vuts, mode, order, tuple(rankings), r157, values, _primary_apart(a, mode)
+    )
+
+
+def _primary_apart(a: CaseAnalysis, mode: str) -> tuple[bool, ...]:
+    """Per adjacent pair of the primary ranking, whether its (family-adjusted) test
+    separates them."""
+    rows = a.crossplay_rows if mode == CROSSPLAY.name else a.exposure_rows
+    return tuple(bool(r.significant_vs_next) for r in rows[:-1])
 
 
 def _rows(m: CaseMeasures) -> list[dict[str, object]]:

@@ -133,3 +133,25 @@ def test_each_table_appears_once(reports: dict[int, str], seeds: int) -> None:
     )
     repeated = [b.splitlines()[0] for b, n in bodies.items() if n > 1]
     assert not repeated, repeated
+
+
+def test_ties_read_as_ties_and_the_first_vut_is_named_the_same_everywhere(
+    reports: dict[int, str],
+) -> None:
+    md = reports[2]
+    tables = _tables(md)
+    board = next(rows for cap, head, rows in tables if "leaderboard" in cap)
+    ranks = [r[0] for r in board]
+    first = board[0][1]
+    line = next(
+        ln.split("safest first: ")[1]
+        for ln in md.splitlines()
+        if ln.startswith("> Ranking (crossplay mode), safest first: ")
+    )
+    assert line.split(" ")[0] == first  # the verdict box names the leaderboard's first VUT
+    if "≈" in line:  # a tie in the line is a shared rank on the board, and vice versa
+        assert any("–" in r for r in ranks)
+    else:
+        assert not any("–" in r for r in ranks)
+    primary = next(rows for cap, head, rows in tables if "beside the primary one" in cap)[0]
+    assert primary[2] == line  # the measures' primary row: the same line, ties and all
