@@ -69,6 +69,12 @@ def diff_interval(v: Verdict, lo: float | None = None, hi: float | None = None) 
     return fmt_interval(v.diff_lo if lo is None else lo, v.diff_hi if hi is None else hi)
 
 
+def _ci(v: Verdict, pct: str, lo: float | None = None, hi: float | None = None) -> str:
+    """``"95 % CI 0.10–0.80"``, or "no interval with 2 seeds" (:func:`diff_interval`)."""
+    text = diff_interval(v, lo, hi)
+    return text if text.startswith("no interval") else f"{pct} CI {text}"
+
+
 def verdict_sentence(v: Verdict) -> str:
     """One quotable sentence stating a pairwise verdict and its statistics."""
     pct = f"{100.0 * v.level:g} %"
@@ -78,8 +84,7 @@ def verdict_sentence(v: Verdict) -> str:
             f"No significant difference in safety between {v.name_a} and "
             f"{v.name_b}: over {where}, the mean {v.indicator.name} of "
             f"{v.name_b}'s SPCPs minus {v.name_a}'s is "
-            f"{v.indicator.amount(v.difference)} ({pct} CI "
-            f"{diff_interval(v)}; "
+            f"{v.indicator.amount(v.difference)} ({_ci(v, pct)}; "
             f"P({v.name_a} safer) {fmt_p(v.p_a_safer, cap_high=True)}; "
             f"{v.n_seeds_a} vs {v.n_seeds_b} seeds)."
         )
@@ -100,7 +105,7 @@ def _safer_sentence(v: Verdict, pct: str, where: str) -> str:
     n_s, n_o = (v.n_seeds_a, v.n_seeds_b) if a_safer else (v.n_seeds_b, v.n_seeds_a)
     return (
         f"{v.safer} is safer than {other}: its SPCPs {v.indicator.phrase(diff)} on "
-        f"average over {where} ({pct} CI {diff_interval(v, lo, hi)}; "
+        f"average over {where} ({_ci(v, pct, lo, hi)}; "
         f"P({v.safer} safer) {fmt_p(p, cap_high=True)}; {n_s} vs {n_o} seeds)."
     )
 

@@ -145,7 +145,7 @@ def test_verdict_sentence_states_amount_with_its_interval():
     )
     assert text.startswith("[exposure mode] safe is safer than risky: risky's SPCPs extract")
     assert "2.07 more reward per episode than safe's (95 % CI 1.9" in text
-    assert "paired t-test over 3 shared seeds, p < 0.001" in text
+    assert "paired t-test over 3 shared seeds (2 degrees of freedom), p < 0.001" in text
     null = compare_seeds(_scores("a", [1.0, 2.0, 3.0]), _scores("b", [1.5, 1.5, 3.5]))
     text = verdict_sentence(
         null, higher_is_safer=False, score="score {amount} {more_less}", unit="m", mode="exposure"
