@@ -3,19 +3,16 @@ where the seeds cannot support one, and each table once (issue 35)."""
 
 from __future__ import annotations
 
-import re
 from collections import Counter
 from pathlib import Path
 
 import pytest
 
 from sumo_ayss.report import write_report
+from tests.report.report_scan import INTERVAL, bounds, seed_level, tables, value
 from tests.report.test_report import FAST, make_crossplay, make_run
 
 VUTS = ("pi1", "pi2", "pi1_again")
-
-NUM = r"[−-]?\d+(?:\.\d+)?"
-INTERVAL = re.compile(rf"\(({NUM}) ?%?(?:–| to )({NUM}) ?%?\)")
 
 
 def _report(root: Path, seeds: int) -> str:
@@ -32,85 +29,29 @@ def reports(tmp_path_factory: pytest.TempPathFactory) -> dict[int, str]:
     return {n: _report(tmp_path_factory.mktemp(f"runs{n}"), n) for n in (2, 4)}
 
 
-def _tables(md: str) -> list[tuple[str, list[str], list[list[str]]]]:
-    """``(caption, header, rows)`` of every Markdown table (caption: the bold line above)."""
-    out = []
-    lines = md.splitlines()
-    i = 0
-    while i < len(lines):
-        if lines[i].startswith("|") and i + 1 < len(lines) and lines[i + 1].startswith("|---"):
-            caption = next(
-                (lines[j] for j in range(i - 1, max(i - 4, -1), -1) if lines[j].startswith("**")),
-                "",
-            )
-            header = [c.strip() for c in lines[i].strip("|").split(" | ")]
-            rows = []
-            i += 2
-            while i < len(lines) and lines[i].startswith("|"):
-                rows.append([c.strip() for c in lines[i].strip("|").split(" | ")])
-                i += 1
-            out.append((caption, header, rows))
-        else:
-            i += 1
-    return out
-
-
-def _value(text: str) -> float:
-    return float(text.replace("−", "-"))
-
-
-def _bounds(header: str, row_label: str) -> tuple[float, float] | None:
-    """What the column's (or, in the premise table, the row's) quantity can take."""
-    h = header.lower()
-    if "crash rate" in h or row_label.startswith("crash rate"):
-        return 0.0, 100.0
-    if "−" in header and ("harm" in h or re.search(r"\bH_", header)):
-        return -1.0, 1.0  # a difference of two harms in [0, 1]
-    if "margin" in h:
-        return -1.0, 1.0  # the leaderboard's margin: a difference of harms here
-    if "harm" in h or re.match(r"H \(", header):
-        return 0.0, 1.0
-    if "final headway" in row_label:
-        return 0.0, float("inf")
-    return None
-
-
-def _seed_level(header: str, caption: str) -> bool:
-    """Whether a column's intervals are over training seeds (none with two)."""
-    h = header.lower()
-    return (
-        (
-            ("harm" in h or bool(re.match(r"H \(", header)) or "margin" in h or "index" in h)
-            and "crash" not in h
-        )
-        or "premise" in caption.lower()
-        or "outcome of the spcps per vut" in caption.lower()
-    )
-
-
 @pytest.mark.parametrize("seeds", [2, 4])
 def test_no_interval_past_what_the_quantity_can_take(reports: dict[int, str], seeds: int) -> None:
     checked = 0
-    for caption, header, rows in _tables(reports[seeds]):
+    for caption, header, rows in tables(reports[seeds]):
         for row in rows:
             for col, cell in zip(header, row, strict=False):
                 for lo, hi in INTERVAL.findall(cell):
-                    lo_v, hi_v = _value(lo), _value(hi)
+                    lo_v, hi_v = value(lo), value(hi)
                     assert lo_v <= hi_v, (caption, col, cell)
-                    bounds = _bounds(col, row[0])
-                    if bounds is not None:
+                    b = bounds(col, row[0])
+                    if b is not None:
                         checked += 1
-                        assert bounds[0] <= lo_v and hi_v <= bounds[1], (caption, col, cell)
+                        assert b[0] <= lo_v and hi_v <= b[1], (caption, col, cell)
     assert checked > 10  # the scan saw the report's intervals
 
 
 def test_two_seeds_print_no_interval_over_seeds(reports: dict[int, str]) -> None:
     md = reports[2]
     seen = 0
-    for caption, header, rows in _tables(md):
+    for caption, header, rows in tables(md):
         for row in rows:
             for col, cell in zip(header, row, strict=False):
-                if _seed_level(col, caption) and INTERVAL.search(cell) and col != "seed":
+                if seed_level(col, caption) and INTERVAL.search(cell) and col != "seed":
                     pytest.fail(f"an interval over 2 seeds: {caption} / {col}: {cell}")
                 seen += "no interval" in cell
     assert seen >= 6
@@ -129,7 +70,7 @@ def test_four_seeds_print_the_intervals(reports: dict[int, str]) -> None:
 @pytest.mark.parametrize("seeds", [2, 4])
 def test_each_table_appears_once(reports: dict[int, str], seeds: int) -> None:
     bodies = Counter(
-        "\n".join(" | ".join(r) for r in rows) for _, _, rows in _tables(reports[seeds]) if rows
+        "\n".join(" | ".join(r) for r in rows) for _, _, rows in tables(reports[seeds]) if rows
     )
     repeated = [b.splitlines()[0] for b, n in bodies.items() if n > 1]
     assert not repeated, repeated
@@ -139,8 +80,8 @@ def test_ties_read_as_ties_and_the_first_vut_is_named_the_same_everywhere(
     reports: dict[int, str],
 ) -> None:
     md = reports[2]
-    tables = _tables(md)
-    board = next(rows for cap, head, rows in tables if "leaderboard" in cap)
+    found = tables(md)
+    board = next(rows for cap, head, rows in found if "leaderboard" in cap)
     ranks = [r[0] for r in board]
     first = board[0][1]
     line = next(
@@ -153,5 +94,5 @@ def test_ties_read_as_ties_and_the_first_vut_is_named_the_same_everywhere(
         assert any("–" in r for r in ranks)
     else:
         assert not any("–" in r for r in ranks)
-    primary = next(rows for cap, head, rows in tables if "beside the primary one" in cap)[0]
+    primary = next(rows for cap, head, rows in found if "beside the primary one" in cap)[0]
     assert primary[2] == line  # the measures' primary row: the same line, ties and all
