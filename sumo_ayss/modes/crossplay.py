@@ -54,7 +54,8 @@ def crossplay_sentence(c: SeedComparison, blocks: str = "seed") -> str:
     """One quotable sentence for a cross-play comparison (A ranked above B)."""
     from sumo_ayss.analysis.seed_intervals import MIN_SEEDS_FOR_INTERVAL
 
-    unit = "training seeds (blocks of opponents)" if blocks == "seed" else "opponent SPCPs"
+    unit = "training seeds" if blocks == "seed" else "opponent SPCPs"
+    note = "blocks of opponents; " if blocks == "seed" else ""
     pct = f"{100 * c.level:g} %"
     b_higher = c.difference < 0
     lo, hi = (-c.hi, -c.lo) if b_higher else (c.lo, c.hi)
@@ -66,7 +67,7 @@ def crossplay_sentence(c: SeedComparison, blocks: str = "seed") -> str:
         ci = "interval undefined"
     p = "p undefined" if not math.isfinite(c.p) else fmt_p_family(c.p, c.p_family, c.family_size)
     df = f"{c.n_a - 1} degree{'s' if c.n_a != 2 else ''} of freedom"
-    stats = f"{ci}; paired t-test over {c.n_a} {unit} ({df}), {p}"
+    stats = f"{ci}; paired t-test over {c.n_a} {unit} ({note}{df}), {p}"
     more = "more" if b_higher else "less"
     what = (
         f"the pooled SPCPs bring about {abs(c.difference):.3f} {more} harm per episode "

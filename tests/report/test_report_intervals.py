@@ -57,7 +57,7 @@ def test_two_seeds_print_no_interval_over_seeds(reports: dict[int, str]) -> None
     assert seen >= 6
     # ... nor in the verdict sentences: a difference over 2 seed blocks has no interval.
     for line in md.splitlines():
-        if "training seeds (blocks of opponents)" in line or "shared seeds" in line:
+        if "training seeds (blocks of opponents" in line or "shared seeds" in line:
             assert "% CI" not in line, line
 
 
