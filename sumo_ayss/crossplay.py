@@ -56,7 +56,7 @@ from sumo_ayss.run_folder import (
     write_table,
 )
 from sumo_ayss.util.errors import AyssError, CheckpointError, TableError
-from sumo_ayss.vuts.catalog import controller_imports
+from sumo_ayss.vuts.catalog import DEFAULT_REFERENCE, controller_imports
 
 logger = logging.getLogger(__name__)
 
@@ -91,6 +91,7 @@ def run_case(
     force: bool = False,
     trust_controller: bool = False,
     progress: Callable[[str], None] | None = None,
+    reference: str | None = DEFAULT_REFERENCE,
 ) -> Path:
     """Cross-play of one case's runs; writes and returns the case folder's ``crossplay.csv``.
 
@@ -99,6 +100,10 @@ def run_case(
     every SPCP's episodes against its own VUT are compared with its run's ``outcome.csv``
     (:func:`~sumo_ayss.scenarios.crossplay.diagonal_check`); the result goes into
     ``crossplay.json``.
+
+    ``reference`` labels every crash preventable or not
+    (:mod:`sumo_ayss.scenarios.preventability`; None: no labels). It is not part of the
+    stage's settings: a table made without labels is kept (``--force`` relabels).
 
     Raises:
         DiagonalMismatchError: If an SPCP did not reproduce its outcome table (the table
@@ -147,7 +152,9 @@ def run_case(
     ]
     t0 = time.perf_counter()
     with controller_imports(trust_controller):
-        table = run_crossplay(envs, opponents, n=n, seed=seed, progress=progress)
+        table = run_crossplay(
+            envs, opponents, n=n, seed=seed, progress=progress, reference=reference
+        )
     wall_s = time.perf_counter() - t0
     checks = tuple(diagonal_check(table, v, s, out) for (v, s), out in outcomes.items())
     if earlier is not None:
@@ -303,6 +310,7 @@ def main(argv: Sequence[str] | None = None) -> None:
                 force=args.force,
                 trust_controller=args.trust_controller,
                 progress=functools.partial(print, f"{case}:", flush=True),
+                reference=cfg.evaluate.reference,
             )
             matrix = read_matrix(runs)
             rows, _pairs = rank_crossplay(matrix, blocks=args.blocks)

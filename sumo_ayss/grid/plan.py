@@ -50,6 +50,7 @@ def _job(cfg: PipelineConfig, exp: ExperimentConfig, case: str, vut: str, seed: 
         out=str(cfg.out),
         n_outcome=cfg.evaluate.n_outcome,
         ayss=cfg.evaluate.ayss,
+        reference=cfg.evaluate.reference,
     )
 
 

@@ -51,19 +51,16 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 from sumo_ayss.sim.pair import SensedObject
 from sumo_ayss.util.errors import ConfigError
-from sumo_ayss.util.frozen import FrozenMap
-from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
 from sumo_ayss.vuts.controllers import ControllerInput
 
 __all__ = [
     "G_MPS2",
-    "REFERENCE_VUTS",
     "CarefulDriver",
     "FuzzySafetyDriver",
     "RssDriver",
@@ -77,6 +74,9 @@ G_MPS2 = 9.81
 
 #: Default width of the own body [m] where a driver needs it (SUMO's passenger default).
 OWN_WIDTH_M = 1.8
+
+# The catalog entries that name these classes (``cc_driver``, ``fsm``, ``rss``) are
+# :data:`sumo_ayss.vuts.catalog.REFERENCE_VUTS`.
 
 
 # ----------------------------------------------------------------------------- geometry
@@ -678,41 +678,3 @@ class RssDriver:
                     continue
             return -self.b_min_mps2
         return 0.0
-
-
-# ----------------------------------------------------------------------------- catalog
-
-
-def _reference(target: str, description: str, max_decel_mps2: float) -> VehicleType:
-    return VehicleType(
-        model="IDM",
-        params={"length": 5.0, "width": OWN_WIDTH_M, "minGap": 0.0},
-        description=description,
-        controller=ControllerSpec(
-            target=f"sumo_ayss.vuts.reference:{target}",
-            params={},
-            max_accel_mps2=3.0,
-            max_decel_mps2=max_decel_mps2,
-            max_speed_mps=40.0,
-        ),
-    )
-
-
-#: The reference drivers as VUTs: name them in a grid (``grid.vuts``) or in a catalog
-#: entry's place; cross-play drives them against the pooled opponents (they need no
-#: opponents of their own), and the preventability labels replay crashes with one.
-REFERENCE_VUTS: Mapping[str, VehicleType] = FrozenMap(
-    {
-        "cc_driver": _reference(
-            "CarefulDriver",
-            "R157 competent and careful human driver (reaction 0.75 s, 0.774 g in 0.6 s, AEB)",
-            0.85 * G_MPS2,
-        ),
-        "fsm": _reference(
-            "FuzzySafetyDriver", "JRC Fuzzy Safety Model (Mattas et al. 2020)", 0.774 * G_MPS2
-        ),
-        "rss": _reference(
-            "RssDriver", "RSS longitudinal proper response (rho 1 s, b_min 4 m/s²)", 8.0
-        ),
-    }
-)

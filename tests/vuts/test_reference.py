@@ -8,10 +8,10 @@ import pytest
 
 from sumo_ayss.sim.pair import SensedObject
 from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.vuts.catalog import REFERENCE_VUTS
 from sumo_ayss.vuts.controllers import ControllerInput, bound_acceleration, commanded_speed
 from sumo_ayss.vuts.reference import (
     G_MPS2,
-    REFERENCE_VUTS,
     CarefulDriver,
     FuzzySafetyDriver,
     RssDriver,
