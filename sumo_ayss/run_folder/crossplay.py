@@ -247,6 +247,7 @@ def read_crossplay_matrix(path: Path, scale: HarmScale) -> CrossplayMatrix:
         c["collided"],
         episode_return=c["episode_return"],
         mobility=c["vut_mean_speed_mps"],
+        preventable=c["crash_preventable"],
     )
 
 
@@ -315,4 +316,12 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
             missing=f"the cross-play table is unreadable ({exc})",
             problem=text if text.startswith(str(path)) else f"{path}: {text}",
         )
-    return CrossplayInput(matrix, path, diagonal=diagonal)
+    reference = None
+    if folder.crossplay_reference_csv.is_file():
+        try:
+            reference = read_crossplay_matrix(folder.crossplay_reference_csv, scale)
+        except (TableError, ConfigError) as exc:  # the ranking stands without it
+            return CrossplayInput(
+                matrix, path, diagonal=diagonal, problem=f"reference rows unreadable: {exc}"
+            )
+    return CrossplayInput(matrix, path, diagonal=diagonal, reference=reference)

@@ -58,12 +58,14 @@ LABEL_PREVENTABLE = 1.0
 LABEL_UNPREVENTABLE = 0.0
 
 
-def reference_config(config: EnvConfig, reference: str) -> EnvConfig:
+def reference_config(config: EnvConfig, reference: str, *, own_body: bool = False) -> EnvConfig:
     """``config`` with the reference driver ``reference`` in the VUT's place and body.
 
     The reference's catalog entry (:data:`~sumo_ayss.vuts.catalog.REFERENCE_VUTS`) keeps its
     controller; its body (length, width, ...) is the VUT's where the VUT gives one, so that
-    the replay's geometry is the original's. Entered into the catalog under ``reference``.
+    the replay's geometry is the original's (``own_body``: the reference's own 5 m x 1.8 m
+    body instead, for its own row in cross-play). Entered into the catalog under
+    ``reference``.
     """
     if reference not in REFERENCE_VUTS:
         raise ConfigError(
@@ -71,6 +73,8 @@ def reference_config(config: EnvConfig, reference: str) -> EnvConfig:
         )
     ref = REFERENCE_VUTS[reference]
     body = {k: v for k, v in config.vut_type.params.items() if k in CONTROLLED_BODY_PARAMS}
+    if own_body:
+        body = {}
     vt = dataclasses.replace(ref, params={**ref.params, **body})
     vuts = {**config.vuts, reference: vt}
     return dataclasses.replace(config, vuts=vuts, vut=reference)
