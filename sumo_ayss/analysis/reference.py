@@ -79,7 +79,8 @@ class ReferenceComparison:
             suffered less harm than the careful human under the same opponents).
         p_adjusted: Holm-adjusted p over the case's VUTs (NaN: no test).
         verdict: ``safer`` / ``less safe`` (adjusted p <= alpha, by the sign),
-            ``not distinguishable``, or ``untested`` (too few blocks or no spread).
+            ``not distinguishable`` (also: identical in every block), or ``untested`` (too
+            few blocks, or no spread around a non-zero difference).
         crashes: The VUT's cross-play collisions.
         episodes: Its cross-play episodes.
         preventable: Collisions labelled preventable.
@@ -182,8 +183,10 @@ def read_against_reference(
         crashes, n = m.crashes(t.name_a)
         prev, lab = m.preventable_crashes(t.name_a)
         lo, hi = wilson_interval(prev, n, level) if n else (math.nan, math.nan)
-        if math.isnan(p_adj):
-            verdict: Verdict = "untested"
+        if math.isnan(p_adj) and t.test == "paired t" and t.difference == 0.0:
+            verdict: Verdict = "not distinguishable"  # identical in every block
+        elif math.isnan(p_adj):
+            verdict = "untested"
         elif p_adj <= alpha:
             verdict = "safer" if t.difference < 0 else "less safe"
         else:

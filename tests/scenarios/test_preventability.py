@@ -108,9 +108,7 @@ def test_labels_blind_vut_crashes_preventable_where_the_reference_stops_in_time(
     episodes = _run(cfg, scenarios)
     collided = [e.collided for e in episodes]
     assert all(collided), "the blind VUT crashes into a POV braking to a stop every time"
-    labels = label_crashes(
-        cfg, scenarios, collided, [e.actions for e in episodes], sumo_seed=7
-    )
+    labels = label_crashes(cfg, scenarios, collided, [e.actions for e in episodes], sumo_seed=7)
     # At 1 m no reaction can help; with 20 m and 30 m the careful driver stops in time.
     assert labels[0] == 0.0
     assert labels[3] == 1.0 and labels[4] == 1.0
