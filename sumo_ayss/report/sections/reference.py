@@ -58,7 +58,7 @@ def _preventable_text(r: ReferenceComparison) -> str:
 
 
 def _rows(reading: ReferenceReading) -> list[tuple[str, ...]]:
-    rows = []
+    rows: list[tuple[str, ...]] = []
     for r in reading.rows:
         t = r.test
         diff = f"{fmt_num(t.difference, 3)} ({fmt_num(t.lo, 3)} to {fmt_num(t.hi, 3)})"
