@@ -212,7 +212,9 @@ def _reference_rows(
         if same:
             return
     base = runs[0].experiment.env
-    envs = {name: reference_config(base, name, own_body=True) for name in references}
+    for name in references:  # one catalog holding every reference: one world for all
+        base = reference_config(base, name, own_body=True)
+    envs = {name: dataclasses.replace(base, vut=name) for name in references}
     opponents = [
         Opponent(r.experiment.env.vut, r.config_seed, functools.partial(load_spcp, r)) for r in runs
     ]
