@@ -152,7 +152,7 @@ def test_ragged_rows_bad_bools_and_missing_files_are_refused(tmp_path: Path) -> 
     write_table(path, table_from_rows(OUTCOME_SCHEMA, outcome_rows()))
     lines = path.read_text().splitlines()
     path.write_text("\n".join([*lines[:2], lines[2] + ",9", *lines[3:]]) + "\n")
-    with pytest.raises(TableError, match="row 1 has 25 cells, header has 24"):
+    with pytest.raises(TableError, match="row 1 has 26 cells, header has 25"):
         read_table(path, OUTCOME_SCHEMA)
     rows = [line.split(",") for line in lines]
     rows[1][OUTCOME_SCHEMA.names.index("collided")] = "2"
