@@ -48,11 +48,13 @@ from sumo_ayss.run_folder import (
     is_done,
     load_crossplay,
     read_crossplay_json,
+    read_inevitable,
     read_outcome_json,
     read_run,
     read_table,
     run_dir_for,
     write_crossplay_json,
+    write_inevitable,
     write_table,
 )
 from sumo_ayss.util.errors import AyssError, CheckpointError, TableError
@@ -176,6 +178,23 @@ def run_case(
     return folder.crossplay_csv
 
 
+def _inevitable(env: Any, folder: CaseFolder, n: int, seed: int) -> None:
+    """``inevitable.json``: which of the ``n`` scenarios are inevitable-collision states
+    (a second per thousand scenarios; kept when it holds this scenario set)."""
+    from sumo_ayss.envs.odd import sample_initial_conditions
+    from sumo_ayss.scenarios.inevitable import ics_flags, pov_strategies
+
+    path = folder.inevitable_json
+    if path.is_file():
+        try:
+            if read_inevitable(path)[:2] == (n, seed):
+                return
+        except TableError:
+            pass
+    flags = ics_flags(env, sample_initial_conditions(env.odd, n, seed))
+    write_inevitable(path, n, seed, flags, tuple(pov_strategies(env.case)))
+
+
 def _reference_rows(
     runs: Sequence[RunRecord],
     folder: CaseFolder,
@@ -193,6 +212,7 @@ def _reference_rows(
     from sumo_ayss.scenarios.crossplay import Opponent, run_crossplay
     from sumo_ayss.scenarios.preventability import reference_config
 
+    _inevitable(runs[0].experiment.env, folder, n, seed)
     path = folder.crossplay_reference_csv
     if not references:
         return

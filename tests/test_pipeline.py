@@ -116,6 +116,9 @@ def test_crossplay_mode_runs_the_crossplay_stage_and_reports_it(tmp_path: Path) 
         assert np.isin(label[table["collided"]], [0.0, 1.0]).all()
         assert np.isnan(label[~table["collided"]]).all()
     assert "(k) Against the careful human" in text and "the careful human (cc_driver)" in text
+    ics = json.loads((case / "inevitable.json").read_text())
+    assert ics["n"] == 10 and ics["seed"] == 4242 and ics["strategies"] == ["brake"]
+    assert "are inevitable-collision states" in text
     before = (case / "crossplay.csv").stat().st_mtime_ns
     ref_before = (case / "crossplay_reference.csv").stat().st_mtime_ns
     run_pipeline(cfg, live=False)  # a rerun skips every finished stage, cross-play included

@@ -236,6 +236,8 @@ class CrossplayInput:
             episodes of its outcome table; empty when the record predates the check.
         reference: The reference drivers' rows against the same pool
             (``crossplay_reference.csv``), or None (no such table, or unreadable).
+        inevitable: ``(n, seed, indices)`` of the scenario set and its inevitable-collision
+            states (``inevitable.json``), or None.
     """
 
     matrix: CrossplayMatrix | None = None
@@ -244,6 +246,7 @@ class CrossplayInput:
     problem: str = ""
     diagonal: tuple[tuple[str, int, int, int], ...] = ()
     reference: CrossplayMatrix | None = None
+    inevitable: tuple[int, int, tuple[int, ...]] | None = None
 
 
 @dataclass(frozen=True)

@@ -41,6 +41,7 @@ __all__ = [
     "CAREFUL_HUMAN",
     "ReferenceComparison",
     "ReferenceReading",
+    "ScenarioSet",
     "holm_adjust",
     "read_against_reference",
 ]
@@ -137,6 +138,34 @@ class ReferenceReading:
     @property
     def crash_rate(self) -> float:
         return self.crashes / self.episodes if self.episodes else math.nan
+
+
+@dataclass(frozen=True)
+class ScenarioSet:
+    """How much of a case's scenario set no braking survives.
+
+    Attributes:
+        n: Scenarios (the outcome / cross-play set).
+        ics: Of those, inevitable-collision states
+            (:mod:`sumo_ayss.scenarios.inevitable`): a VUT braking at 0.85 g from the
+            first step still touches a POV that brakes (or cuts in) at once.
+        lo: Lower end of the Wilson interval of ``ics / n``.
+        hi: Upper end.
+    """
+
+    n: int
+    ics: int
+    lo: float
+    hi: float
+
+    @property
+    def share(self) -> float:
+        return self.ics / self.n if self.n else math.nan
+
+    @classmethod
+    def of(cls, n: int, ics: int, level: float = 0.95) -> ScenarioSet:
+        lo, hi = wilson_interval(ics, n, level) if n else (math.nan, math.nan)
+        return cls(n, ics, lo, hi)
 
 
 def read_against_reference(

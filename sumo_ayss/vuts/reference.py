@@ -678,3 +678,22 @@ class RssDriver:
                     continue
             return -self.b_min_mps2
         return 0.0
+
+
+@dataclass
+class FullBraking:
+    """Brakes at ``decel_mps2`` (default 0.85 g, the CC driver's AEB) from the first step,
+    whatever it sees: the best any driver could do by braking, for the inevitable-collision
+    states of :mod:`sumo_ayss.scenarios.inevitable`."""
+
+    decel_mps2: float = 0.85 * G_MPS2
+
+    def __post_init__(self) -> None:
+        _check("decel_mps2", self.decel_mps2, low=0.0, strict=True)
+
+    def reset(self) -> None:
+        """Stateless."""
+
+    def acceleration(self, state: ControllerInput) -> float:
+        del state
+        return -self.decel_mps2

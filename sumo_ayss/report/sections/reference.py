@@ -10,7 +10,7 @@ from sumo_ayss.modes.formatting import fmt_num, fmt_prob
 from sumo_ayss.report.blocks import Block, Heading, Paragraph, Table
 from sumo_ayss.report.sections.common import crash_text
 
-__all__ = ["EXPLANATION", "reference_blocks", "reference_markdown"]
+__all__ = ["EXPLANATION", "reference_blocks", "reference_markdown", "scenario_set_line"]
 
 #: The paragraph a safety engineer can quote.
 EXPLANATION = (
@@ -104,11 +104,29 @@ def _scenario_line(reading: ReferenceReading, case: str) -> str:
     )
 
 
+def scenario_set_line(a: CaseAnalysis) -> str:
+    """One sentence on the scenario set's inevitable-collision states ("" without them)."""
+    ss = a.scenario_set
+    if ss is None:
+        return ""
+    return (
+        f"{ss.ics} of the {ss.n} {a.info.title} scenarios "
+        f"({100 * ss.share:.1f} %, {100 * ss.lo:.1f}–{100 * ss.hi:.1f} %) are "
+        "inevitable-collision states: a vehicle braking at 0.85 g from the first instant "
+        "still touches a POV that brakes at once (or cuts in at once). Crashes drawn there "
+        "are no driver's failure; the episodes start there because the ODD draws speeds and "
+        "gaps independently."
+    )
+
+
 def reference_blocks(a: CaseAnalysis) -> list[Block]:
-    """(k) The case's VUTs against each reference driver that drove in cross-play."""
-    if not a.references:
+    """(k) The case's VUTs against each reference driver that drove in cross-play, and the
+    scenario set's inevitable-collision states."""
+    if not a.references and a.scenario_set is None:
         return []
     blocks: list[Block] = [Heading("(k) Against the careful human", 3), Paragraph(EXPLANATION)]
+    if a.scenario_set is not None:
+        blocks.append(Paragraph(scenario_set_line(a)))
     for reading in a.references.values():
         blocks.append(Paragraph(_scenario_line(reading, a.info.title)))
         blocks.append(
@@ -131,6 +149,8 @@ def reference_markdown(analyses: Sequence[CaseAnalysis]) -> list[str]:
     """``ranking.md`` lines: per case, the VUTs against each reference driver."""
     lines: list[str] = []
     for a in analyses:
+        if a.scenario_set is not None:
+            lines += ["", f"Scenario set, {a.case}: {scenario_set_line(a)}"]
         for reading in a.references.values():
             lines += [
                 "",
