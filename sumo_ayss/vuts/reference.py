@@ -218,7 +218,8 @@ class CarefulDriver:
     5. **AEB** (``aeb: true``): whenever TTC to an object fully in the own lane (full
        overlap within 0.1 m) is below ``aeb_ttc_s`` (1.5 s, esmini's code; its catalogue
        says 1.4), braking ramps to ``aeb_decel_mps2`` (0.85 g) over ``aeb_ramp_s`` (0.6 s)
-       without reaction time; the stronger of the driver's and the AEB's braking acts.
+       without reaction time and holds it to a standstill (an AEB does not release); the
+       stronger of the driver's and the AEB's braking acts.
 
     Args: the named parameters above (defaults cited in the module docstring).
     """
