@@ -117,7 +117,7 @@ def scenario_set_line(a: CaseAnalysis) -> str:
     if ss is None:
         return ""
     return (
-        f"{ss.ics} of the {ss.n} {a.info.title} scenarios "
+        f"{ss.ics} of the {ss.n} {a.case.replace('_', '-')} scenarios "
         f"({100 * ss.share:.1f} %, {100 * ss.lo:.1f}–{100 * ss.hi:.1f} %) are "
         "inevitable-collision states: a vehicle braking at 0.85 g from the first instant "
         "still touches a POV that brakes at once (or cuts in at once). Crashes drawn there "
