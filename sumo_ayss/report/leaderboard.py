@@ -23,10 +23,12 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from sumo_ayss.analysis.case import CaseAnalysis
-from sumo_ayss.modes import EXPOSURE, Standing, get_mode, headline_text
+from sumo_ayss.analysis.reference import CAREFUL_HUMAN, ReferenceComparison
+from sumo_ayss.modes import CROSSPLAY, EXPOSURE, Standing, get_mode, headline_text
 from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p, rank_labels
 from sumo_ayss.report.blocks import Table
 from sumo_ayss.report.sections.common import crash_cell, mobility_cell
+from sumo_ayss.report.sections.reference import preventable_text
 
 __all__ = [
     "COLUMNS",
@@ -51,6 +53,10 @@ class LeaderRow:
         score: The mode's score (its point estimate; the interval is in the mode's section).
         crash_rate: Crash rate with its Wilson interval over the pooled episodes, or "—".
         mobility: Mean VUT speed over the same episodes (TIMID flagged), or "—".
+        preventable: Crashes a careful human avoided when replaying them (cross-play), with
+            the Wilson interval of their rate, or "—" (no labels, or not cross-play).
+        vs_human: The verdict against the careful human (cross-play's reference row), e.g.
+            ``"less safe (Holm p = 0.025)"``, or "—".
     """
 
     rank: str
@@ -59,6 +65,8 @@ class LeaderRow:
     score: str
     crash_rate: str
     mobility: str
+    preventable: str = "—"
+    vs_human: str = "—"
 
 
 @dataclass(frozen=True)
@@ -74,6 +82,8 @@ class LeaderColumn:
     header: str
     numeric: bool
     cell: Callable[[LeaderRow], str]
+    optional: bool = False
+    """Left out of a table whose every row has "—" there (e.g. no reference row)."""
 
 
 COLUMNS: tuple[LeaderColumn, ...] = (
@@ -83,6 +93,8 @@ COLUMNS: tuple[LeaderColumn, ...] = (
     LeaderColumn("{score}", True, lambda r: r.score),
     LeaderColumn("crash rate", True, lambda r: r.crash_rate),
     LeaderColumn("mean speed", True, lambda r: r.mobility),
+    LeaderColumn("preventable crashes", True, lambda r: r.preventable, optional=True),
+    LeaderColumn("vs the careful human", False, lambda r: r.vs_human, optional=True),
 )
 """The leaderboard's columns, in order."""
 
@@ -116,6 +128,8 @@ def leaderboard_rows(a: CaseAnalysis) -> list[LeaderRow]:
     outcomes = a.outcomes.get(a.ranking_mode) or a.outcomes.get(EXPOSURE.name, {})
     standings = mode.standings(a)
     labels = rank_labels([bool(s.significant) for s in standings[:-1]]) if standings else []
+    human = a.references.get(CAREFUL_HUMAN) if a.ranking_mode == CROSSPLAY.name else None
+    against = {r.vut: r for r in human.rows} if human is not None else {}
     return [
         LeaderRow(
             label,
@@ -124,9 +138,20 @@ def leaderboard_rows(a: CaseAnalysis) -> list[LeaderRow]:
             fmt_num(s.score, mode.digits),
             crash_cell(outcomes.get(s.vut)),
             mobility_cell(outcomes.get(s.vut)),
+            *_human_cells(against.get(s.vut)),
         )
         for label, s in zip(labels, standings, strict=True)
     ]
+
+
+def _human_cells(r: ReferenceComparison | None) -> tuple[str, str]:
+    """The preventable-crash and careful-human cells of a VUT (cross-play's reference)."""
+    if r is None:
+        return "—", "—"
+    prevent = preventable_text(r)
+    if r.verdict == "untested" or math.isnan(r.p_adjusted):
+        return prevent, r.verdict
+    return prevent, f"{r.verdict} (Holm p {fmt_p(r.p_adjusted)})"
 
 
 def leaderboard_table(a: CaseAnalysis, level: float) -> Table | None:
@@ -137,19 +162,27 @@ def leaderboard_table(a: CaseAnalysis, level: float) -> Table | None:
     pct = f"{100 * level:g} %"
     mode = get_mode(a.ranking_mode)
     score = f"{mode.score_name}, {mode.unit(a)}" if a.ranking_mode == "paper" else mode.score_name
-    head = tuple(c.header.replace("{score}", score).replace("95 %", pct) for c in COLUMNS)
+    columns = [c for c in COLUMNS if not (c.optional and all(c.cell(r) == "—" for r in rows))]
+    head = tuple(c.header.replace("{score}", score).replace("95 %", pct) for c in columns)
     return Table(
         f"{a.info.title}: leaderboard ({a.ranking_mode} mode), safest first",
         head,
-        tuple(tuple(c.cell(r) for c in COLUMNS) for r in rows),
-        tuple(c.numeric for c in COLUMNS),
+        tuple(tuple(c.cell(r) for c in columns) for r in rows),
+        tuple(c.numeric for c in columns),
         f"vs next: how much safer than the VUT ranked next, as the paired difference the test "
         f"is about, with its {pct} interval (none with fewer than three seeds, never past "
         "what a difference of two scores can be); 'safer than' when the test's p, adjusted by "
         "Holm over the ranking's adjacent claims, is below 0.05, else 'tied' (a tie shares "
         "one rank). Score: point estimate (per-VUT intervals in the mode's section). Crash "
         "rate: episodes pooled over the SPCPs this mode drives, Wilson 95 % interval. Mean "
-        "speed: the VUT's mean speed over the same episodes.",
+        "speed: the VUT's mean speed over the same episodes."
+        + (
+            " Preventable crashes: those R157's careful human avoided when replaying them "
+            "(section k); vs the careful human: the VUT's harm against the careful human's "
+            "under the same opponents (paired, Holm over the VUTs)."
+            if len(columns) > len(COLUMNS) - 2
+            else ""
+        ),
     )
 
 
@@ -175,9 +208,14 @@ def leaderboard_text(analyses: Sequence[CaseAnalysis], width: int = 80) -> str:
         name_w = max((len(r.vut) for r in rows), default=0)
         rank_w = max((len(r.rank) for r in rows), default=0)
         for r in rows:
+            human = (
+                f"   preventable {r.preventable}   vs careful human: {r.vs_human}"
+                if r.vs_human != "—"
+                else ""
+            )
             lines += textwrap.wrap(
                 f"{r.rank:>{rank_w}}. {r.vut:<{name_w}}  {r.score}   crashes {r.crash_rate}   "
-                f"speed {r.mobility}",
+                f"speed {r.mobility}{human}",
                 width,
                 initial_indent="  ",
                 subsequent_indent="      ",
