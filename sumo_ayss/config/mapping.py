@@ -24,15 +24,9 @@ from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
 
 
 def _anchor_controller(spec: ControllerSpec, base_dir: Path) -> ControllerSpec:
-    """A ``path/to/file.py:attr`` target made absolute against ``base_dir`` (the YAML
-    file's folder), like every other path of a configuration; module targets unchanged."""
-    module_part, _, attr = spec.target.rpartition(":")
-    if not module_part.endswith(".py"):
-        return spec
-    path = Path(module_part).expanduser()
-    if path.is_absolute():
-        return spec
-    return dataclasses.replace(spec, target=f"{(base_dir / path).resolve()}:{attr}")
+    """The spec's paths (a ``file.py`` target, an FMU, a process's folder) made absolute
+    against ``base_dir`` (the YAML file's folder), like every other path of a configuration."""
+    return spec.anchored(base_dir)
 
 
 def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> Any:

@@ -43,3 +43,7 @@ class ControllerVut(VutLaw):
     def accel_mps2(self, pair: VehiclePair) -> float:
         """SUMO's acceleration of the VUT in the last step [m/s²] (the realised command)."""
         return pair.vut_accel_mps2()
+
+    def close(self) -> None:
+        """Release the controller's FMU instance or process, if it has one."""
+        self.driver.close()
