@@ -9,7 +9,9 @@ library).
 
 Usage (from the repository root)::
 
-    python examples/fmu/build_fmu.py --fmi 2 runs/fmus/acc.fmu
+    python -m examples.fmu.build_fmu --fmi 2 runs/fmus/acc.fmu     # C, FMI 2.0
+    python -m examples.fmu.build_fmu --fmi 3 runs/fmus/acc3.fmu    # C, FMI 3.0
+    python -m examples.fmu.build_fmu --python runs/fmus/           # acc_slave.py, pythonfmu
 
 The FMU's variables (all SI units)::
 
@@ -25,6 +27,7 @@ import argparse
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
 import uuid
 import zipfile
@@ -203,12 +206,38 @@ def build_acc_fmu(
     return dest
 
 
+def build_python_fmu(script: Path, dest_dir: Path) -> Path:
+    """Export the pythonfmu slave in ``script`` as an FMU into ``dest_dir``; its path.
+
+    Runs ``python -m pythonfmu build`` in the script's folder (it imports the script).
+
+    Raises:
+        RuntimeError: pythonfmu failed (its output in the message).
+    """
+    script = Path(script).resolve()
+    dest_dir = Path(dest_dir).resolve()
+    dest_dir.mkdir(parents=True, exist_ok=True)
+    before = set(dest_dir.glob("*.fmu"))
+    cmd = [sys.executable, "-m", "pythonfmu", "build", "-f", script.name, "-d", str(dest_dir)]
+    done = subprocess.run(cmd, cwd=script.parent, capture_output=True, text=True, check=False)
+    built = sorted(set(dest_dir.glob("*.fmu")) - before) or sorted(dest_dir.glob("*.fmu"))
+    if done.returncode != 0 or not built:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stdout}{done.stderr}")
+    return built[-1]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("dest", type=Path, help="the .fmu file to write")
+    parser.add_argument("dest", type=Path, help="the .fmu file to write (--python: a folder)")
     parser.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="FMI version")
+    parser.add_argument(
+        "--python", action="store_true", help="export acc_slave.py with pythonfmu instead"
+    )
     args = parser.parse_args()
-    print(build_acc_fmu(args.dest, args.fmi))
+    if args.python:
+        print(build_python_fmu(HERE / "acc_slave.py", args.dest))
+    else:
+        print(build_acc_fmu(args.dest, args.fmi))
 
 
 if __name__ == "__main__":

@@ -20,13 +20,19 @@ from typing import Any, Literal
 from sumo_ayss.config.env import EnvConfig
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.validation import check_choice, unknown_key
-from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
+from sumo_ayss.vuts.catalog import DRIVER_KEYS, ControllerSpec, VehicleType
 
 
 def _anchor_controller(spec: ControllerSpec, base_dir: Path) -> ControllerSpec:
     """The spec's paths (a ``file.py`` target, an FMU, a process's folder) made absolute
     against ``base_dir`` (the YAML file's folder), like every other path of a configuration."""
     return spec.anchored(base_dir)
+
+
+def _names_black_box(value: Mapping[Any, Any]) -> bool:
+    """Whether a VUT entry is driven by an FMU or a process (a driver key other than
+    ``controller``, :data:`~sumo_ayss.vuts.catalog.DRIVER_KEYS`)."""
+    return any(value.get(key) is not None for key in DRIVER_KEYS if key != "controller")
 
 
 def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> Any:
@@ -36,15 +42,17 @@ def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> A
         if isinstance(value, ControllerSpec):
             return value
         return _anchor_controller(ControllerSpec.from_mapping(value, where), base_dir)
-    if dataclasses.is_dataclass(tp) and isinstance(tp, type):
-        if isinstance(value, tp):
-            return value
-        return build(tp, value, where, base_dir, default)
-    if tp is VehicleType:
+    if tp is VehicleType and isinstance(value, Mapping) and _names_black_box(value):
+        # An FMU or a process VUT: read whole by the catalog (its record is not a field of
+        # VehicleType's own, so the field-by-field build below would not know the key).
         vt = VehicleType.from_mapping(value, where)
         if vt.controller is None:
             return vt
         return dataclasses.replace(vt, controller=_anchor_controller(vt.controller, base_dir))
+    if dataclasses.is_dataclass(tp) and isinstance(tp, type):
+        if isinstance(value, tp):
+            return value
+        return build(tp, value, where, base_dir, default)
     if origin in (types.UnionType, typing.Union):
         if value is None and type(None) in args:
             return None

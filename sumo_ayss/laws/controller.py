@@ -27,7 +27,7 @@ class ControllerVut(VutLaw):
         """Import and build ``config.vut``'s controller (errors name the config field)."""
         spec = config.vut_type.controller
         assert spec is not None
-        where = f"env.vuts.{config.vut}.controller"
+        where = f"env.vuts.{config.vut}.{spec.yaml_key}"
         return cls(ControlledVut(spec.build(where), spec, config.sim.step_length_s))
 
     def start(self, pair: VehiclePair, speed_mps: float) -> None:

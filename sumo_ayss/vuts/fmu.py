@@ -203,7 +203,8 @@ class FmuController:
             raise _fail(
                 f"{self.where}.{field}",
                 self.label,
-                f"variable {name!r} is a {var.causality}, not {' or '.join(causalities)}",
+                f"variable {name!r} has causality {var.causality!r}, not "
+                f"{' or '.join(map(repr, causalities))}",
             )
         return var
 
