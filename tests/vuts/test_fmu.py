@@ -11,15 +11,13 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pytest
 
-from sumo_ayss.config import EnvConfig
-from sumo_ayss.envs import make_env
 from sumo_ayss.util.errors import ConfigError, ControllerError
-from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType, controller_imports
+from sumo_ayss.vuts.catalog import VehicleType, controller_imports
 from sumo_ayss.vuts.controllers import ControllerInput
 from sumo_ayss.vuts.fmu_spec import FmuSpec
+from tests.vuts.episodes import episodes, python_acc
 
 ACC_INPUTS = {
     "v_ego": "speed_mps",
@@ -39,35 +37,6 @@ def acc_fmu(path: Path, time_gap_s: float = 2.0, **kw: Any) -> FmuSpec:
         parameters={"time_gap_s": time_gap_s},
         **kw,
     )
-
-
-def python_acc(time_gap_s: float = 2.0) -> ControllerSpec:
-    return ControllerSpec(
-        "examples.acc_controller:TimeGapACC", 3.0, 6.0, params={"time_gap_s": time_gap_s}
-    )
-
-
-def episodes(spec: ControllerSpec, case: str, n: int = 3) -> list[list[Any]]:
-    """``n`` episodes of random POV actions against the VUT ``spec`` drives (real SUMO)."""
-    cfg = EnvConfig(case=case, vut="v", vuts={"v": VehicleType(controller=spec)})  # type: ignore[arg-type]
-    env = make_env(cfg, sumo_seed=0)
-    rng = np.random.default_rng(7)
-    out = []
-    try:
-        for episode in range(n):
-            obs, _ = env.reset(seed=100 + episode)
-            steps: list[Any] = [obs.tolist()]
-            while True:
-                obs, reward, terminated, truncated, info = env.step(
-                    int(rng.integers(env.action_space.n))  # type: ignore[attr-defined]
-                )
-                steps.append((obs.tolist(), reward, terminated, info["vut_accel_mps2"]))
-                if terminated or truncated:
-                    break
-            out.append(steps)
-    finally:
-        env.close()
-    return out
 
 
 def state(speed: float = 20.0, gap: float = 30.0, rel: float = -3.0) -> ControllerInput:
