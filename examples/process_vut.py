@@ -4,9 +4,12 @@ The testbed starts this program, writes one line per message to its standard inp
 reads one line per answer from its standard output (:mod:`sumo_ayss.vuts.process`)::
 
     sumo_ayss-vut 1 <signal> ...   ->  ok 1              (once: the signals of each step)
-    reset                          ->  ok                (every episode)
-    step <value> ...               ->  accel <m/s²>      (every SUMO step)
+    reset <k>                      ->  ok                (every episode of VUT instance k)
+    step <k> <value> ...           ->  accel <m/s²>      (every SUMO step of instance k)
     quit                           ->  (exit)
+
+One process serves every VUT instance ``k`` of a vectorised env; this law keeps no state,
+so it ignores ``k`` (a controller with state would keep one per ``k``).
 
 It needs nothing but Python's standard library, so it reads as a template for a client in
 any language: read a line, split on spaces, answer one line, flush. The law is
@@ -77,7 +80,7 @@ def main() -> int:
         elif words[0] == "reset":
             answer("ok")  # the law keeps no state
         elif words[0] == "step":
-            values = words[1:]
+            values = words[2:]  # words[1] is the instance k
             v, gap, rel = (float(values[index[n]]) for n in NEEDED[:3])
             lead = values[index["has_leader"]] == "1"
             answer(f"accel {acceleration(args, v, gap, rel, lead)!r}")

@@ -21,6 +21,7 @@ from sumo_ayss.config.env import EnvConfig
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.validation import check_choice, unknown_key
 from sumo_ayss.vuts.catalog import DRIVER_KEYS, ControllerSpec, VehicleType
+from sumo_ayss.vuts.controller_spec import DEFAULT_CALL_DEADLINE_S
 
 
 def _anchor_controller(spec: ControllerSpec, base_dir: Path) -> ControllerSpec:
@@ -154,6 +155,8 @@ def _field_default(cls: type, name: str) -> Any:
 
 def to_dict(obj: Any) -> Any:
     """Plain YAML-safe form of a config (the exact resolved config a run used)."""
+    if isinstance(obj, VehicleType) and obj.controller is not None:
+        return _controlled_vut_dict(obj)
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         return {f.name: to_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
     if isinstance(obj, Mapping):
@@ -163,6 +166,24 @@ def to_dict(obj: Any) -> Any:
     if isinstance(obj, Path):
         return str(obj)
     return obj
+
+
+def _controlled_vut_dict(vt: VehicleType) -> dict[str, Any]:
+    """A VUT driven by a controller, an FMU or a process, under its own key (``controller``,
+    ``fmu``, ``process``). A Python controller keeps the form it always had (every field;
+    ``call_deadline_s`` only when it is not the default), so existing run files read the same."""
+    spec = vt.controller
+    assert spec is not None
+    out = {f.name: to_dict(getattr(vt, f.name)) for f in dataclasses.fields(vt)}
+    del out["controller"]
+    if type(spec) is ControllerSpec:
+        fields = {f.name: to_dict(getattr(spec, f.name)) for f in dataclasses.fields(spec)}
+        if spec.call_deadline_s == DEFAULT_CALL_DEADLINE_S:
+            del fields["call_deadline_s"]
+        out["controller"] = fields
+    else:
+        out[spec.yaml_key] = spec.to_dict()
+    return out
 
 
 def env_config_from_mapping(data: Mapping[str, Any], base_dir: Path | None = None) -> EnvConfig:

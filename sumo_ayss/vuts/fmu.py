@@ -33,6 +33,7 @@ left unmapped; a ``doStep`` that fails or asks to terminate; a NaN or infinite o
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import ctypes
 import math
@@ -66,6 +67,15 @@ _TYPES: dict[int, dict[str, tuple[str, Any, frozenset[SignalKind]]]] = {
     },
 }
 _REAL_TYPES = frozenset({"Real", "Float64", "Float32"})
+
+# Each FMU file is read and extracted once per Python process, by (path, size, mtime): the
+# pairs of a vectorised env (up to 256) each hold an instance of the same FMU, and loading
+# one library path again only adds a reference to it (one copy of its code and data
+# segment; instances keep their state apart as the standard requires).
+#: Model descriptions read so far.
+_DESCRIPTIONS: dict[tuple[str, int, int], Any] = {}
+#: Folders the FMUs are extracted to (removed at exit).
+_EXTRACTED: dict[tuple[str, int, int], Path] = {}
 
 
 def _fail(where: str, label: str, message: str) -> ConfigError:
@@ -112,11 +122,19 @@ class FmuController:
             raise ConfigError(f"{where}.path: no FMU file at {path}")
         if not zipfile.is_zipfile(path):
             raise _fail(where, self.label, "is not an FMU: an FMU is a zip archive, this is not")
-        try:
-            md = read_model_description(str(path))
-        except Exception as e:  # fmpy raises plain Exceptions for unreadable descriptions
-            msg = " ".join(str(e).split())[:300] or type(e).__name__
-            raise _fail(where, self.label, f"has no readable modelDescription.xml ({msg})") from e
+        stat = path.stat()
+        key = (str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+        md = _DESCRIPTIONS.get(key)
+        if md is None:
+            try:
+                md = read_model_description(str(path))
+            except Exception as e:  # fmpy raises plain Exceptions for unreadable descriptions
+                msg = " ".join(str(e).split())[:300] or type(e).__name__
+                raise _fail(
+                    where, self.label, f"has no readable modelDescription.xml ({msg})"
+                ) from e
+            _DESCRIPTIONS[key] = md
+        self._key = key
         self.fmi_version = md.fmiMajorVersion if md.fmiVersion else 0
         if self.fmi_version not in _TYPES:
             raise _fail(where, self.label, f"is FMI {md.fmiVersion}; supported: FMI 2.0 and 3.0")
@@ -169,8 +187,11 @@ class FmuController:
         import fmpy
 
         md = self._md
-        folder = Path(tempfile.mkdtemp(prefix="sumo_ayss_fmu_"))
-        fmpy.extract(str(self._path), str(folder))
+        folder = _EXTRACTED.get(self._key)
+        if folder is None or not folder.is_dir():
+            folder = Path(tempfile.mkdtemp(prefix="sumo_ayss_fmu_"))
+            fmpy.extract(str(self._path), str(folder))
+            _EXTRACTED[self._key] = folder
         from fmpy.fmi2 import FMU2Slave
         from fmpy.fmi3 import FMU3Slave
 
@@ -183,7 +204,7 @@ class FmuController:
             instanceName="vut",
         )
         self._live = [False]  # an instance exists (shared with the finalizer)
-        self._finalizer = weakref.finalize(self, _release, self._fmu, self._live, folder)
+        self._finalizer = weakref.finalize(self, _release, self._fmu, self._live)
         self._instantiate()
         self._initialize()
         self._fresh = False
@@ -377,20 +398,23 @@ class FmuController:
         return value
 
     def close(self) -> None:
-        """Terminate and free the instance, unload the library, delete the extracted files
-        (safe to call twice; the next :meth:`reset` opens it again)."""
+        """Terminate and free the instance, release the library (safe to call twice; the
+        next :meth:`reset` opens it again)."""
         if self._fmu is not None:
             self._finalizer()
             self._fmu = None
 
 
-def _release(fmu: Any, live: list[bool], folder: Path) -> None:
-    """Free an FMU instance and its extracted folder (also at garbage collection)."""
-    try:
-        if live[0]:
-            live[0] = False
-            with contextlib.suppress(Exception):  # a failed instance may refuse to terminate
-                fmu.terminate()
-            fmu.freeInstance()
-    finally:
+def _release(fmu: Any, live: list[bool]) -> None:
+    """Free an FMU instance and release its library (also at garbage collection)."""
+    if live[0]:
+        live[0] = False
+        with contextlib.suppress(Exception):  # a failed instance may refuse to terminate
+            fmu.terminate()
+        fmu.freeInstance()
+
+
+@atexit.register
+def _remove_extracted() -> None:
+    for folder in _EXTRACTED.values():
         shutil.rmtree(folder, ignore_errors=True)

@@ -9,14 +9,19 @@ program's own (kept in a file; its last lines appear in errors).
 testbed writes                              the process answers          when
 ==========================================  ===========================  =================
 ``sumo_ayss-vut 1 <signal> <signal> ...``   ``ok 1``                     once, at start
-``reset``                                   ``ok``                       every episode
-``step <value> <value> ...``                ``accel <m/s²>``             every SUMO step
+``reset <k>``                               ``ok``                       every episode
+``step <k> <value> <value> ...``            ``accel <m/s²>``             every SUMO step
 ``quit``                                    (nothing; it exits)          at the end
 ==========================================  ===========================  =================
 
 * The hello line names the protocol, its version and the signals
   (:data:`~sumo_ayss.vuts.signals.SIGNALS`) whose values every ``step`` line carries, in that
   order. A process that does not speak version 1 answers ``error <why>``.
+* ``k`` (0, 1, ...) is the VUT instance. One process serves every instance of the same VUT
+  configuration in one testbed process (the pairs of a vectorised env: 8 in training, up
+  to 256 when responses are measured), each with its own episodes: a controller with state
+  keeps one state per ``k`` and resets only ``k``'s on ``reset <k>``. Requests are
+  strictly one at a time (an answer before the next request).
 * Values: reals in Python's ``repr`` (``20.5``, ``inf`` for no leader), integers in
   decimal, truth values as ``1``/``0``. The answer's number is parsed by ``float``.
 * Any answer may instead be ``error <message>``: the run stops with that message.
@@ -35,13 +40,14 @@ A reference client in Python is ``examples/process_vut.py``.
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import select
 import subprocess
 import tempfile
 import time
 import weakref
-from typing import IO, Any
+from typing import IO, Any, NoReturn
 
 from sumo_ayss.util.errors import ConfigError, ControllerError
 from sumo_ayss.vuts.process_spec import ProcessSpec
@@ -63,36 +69,20 @@ def format_value(value: float | int | bool) -> str:
     return repr(float(value))
 
 
-class ProcessController:
-    """A process speaking the line protocol, as a controller (``reset``, ``acceleration``).
+class _Connection:
+    """One running process and its pipe, shared by the controllers of one configuration."""
 
-    Args:
-        spec: The process's configuration.
-        where: The config field, for errors (``env.vuts.<name>.process``).
-
-    Raises:
-        ConfigError: The program cannot be started or does not answer the hello in time.
-    """
-
-    def __init__(self, spec: ProcessSpec, where: str = "process") -> None:
+    def __init__(self, spec: ProcessSpec, where: str, error: type[Exception]) -> None:
         self.spec = spec
-        self.where = where
         self.label = spec.label
-        self._reads = [SIGNALS[name].read for name in spec.signals]
-        self._proc: subprocess.Popen[bytes] | None = None
-        self._fresh = False
-        self._start(ConfigError)
-        self._fresh = True  # the first episode needs no reset
-
-    # ------------------------------------------------------------------ lifecycle
-
-    def _start(self, error: type[Exception]) -> None:
+        self.users: set[int] = set()
+        self._next_id = 0
         # Closed by the finalizer (_stop), with the process: it outlives this call.
         self._stderr: IO[bytes] = tempfile.TemporaryFile(prefix="sumo_ayss_vut_")  # noqa: SIM115
         try:
-            self._proc = subprocess.Popen(
-                list(self.spec.command),
-                cwd=self.spec.cwd or None,
+            self.proc: subprocess.Popen[bytes] | None = subprocess.Popen(
+                list(spec.command),
+                cwd=spec.cwd or None,
                 stdin=subprocess.PIPE,
                 stdout=subprocess.PIPE,
                 stderr=self._stderr,
@@ -101,69 +91,54 @@ class ProcessController:
         except OSError as e:
             self._stderr.close()
             raise error(
-                f"{self.where}.command: cannot start {self.label} ({type(e).__name__}: {e})"
+                f"{where}.command: cannot start {self.label} ({type(e).__name__}: {e})"
             ) from e
         self._buffer = b""
-        self._finalizer = weakref.finalize(self, _stop, self._proc, self._stderr)
-        hello = " ".join([PROTOCOL, str(PROTOCOL_VERSION), *self.spec.signals])
+        self._finalizer = weakref.finalize(self, _stop, self.proc, self._stderr)
+        hello = " ".join([PROTOCOL, str(PROTOCOL_VERSION), *spec.signals])
         try:
-            answer = self._ask(hello, self.spec.start_timeout_s, "the hello")
+            answer = self.ask(hello, spec.start_timeout_s, "the hello")
             if answer != f"ok {PROTOCOL_VERSION}":
-                self._garbage(answer, f"'ok {PROTOCOL_VERSION}'", "the hello")
+                self.garbage(answer, f"'ok {PROTOCOL_VERSION}'", "the hello")
         except ControllerError as e:
+            raise error(f"{where}: {e}") from None
+
+    def new_id(self) -> int:
+        """A fresh instance number ``k`` for one more controller."""
+        k = self._next_id
+        self._next_id += 1
+        self.users.add(k)
+        return k
+
+    def release(self, k: int) -> None:
+        """Instance ``k`` is done; the last one stops the process."""
+        self.users.discard(k)
+        if not self.users:
             self.close()
-            raise error(f"{self.where}: {e}") from None
-
-    def reset(self) -> None:
-        """Start an episode (``reset`` -> ``ok``); a closed process is started again."""
-        if self._proc is None:
-            self._start(ControllerError)
-            self._fresh = False
-            return
-        if self._fresh:
-            self._fresh = False
-            return
-        answer = self._ask("reset", self.spec.call_deadline_s, "reset")
-        if answer != "ok":
-            self._garbage(answer, "'ok'", "reset")
-
-    def acceleration(self, state: Any) -> float:
-        """The process's command for the coming step [m/s²]."""
-        self._fresh = False
-        line = "step " + " ".join(format_value(read(state)) for read in self._reads)
-        answer = self._ask(line, self.spec.call_deadline_s, "step")
-        word, _, number = answer.partition(" ")
-        if word == "accel":
-            try:
-                return float(number)
-            except ValueError:
-                pass
-        self._garbage(answer, "'accel <number>'", "step")
-        raise AssertionError  # pragma: no cover (_garbage raises)
 
     def close(self) -> None:
-        """Send ``quit``, wait briefly, kill if needed (safe to call twice; the next
-        :meth:`reset` starts the process again)."""
-        if self._proc is not None:
+        """Stop the process (``quit``, then kill if it lingers); safe to call twice."""
+        if self.proc is not None:
+            self.proc = None
             self._finalizer()
-            self._proc = None
+            if _CONNECTIONS.get(_key(self.spec)) is self:
+                del _CONNECTIONS[_key(self.spec)]
 
-    # ------------------------------------------------------------------ the pipe
-
-    def _ask(self, line: str, timeout_s: float, what: str) -> str:
-        proc = self._proc
+    def ask(self, line: str, timeout_s: float, what: str) -> str:
+        """Write ``line``, return the answer line (an ``error`` answer raises)."""
+        proc = self.proc
         if proc is None or proc.stdin is None or proc.stdout is None:
-            raise ControllerError(f"{self.label}: asked for {what} after close()")
+            raise ControllerError(f"{self.label} is stopped (asked for {what})")
         try:
             proc.stdin.write(line.encode() + b"\n")
             proc.stdin.flush()
-        except (BrokenPipeError, OSError):
+        except OSError:
             self._died(what)
         deadline = time.monotonic() + timeout_s
         fd = proc.stdout.fileno()
         while b"\n" not in self._buffer:
             remaining = deadline - time.monotonic()
-            ready = select.select([fd], [], [], max(remaining, 0.0))[0] if remaining > 0 else []
+            ready = select.select([fd], [], [], remaining)[0] if remaining > 0 else []
             if not ready:
                 proc.kill()  # it is not answering: do not wait for it to quit
                 self.close()
@@ -183,24 +158,24 @@ class ProcessController:
             raise ControllerError(f"{self.label} reported an error at {what}: {answer[5:].strip()}")
         return answer
 
-    def _died(self, what: str) -> None:
-        proc = self._proc
+    def garbage(self, answer: str, expected: str, what: str) -> NoReturn:
+        """Stop the process: it answered outside the protocol."""
+        self.close()
+        raise ControllerError(
+            f"{self.label} answered {answer[:200]!r} to {what}; protocol "
+            f"{PROTOCOL} {PROTOCOL_VERSION} expects {expected}"
+        )
+
+    def _died(self, what: str) -> NoReturn:
         code = None
-        if proc is not None:
+        if self.proc is not None:
             with contextlib.suppress(subprocess.TimeoutExpired):
-                code = proc.wait(timeout=1.0)
+                code = self.proc.wait(timeout=1.0)
         tail = self._stderr_tail()
         self.close()
         raise ControllerError(
             f"{self.label} exited (code {code}) before answering {what}"
             + (f"; its last stderr: {tail}" if tail else "")
-        )
-
-    def _garbage(self, answer: str, expected: str, what: str) -> None:
-        self.close()
-        raise ControllerError(
-            f"{self.label} answered {answer[:200]!r} to {what}; protocol "
-            f"{PROTOCOL} {PROTOCOL_VERSION} expects {expected}"
         )
 
     def _stderr_tail(self) -> str:
@@ -210,6 +185,87 @@ class ProcessController:
         except (OSError, ValueError):
             return ""
         return " | ".join(lines[-3:])[:400]
+
+
+#: The running process of each configuration in this Python process, by :func:`_key`.
+_CONNECTIONS: dict[str, _Connection] = {}
+
+
+def _key(spec: ProcessSpec) -> str:
+    return json.dumps(spec.to_dict(), sort_keys=True)
+
+
+def _connection(spec: ProcessSpec, where: str, error: type[Exception]) -> _Connection:
+    conn = _CONNECTIONS.get(_key(spec))
+    if conn is None or conn.proc is None:
+        conn = _CONNECTIONS[_key(spec)] = _Connection(spec, where, error)
+    return conn
+
+
+class ProcessController:
+    """One VUT instance ``k`` served by the configuration's process (``reset``,
+    ``acceleration``), see the module docstring.
+
+    Args:
+        spec: The process's configuration.
+        where: The config field, for errors (``env.vuts.<name>.process``).
+
+    Raises:
+        ConfigError: The program cannot be started or does not answer the hello in time.
+    """
+
+    def __init__(self, spec: ProcessSpec, where: str = "process") -> None:
+        self.spec = spec
+        self.where = where
+        self.label = spec.label
+        self._reads = [SIGNALS[name].read for name in spec.signals]
+        self._conn: _Connection | None = _connection(spec, where, ConfigError)
+        self._k = self._conn.new_id()
+        self._fresh = True  # the first episode needs no reset
+
+    def reset(self) -> None:
+        """Start an episode (``reset <k>`` -> ``ok``); a stopped process is started again."""
+        conn = self._live()
+        if conn is None:
+            conn = self._conn = _connection(self.spec, self.where, ControllerError)
+            self._k = conn.new_id()
+        elif self._fresh:
+            self._fresh = False
+            return
+        self._fresh = False
+        answer = conn.ask(f"reset {self._k}", self.spec.call_deadline_s, "reset")
+        if answer != "ok":
+            conn.garbage(answer, "'ok'", "reset")
+
+    def acceleration(self, state: Any) -> float:
+        """The process's command for the coming step [m/s²]."""
+        conn = self._live()
+        if conn is None:
+            raise ControllerError(f"{self.label}: asked for a command after close()")
+        self._fresh = False
+        values = " ".join(format_value(read(state)) for read in self._reads)
+        answer = conn.ask(f"step {self._k} {values}", self.spec.call_deadline_s, "step")
+        word, _, number = answer.partition(" ")
+        if word == "accel":
+            try:
+                return float(number)
+            except ValueError:
+                pass
+        conn.garbage(answer, "'accel <number>'", "step")
+
+    def close(self) -> None:
+        """Release this instance; the last instance of a configuration stops its process
+        (safe to call twice; the next :meth:`reset` starts it again if needed)."""
+        if self._conn is not None:
+            self._conn.release(self._k)
+            self._conn = None
+
+    def _live(self) -> _Connection | None:
+        conn = self._conn
+        if conn is not None and conn.proc is None:  # stopped by an error or another close
+            self._conn = None
+            return None
+        return conn
 
 
 def _stop(proc: subprocess.Popen[bytes], stderr: IO[bytes]) -> None:

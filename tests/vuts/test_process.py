@@ -91,7 +91,7 @@ def test_a_misbehaving_process_is_a_one_line_error(mode: str, match: str) -> Non
             vut.acceleration(STATE)
         assert "\n" not in str(info.value)
         assert time.monotonic() - start < 3.0  # a hung process is not waited for
-        assert vut._proc is None  # stopped
+        assert vut._live() is None  # stopped
     finally:
         vut.close()
 
@@ -117,6 +117,22 @@ def test_a_process_that_cannot_start_is_a_one_line_config_error(
     with pytest.raises(ConfigError, match=match) as info:
         spec.build("vut")
     assert "\n" not in str(info.value)
+
+
+def test_instances_of_one_config_share_one_process() -> None:
+    """The pairs of a vectorised env: one process, one instance number k each."""
+    first, second = acc_process().build("vut"), acc_process().build("vut")
+    conn = first._conn
+    assert conn is not None and second._conn is conn and (first._k, second._k) == (0, 1)
+    first.reset()
+    second.reset()
+    assert first.acceleration(STATE) == second.acceleration(STATE)
+    proc = conn.proc
+    assert proc is not None
+    first.close()
+    assert proc.poll() is None  # still serving the second
+    second.close()
+    assert proc.wait(timeout=5) == 0  # quit on the last close
 
 
 def test_a_closed_process_restarts_at_the_next_episode() -> None:
