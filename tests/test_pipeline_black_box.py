@@ -95,6 +95,7 @@ def test_fmu_and_process_vuts_train_evaluate_crossplay_and_report(
 
 
 @pytest.mark.sumo
+@pytest.mark.slow  # 2 jobs, discriminability of 2 controller-kind VUTs: 1-2 min
 def test_a_process_that_dies_mid_job_fails_that_job_and_keeps_the_others(tmp_path: Path) -> None:
     misbehave = str(PROJECT_ROOT / "tests" / "data" / "process" / "misbehave.py")
     vuts = {

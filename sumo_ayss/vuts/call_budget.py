@@ -11,7 +11,8 @@ Every call of a VUT's ``acceleration(state)`` is timed (wall clock, :func:`time.
 * **Share of the step.** Every :data:`WINDOW_CALLS` calls the VUT's share of the wall time
   since the window began (its calls, SUMO's step, the POV, the learner) is computed; the
   first window in which the VUT takes more than :data:`WARN_SHARE` of it logs one warning
-  with its mean and largest call time.
+  with its mean and largest call time: once per VUT and Python process (the pairs of a
+  vectorised env each time their own calls, and would otherwise warn once each).
 """
 
 from __future__ import annotations
@@ -29,6 +30,9 @@ logger = logging.getLogger(__name__)
 WARN_SHARE = 0.5
 #: Calls per measurement window of that share.
 WINDOW_CALLS = 200
+
+#: The VUTs (by label) warned about in this Python process.
+_WARNED: set[str] = set()
 
 
 class CallBudget:
@@ -89,6 +93,9 @@ class CallBudget:
         share = self._window_s / wall_s if wall_s > 0 else 0.0
         if share > WARN_SHARE:
             self.warned = True
+            if self.label in _WARNED:
+                return
+            _WARNED.add(self.label)
             logger.warning(
                 "%s takes %.3g ms per call (largest %.3g ms): %.0f %% of the wall time of its "
                 "last %d steps; the run's speed is the VUT's",

@@ -13,6 +13,7 @@ from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.util.errors import ControllerError
+from sumo_ayss.vuts import call_budget
 from sumo_ayss.vuts.call_budget import WINDOW_CALLS, CallBudget
 from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
 
@@ -46,6 +47,7 @@ def test_a_call_past_the_deadline_is_an_error_naming_the_vut() -> None:
 
 def test_warns_once_when_the_vut_dominates_the_wall_time(caplog: pytest.LogCaptureFixture) -> None:
     caplog.set_level(logging.WARNING, logger="sumo_ayss.vuts.call_budget")
+    call_budget._WARNED.clear()
     quick = CallBudget("quick", 1.0)
     for _ in range(WINDOW_CALLS):  # 1 ms between calls, calls take no time
         time.sleep(0.001)
@@ -58,6 +60,11 @@ def test_warns_once_when_the_vut_dominates_the_wall_time(caplog: pytest.LogCaptu
         time.sleep(0.001)
         slow.record(start, time.perf_counter() - start)
     assert slow.warned
+    again = CallBudget("slow", 1.0)  # another pair of the same VUT: no second warning
+    for _ in range(WINDOW_CALLS):
+        start = time.perf_counter()
+        time.sleep(0.001)
+        again.record(start, time.perf_counter() - start)
     [record] = caplog.records
     assert record.getMessage().startswith("slow takes ") and "of the wall time" in record.message
 
