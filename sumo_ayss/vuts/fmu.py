@@ -308,6 +308,7 @@ class FmuController:
     def _instantiate(self) -> None:
         self._call("instantiate", self._fmu.instantiate)
         self._live[0] = True
+        self._bind()
 
     def _initialize(self) -> None:
         fmu = self._fmu
@@ -342,52 +343,72 @@ class FmuController:
             self._instantiate()
         self._initialize()
 
+    def _bind(self) -> None:
+        """The raw C functions of this instance with their fixed arguments, bound once (the
+        per-step path makes no name lookups and no fmpy wrapper calls)."""
+        fmu = self._fmu
+        fns = fmu._functions
+        prefix = f"fmi{self.fmi_version}"
+        tail = self.fmi_version == 3  # FMI 3 passes the number of values too
+        self._set_calls = [
+            (
+                f"{prefix}Set{g.suffix}",
+                fns[f"{prefix}Set{g.suffix}"],
+                (fmu.component, g.refs, g.n, g.values, *((g.n,) if tail else ())),
+                g.values,
+                reads,
+            )
+            for g, reads in zip(self._inputs, self._input_signals, strict=True)
+        ]
+        out = self._output
+        self._get_call = (
+            f"{prefix}Get{out.suffix}",
+            fns[f"{prefix}Get{out.suffix}"],
+            (fmu.component, out.refs, 1, out.values, *((1,) if tail else ())),
+        )
+        self._do_step = fns[f"{prefix}DoStep"]
+        if tail:
+            self._step_flags = tuple(ctypes.c_bool() for _ in range(3))
+            self._step_time = ctypes.c_double()
+            self._step_tail: tuple[Any, ...] = (
+                True,
+                *(ctypes.byref(f) for f in self._step_flags),
+                ctypes.byref(self._step_time),
+            )
+        else:
+            self._step_tail = (1,)
+
+    def _status(self, what: str, status: int) -> None:
+        if status > 1:  # fmiOK 0, fmiWarning 1; then discard, error, fatal (, pending)
+            label = ["ok", "warning", "discard", "error", "fatal", "pending"][min(status, 5)]
+            raise ControllerError(
+                f"{self.label}: {what} failed with status {status} ({label}) at FMU time "
+                f"{self._k * self._last_dt:g} s"
+            )
+
     def acceleration(self, state: Any) -> float:
         """The FMU's command for the coming step [m/s²] (a commanded speed converted)."""
-        fmu = self._fmu
-        if fmu is None:
+        if self._fmu is None:
             raise ControllerError(f"{self.label}: asked for a command after close()")
-        component = fmu.component
-        v2 = self.fmi_version == 2
-        prefix = "fmi2" if v2 else "fmi3"
-        for group, reads in zip(self._inputs, self._input_signals, strict=True):
-            values = group.values
+        for what, fn, args, values, reads in self._set_calls:
             for i, read in enumerate(reads):
                 values[i] = read(state)
-            setter = getattr(fmu, f"{prefix}Set{group.suffix}")
-            if v2:
-                self._call(
-                    f"{prefix}Set{group.suffix}", setter, component, group.refs, group.n, values
-                )
-            else:
-                self._call(
-                    f"{prefix}Set{group.suffix}",
-                    setter,
-                    component,
-                    group.refs,
-                    group.n,
-                    values,
-                    group.n,
-                )
+            self._status(what, fn(*args))
         dt = float(state.dt_s)
         self._last_dt = dt
         t = self._k * dt
-        if v2:
-            self._call("fmi2DoStep", fmu.doStep, t, dt)
-        else:
-            _, terminate, _, _ = self._call("fmi3DoStep", fmu.doStep, t, dt)
-            if terminate:
-                raise ControllerError(
-                    f"{self.label}: fmi3DoStep asked to terminate at FMU time {t:g} s"
-                )
-        out = self._output
-        getter = getattr(fmu, f"{prefix}Get{out.suffix}")
-        if v2:
-            self._call(f"{prefix}Get{out.suffix}", getter, component, out.refs, 1, out.values)
-        else:
-            self._call(f"{prefix}Get{out.suffix}", getter, component, out.refs, 1, out.values, 1)
+        component = self._fmu.component
+        self._status(
+            f"fmi{self.fmi_version}DoStep", self._do_step(component, t, dt, *self._step_tail)
+        )
+        if self.fmi_version == 3 and self._step_flags[1].value:
+            raise ControllerError(
+                f"{self.label}: fmi3DoStep asked to terminate at FMU time {t:g} s"
+            )
+        what, fn, args = self._get_call
+        self._status(what, fn(*args))
         self._k += 1
-        value = float(out.values[0])
+        value = float(self._output.values[0])
         if not math.isfinite(value):
             raise ControllerError(
                 f"{self.label}: output {self._output_name!r} is {value} after the step at FMU "
