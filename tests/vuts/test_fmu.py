@@ -279,7 +279,10 @@ def test_a_boolean_output_is_refused(py_fmu: Callable[[str], Path]) -> None:
             {"nan_at_call": 2},
             r"FMU 'Probe\.fmu': output 'a' is nan after the step at FMU time 0\.2 s",
         ),
-        ({"fail_at_call": 1}, r"FMU 'Probe\.fmu': fmi2DoStep failed with status 2 \(discard\) at FMU time 0 s"),
+        (
+            {"fail_at_call": 1},
+            r"FMU 'Probe\.fmu': fmi2DoStep failed with status 2 \(discard\) at FMU time 0 s",
+        ),
     ],
 )
 def test_step_failures_and_nan_outputs_stop_the_run(
