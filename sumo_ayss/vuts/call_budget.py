@@ -8,8 +8,10 @@ Every call of a VUT's ``acceleration(state)`` is timed (wall clock, :func:`time.
   deadline. An in-process call (a Python controller, an FMU) cannot be interrupted: it is
   judged when it returns. An external process is not waited for past the deadline
   (:mod:`sumo_ayss.vuts.process`).
-* **Share of the step.** Every :data:`WINDOW_CALLS` calls the VUT's share of the wall time
-  since the window began (its calls, SUMO's step, the POV, the learner) is computed; the
+* **Share of the step.** Over windows of at least :data:`WINDOW_S` seconds (and
+  :data:`WINDOW_CALLS` calls) the VUT's share of the wall time since the window began (its
+  calls, SUMO's step, the POV, the learner) is computed; a window that short holds the odd
+  long call (a preempted process on a busy machine, a garbage collection) among many; the
   first window in which the VUT takes more than :data:`WARN_SHARE` of it logs one warning
   with its mean and largest call time: once per VUT and Python process (the pairs of a
   vectorised env each time their own calls, and would otherwise warn once each).
@@ -22,14 +24,16 @@ import time
 
 from sumo_ayss.util.errors import ControllerError
 
-__all__ = ["WARN_SHARE", "WINDOW_CALLS", "CallBudget"]
+__all__ = ["WARN_SHARE", "WINDOW_CALLS", "WINDOW_S", "CallBudget"]
 
 logger = logging.getLogger(__name__)
 
 #: The VUT's share of the wall time above which it "dominates the step" (one warning).
 WARN_SHARE = 0.5
-#: Calls per measurement window of that share.
-WINDOW_CALLS = 200
+#: Least calls per measurement window of that share.
+WINDOW_CALLS = 50
+#: Least wall time of a measurement window [s].
+WINDOW_S = 2.0
 
 #: The VUTs (by label) warned about in this Python process.
 _WARNED: set[str] = set()
@@ -41,6 +45,7 @@ class CallBudget:
     Args:
         label: How messages name the VUT (``"FMU 'acc.fmu'"``).
         deadline_s: Longest wall time one call may take [s], > 0.
+        window_s: Least wall time of a share window [s].
 
     Attributes:
         calls: Calls timed so far.
@@ -49,9 +54,10 @@ class CallBudget:
         warned: Whether the share warning was logged.
     """
 
-    def __init__(self, label: str, deadline_s: float) -> None:
+    def __init__(self, label: str, deadline_s: float, window_s: float = WINDOW_S) -> None:
         self.label = label
         self.deadline_s = float(deadline_s)
+        self.window_s = float(window_s)
         self.calls = 0
         self.total_s = 0.0
         self.max_s = 0.0
@@ -87,9 +93,9 @@ class CallBudget:
             self._window_start = start_s
         self._window_calls += 1
         self._window_s += elapsed_s
-        if self._window_calls < WINDOW_CALLS:
-            return
         wall_s = time.perf_counter() - self._window_start
+        if self._window_calls < WINDOW_CALLS or wall_s < self.window_s:
+            return
         share = self._window_s / wall_s if wall_s > 0 else 0.0
         if share > WARN_SHARE:
             self.warned = True

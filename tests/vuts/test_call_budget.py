@@ -14,7 +14,7 @@ from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.util.errors import ControllerError
 from sumo_ayss.vuts import call_budget
-from sumo_ayss.vuts.call_budget import WINDOW_CALLS, CallBudget
+from sumo_ayss.vuts.call_budget import CallBudget
 from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
 
 
@@ -48,20 +48,20 @@ def test_a_call_past_the_deadline_is_an_error_naming_the_vut() -> None:
 def test_warns_once_when_the_vut_dominates_the_wall_time(caplog: pytest.LogCaptureFixture) -> None:
     caplog.set_level(logging.WARNING, logger="sumo_ayss.vuts.call_budget")
     call_budget._WARNED.clear()
-    quick = CallBudget("quick", 1.0)
-    for _ in range(WINDOW_CALLS):  # 1 ms between calls, calls take no time
+    quick = CallBudget("quick", 1.0, window_s=0.1)
+    for _ in range(200):  # 1 ms between calls, calls take no time
         time.sleep(0.001)
         start = time.perf_counter()
         quick.record(start, time.perf_counter() - start)
     assert not quick.warned and not caplog.records
-    slow = CallBudget("slow", 1.0)
-    for _ in range(2 * WINDOW_CALLS):  # the calls are all the time there is
+    slow = CallBudget("slow", 1.0, window_s=0.1)
+    for _ in range(200):  # the calls are all the time there is
         start = time.perf_counter()
         time.sleep(0.001)
         slow.record(start, time.perf_counter() - start)
     assert slow.warned
-    again = CallBudget("slow", 1.0)  # another pair of the same VUT: no second warning
-    for _ in range(WINDOW_CALLS):
+    again = CallBudget("slow", 1.0, window_s=0.1)  # another pair of the same VUT: no second warning
+    for _ in range(200):
         start = time.perf_counter()
         time.sleep(0.001)
         again.record(start, time.perf_counter() - start)
