@@ -51,7 +51,10 @@ initial condition itself (the state after placement, before the first step).
         max_accel_mps2: 3.0                          # declared limits (required)
         max_decel_mps2: 6.0
 
-A worked example is ``examples/acc_controller.py`` (constant time-gap ACC).
+A worked example is ``examples/acc_controller.py`` (constant time-gap ACC). An FMI
+co-simulation FMU (``fmu:``, :mod:`sumo_ayss.vuts.fmu`) or another program (``process:``,
+:mod:`sumo_ayss.vuts.process`) is executed the same way; every kind's calls are timed
+against ``call_deadline_s`` (:mod:`sumo_ayss.vuts.call_budget`).
 """
 
 from __future__ import annotations
