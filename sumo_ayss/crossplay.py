@@ -48,15 +48,17 @@ from sumo_ayss.run_folder import (
     is_done,
     load_crossplay,
     read_crossplay_json,
+    read_inevitable,
     read_outcome_json,
     read_run,
     read_table,
     run_dir_for,
     write_crossplay_json,
+    write_inevitable,
     write_table,
 )
 from sumo_ayss.util.errors import AyssError, CheckpointError, TableError
-from sumo_ayss.vuts.catalog import controller_imports
+from sumo_ayss.vuts.catalog import DEFAULT_REFERENCE, controller_imports
 
 logger = logging.getLogger(__name__)
 
@@ -91,6 +93,8 @@ def run_case(
     force: bool = False,
     trust_controller: bool = False,
     progress: Callable[[str], None] | None = None,
+    reference: str | None = DEFAULT_REFERENCE,
+    references: Sequence[str] = (DEFAULT_REFERENCE,),
 ) -> Path:
     """Cross-play of one case's runs; writes and returns the case folder's ``crossplay.csv``.
 
@@ -99,6 +103,12 @@ def run_case(
     every SPCP's episodes against its own VUT are compared with its run's ``outcome.csv``
     (:func:`~sumo_ayss.scenarios.crossplay.diagonal_check`); the result goes into
     ``crossplay.json``.
+
+    ``references`` (reference drivers, :data:`~sumo_ayss.vuts.catalog.REFERENCE_VUTS`) then
+    drive against the whole pool into ``crossplay_reference.csv`` (none: no file).
+    ``reference`` labels every crash preventable or not
+    (:mod:`sumo_ayss.scenarios.preventability`; None: no labels). It is not part of the
+    stage's settings: a table made without labels is kept (``--force`` relabels).
 
     Raises:
         DiagonalMismatchError: If an SPCP did not reproduce its outcome table (the table
@@ -127,6 +137,7 @@ def run_case(
     if not force and _done(CrossplayStage(folder, requested)):
         logger.info("%s: cross-play done with these settings and SPCPs; skipped", case_dir)
         check_diagonal(read_crossplay_json(folder.crossplay_json).diagonal, case)
+        _reference_rows(runs, folder, references, n, seed, trust_controller, progress, reference)
         return folder.crossplay_csv
     earlier = None if force else _extended(folder, requested, tuple(envs))
     if earlier is not None:
@@ -147,7 +158,9 @@ def run_case(
     ]
     t0 = time.perf_counter()
     with controller_imports(trust_controller):
-        table = run_crossplay(envs, opponents, n=n, seed=seed, progress=progress)
+        table = run_crossplay(
+            envs, opponents, n=n, seed=seed, progress=progress, reference=reference
+        )
     wall_s = time.perf_counter() - t0
     checks = tuple(diagonal_check(table, v, s, out) for (v, s), out in outcomes.items())
     if earlier is not None:
@@ -161,7 +174,83 @@ def run_case(
     record = dataclasses.replace(requested, vuts=tuple(envs), wall_s=wall_s, diagonal=checks)
     write_crossplay_json(folder.crossplay_json, record)
     check_diagonal(checks, case)
+    _reference_rows(runs, folder, references, n, seed, trust_controller, progress, reference)
     return folder.crossplay_csv
+
+
+def _inevitable(env: Any, folder: CaseFolder, n: int, seed: int) -> None:
+    """``inevitable.json``: which of the ``n`` scenarios are inevitable-collision states
+    (a second per thousand scenarios; kept when it holds this scenario set)."""
+    from sumo_ayss.envs.odd import sample_initial_conditions
+    from sumo_ayss.scenarios.inevitable import ics_flags, pov_strategies
+
+    path = folder.inevitable_json
+    if path.is_file():
+        try:
+            if read_inevitable(path)[:2] == (n, seed):
+                return
+        except TableError:
+            pass
+    flags = ics_flags(env, sample_initial_conditions(env.odd, n, seed))
+    write_inevitable(path, n, seed, flags, tuple(pov_strategies(env.case)))
+
+
+def _reference_rows(
+    runs: Sequence[RunRecord],
+    folder: CaseFolder,
+    references: Sequence[str],
+    n: int,
+    seed: int,
+    trust_controller: bool,
+    progress: Callable[[str], None] | None,
+    label_with: str | None,
+) -> None:
+    """Drive the reference drivers against the whole pool (``crossplay_reference.csv``):
+    seconds, since they need no opponents of their own. Kept when the file already holds
+    exactly these references against exactly this pool on these scenarios."""
+    from sumo_ayss.evaluate import load_spcp
+    from sumo_ayss.scenarios.crossplay import Opponent, run_crossplay
+    from sumo_ayss.scenarios.preventability import reference_config
+
+    _inevitable(runs[0].experiment.env, folder, n, seed)
+    path = folder.crossplay_reference_csv
+    if not references:
+        return
+    pool = sorted({(r.experiment.env.vut, r.config_seed) for r in runs})
+    if path.is_file():
+        try:
+            old = read_table(path, CROSSPLAY_SCHEMA)
+            opp = zip(old["opponent_vut"].tolist(), old["opponent_seed"].tolist(), strict=True)
+            held = sorted(set(opp))
+            same = (
+                held == pool
+                and sorted(set(old["vut"].tolist())) == sorted(references)
+                and len(old) == n * len(pool) * len(references)
+            )
+        except TableError:
+            same = False
+        if same:
+            return
+    base = runs[0].experiment.env
+    for name in references:  # one catalog holding every reference: one world for all
+        base = reference_config(base, name, own_body=True)
+    envs = {name: dataclasses.replace(base, vut=name) for name in references}
+    opponents = [
+        Opponent(r.experiment.env.vut, r.config_seed, functools.partial(load_spcp, r)) for r in runs
+    ]
+    t0 = time.perf_counter()
+    with controller_imports(trust_controller):
+        table = run_crossplay(
+            envs, opponents, n=n, seed=seed, progress=progress, reference=label_with
+        )
+    write_table(path, table)
+    logger.info(
+        "%s: reference drivers %s against %d opponents in %.1f s",
+        folder.path,
+        ", ".join(references),
+        len(opponents),
+        time.perf_counter() - t0,
+    )
 
 
 def _done(stage: CrossplayStage) -> bool:
@@ -303,6 +392,8 @@ def main(argv: Sequence[str] | None = None) -> None:
                 force=args.force,
                 trust_controller=args.trust_controller,
                 progress=functools.partial(print, f"{case}:", flush=True),
+                reference=cfg.evaluate.reference,
+                references=cfg.evaluate.reference_rows,
             )
             matrix = read_matrix(runs)
             rows, _pairs = rank_crossplay(matrix, blocks=args.blocks)

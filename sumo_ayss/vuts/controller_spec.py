@@ -149,9 +149,12 @@ class ControllerSpec:
                 (``controller_imports(False)``: a run folder opened untrusted), or it is not
                 a class with a callable ``acceleration`` (``subprocess:getoutput`` is not).
         """
-        check_imports_allowed(
-            f"{where}.target {self.target!r}", "a user controller, and importing it"
-        )
+        if not self.target.startswith("sumo_ayss."):  # the package's own is always allowed
+            check_imports_allowed(
+                f"{where}.target {self.target!r}",
+                "a user controller, and importing it",
+                " (the package's own, sumo_ayss.*, is always allowed)",
+            )
         module_part, _, attr_part = self.target.rpartition(":")
         try:
             module = _import(module_part)
@@ -293,16 +296,17 @@ def controller_imports(allowed: bool) -> Iterator[None]:
         _CONTROLLER_IMPORTS.reset(token)
 
 
-def check_imports_allowed(where: str, what: str) -> None:
+def check_imports_allowed(where: str, what: str, note: str = "") -> None:
     """Raise :class:`ConfigError` unless user code may run now (:func:`controller_imports`).
 
     Args:
         where: The field and value to name (``env.vuts.x.controller.target 'm:C'``).
         what: What this VUT is and what building it does (``"an FMU, and loading it"``).
+        note: Said after "run folder" (what is allowed anyway).
     """
     if not _CONTROLLER_IMPORTS.get():
         raise ConfigError(
-            f"{where}: this VUT is {what} runs code named by the run folder; pass "
+            f"{where}: this VUT is {what} runs code named by the run folder{note}; pass "
             "--trust-controller if you trust the folder (see 'Trust model' in the README)"
         )
 

@@ -15,18 +15,26 @@ signal              unit    kind   meaning
 ``rel_speed_mps``   m/s     real   leader speed minus own speed (> 0 opening); 0 without one
 ``lane_index``      -       int    own lane, 0 = rightmost
 ``has_leader``      -       bool   whether a leader is seen (``gap_m`` finite)
+``lane_width_m``    m       real   width of the own lane (NaN where unknown)
+``n_objects``       -       int    entries in the object list
 ==================  ======  =====  =========================================================
 
+**The object list** (:class:`~sumo_ayss.sim.pair.SensedObject`, in the order of
+``ControllerInput.objects``) as :data:`OBJECT_SLOTS` fixed slots ``i = 0, 1, ...``:
+``objects.<i>.present`` (bool), ``objects.<i>.gap_m`` (m; ``+inf`` for an empty slot),
+``objects.<i>.lateral_offset_m``, ``objects.<i>.rel_speed_mps``,
+``objects.<i>.lateral_speed_mps`` (m, m/s; 0 for an empty slot), ``objects.<i>.length_m``,
+``objects.<i>.width_m`` (m; 0 for an empty slot). An FMU with fixed inputs maps the slots
+it has; a process names the ones it wants.
+
 **Adding signals.** A signal is one entry of :data:`SIGNALS`: a name, a unit, a kind and a
-function of the controller input. A richer sensor view (an object list of nearby vehicles)
-adds one entry per object slot and field, e.g. ``objects.0.gap_m``,
-``objects.0.lateral_offset_m``, ... for slots ``0..N-1`` with a fixed default for an
-empty slot; FMUs and processes can then name them like any other signal, and nothing else
-changes (the FMU maps by name, the process protocol sends the names it was told).
+function of the controller input; FMUs and processes can then name it like any other
+(the FMU maps by name, the process protocol sends the names it was told).
 """
 
 from __future__ import annotations
 
+import math
 import operator
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -36,7 +44,10 @@ from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.frozen import FrozenMap
 from sumo_ayss.util.validation import suggest
 
-__all__ = ["DEFAULT_SIGNALS", "SIGNALS", "Signal", "SignalKind", "check_signal"]
+__all__ = ["DEFAULT_SIGNALS", "OBJECT_SLOTS", "SIGNALS", "Signal", "SignalKind", "check_signal"]
+
+#: Object-list slots offered as signals (``objects.0.*`` .. ``objects.3.*``).
+OBJECT_SLOTS = 4
 
 #: What a signal's value is: a real number, an integer or a truth value.
 SignalKind = Literal["real", "int", "bool"]
@@ -65,6 +76,40 @@ def _signal(name: str, unit: str, kind: SignalKind, meaning: str) -> tuple[str, 
     return name, Signal(name, unit, kind, meaning, operator.attrgetter(name))
 
 
+def _n_objects(state: Any) -> int:
+    return len(state.objects)
+
+
+#: An object-list field: (unit, value in an empty slot, meaning).
+_OBJECT_FIELDS: dict[str, tuple[str, float, str]] = {
+    "gap_m": ("m", math.inf, "rear bumper minus own front bumper, > 0 ahead"),
+    "lateral_offset_m": ("m", 0.0, "centre line from the own lane's centre line, + left"),
+    "rel_speed_mps": ("m/s", 0.0, "longitudinal speed minus own, < 0 closing in"),
+    "lateral_speed_mps": ("m/s", 0.0, "lateral speed relative to own, + left"),
+    "length_m": ("m", 0.0, "length"),
+    "width_m": ("m", 0.0, "width"),
+}
+
+
+def _object_signals(i: int) -> list[tuple[str, Signal]]:
+    """The signals of object-list slot ``i``."""
+
+    def present(state: Any) -> bool:
+        return len(state.objects) > i
+
+    key = f"objects.{i}.present"
+    out = [(key, Signal(key, "-", "bool", f"object slot {i} holds an object", present))]
+    for name, (unit, empty, meaning) in _OBJECT_FIELDS.items():
+
+        def read(state: Any, name: str = name, empty: float = empty) -> float:
+            objects = state.objects
+            return float(getattr(objects[i], name)) if len(objects) > i else empty
+
+        key = f"objects.{i}.{name}"
+        out.append((key, Signal(key, unit, "real", f"object {i}: {meaning}", read)))
+    return out
+
+
 #: Every signal, by name (see the module docstring's table).
 SIGNALS: Mapping[str, Signal] = FrozenMap(
     dict(
@@ -76,6 +121,12 @@ SIGNALS: Mapping[str, Signal] = FrozenMap(
             _signal("rel_speed_mps", "m/s", "real", "leader speed minus own speed, 0 if none"),
             _signal("lane_index", "-", "int", "own lane, 0 = rightmost"),
             _signal("has_leader", "-", "bool", "whether a leader is seen"),
+            _signal("lane_width_m", "m", "real", "width of the own lane, NaN if unknown"),
+            (
+                "n_objects",
+                Signal("n_objects", "-", "int", "entries in the object list", _n_objects),
+            ),
+            *(item for i in range(OBJECT_SLOTS) for item in _object_signals(i)),
         ]
     )
 )

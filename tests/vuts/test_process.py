@@ -163,3 +163,29 @@ def test_process_vut_config_reads_relative_to_the_yaml_and_round_trips(tmp_path:
         )
     with controller_imports(False), pytest.raises(ConfigError, match="--trust-controller"):
         vt.controller.build("x")
+
+
+def test_the_object_list_is_offered_by_slot() -> None:
+    from sumo_ayss.sim.pair import SensedObject
+    from sumo_ayss.vuts.signals import SIGNALS
+
+    pov = SensedObject(-2.0, 2.1, -1.5, -0.6, 5.0, 1.8)
+    seen = ControllerInput(0.0, 0.2, 20.0, math.inf, 0.0, 0, (pov,), 3.2)
+    values = {
+        name: SIGNALS[name].read(seen)
+        for name in ("n_objects", "objects.0.present", "objects.0.gap_m",
+                     "objects.0.lateral_offset_m", "objects.0.lateral_speed_mps",
+                     "objects.1.present", "objects.1.gap_m", "lane_width_m")
+    }  # fmt: skip
+    assert values == {
+        "n_objects": 1,
+        "objects.0.present": True,
+        "objects.0.gap_m": -2.0,
+        "objects.0.lateral_offset_m": 2.1,
+        "objects.0.lateral_speed_mps": -0.6,
+        "objects.1.present": False,
+        "objects.1.gap_m": math.inf,
+        "lane_width_m": 3.2,
+    }
+    line = " ".join(format_value(SIGNALS[n].read(seen)) for n in ("objects.0.gap_m", "n_objects"))
+    assert line == "-2.0 1"
