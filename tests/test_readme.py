@@ -151,6 +151,26 @@ def test_controller_pipeline_block_adds_to_the_shipped_experiment(tmp_path: Path
     assert shipped.train.n_envs > 1  # the snippet alone would have given 1
 
 
+def test_black_box_pipeline_block_reads_an_fmu_and_a_process_vut(tmp_path: Path) -> None:
+    """The README's FMU and process YAML is read (no FMU opened, no process started)."""
+    from sumo_ayss.config.pipeline import load_pipeline
+    from sumo_ayss.pipeline import plan_jobs
+    from sumo_ayss.vuts.fmu_spec import FmuSpec
+    from sumo_ayss.vuts.process_spec import ProcessSpec
+
+    block = re.search(r"<!-- black-box-pipeline.*?-->\s*```yaml\n(.*?)```", README, re.S)
+    assert block, "README.md has no black-box-pipeline block"
+    path = tmp_path / "my_black_boxes.yaml"
+    path.write_text(block.group(1))
+    kinds = {
+        j.vut: type(j.experiment.env.vut_type.controller) for j in plan_jobs(load_pipeline(path))
+    }
+    assert kinds == {"acc_fmu": FmuSpec, "acc_proc": ProcessSpec}
+    fmu = next(j for j in plan_jobs(load_pipeline(path)) if j.vut == "acc_fmu")
+    spec = fmu.experiment.env.vut_type.controller
+    assert isinstance(spec, FmuSpec) and spec.path == str(tmp_path / "runs" / "fmus" / "acc.fmu")
+
+
 def test_readme_commands_exist_on_a_fresh_clone_and_write_only_ignored_folders() -> None:
     """Console scripts live in .venv/bin (not on PATH after `make`); outputs go to runs/,
     which git ignores."""
