@@ -409,6 +409,9 @@ def main(argv: Sequence[str] | None = None) -> None:
         help="no live table: one log line per job event (the default when stdout is not a "
         "terminal)",
     )
+    from sumo_ayss.report.__main__ import STRICT_HELP
+
+    parser.add_argument("--strict", action="store_true", help=STRICT_HELP)
     args = parser.parse_args(argv)
     console = configure_logging(not args.no_live)
     try:
@@ -431,7 +434,19 @@ def main(argv: Sequence[str] | None = None) -> None:
         print(leaderboard_text(result.analyses))
     for line in final_messages(result):
         print(line)
-    sys.exit(1 if any(s.state == "failed" for s in result.statuses) else 0)
+    from sumo_ayss.report.checks import input_problems
+
+    problems = input_problems(result.analyses)
+    for line in problems:
+        print(f"WARNING: {line}", file=sys.stderr)
+    if any(s.state == "failed" for s in result.statuses):
+        sys.exit(1)
+    if args.strict and problems:
+        sys.exit(
+            f"error: --strict: {len(problems)} problem(s) in the input files (the WARNING "
+            "lines above); the report was written"
+        )
+    sys.exit(0)
 
 
 if __name__ == "__main__":

@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.seeds import kendall_tau
-from sumo_ayss.modes import Mode, get_mode, mode_names, registered_modes
+from sumo_ayss.modes import Mode, get_mode, missing_rows_line, mode_names, registered_modes
 from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.run_folder import (
     OUTCOME_JSON,
@@ -356,12 +356,13 @@ def main(argv: Sequence[str] | None = None) -> None:
     checks = order_checks(analyses, cfg.expected_order)
     from sumo_ayss.report.sections.reference import reference_markdown
 
+    gaps = [line for a in analyses if (line := missing_rows_line(a)) is not None]
     csv_path, md = write_ranking(
         ranking_rows(analyses),
         cfg.out,
         checks,
         cfg.expected_order,
-        reference_markdown(analyses),
+        [*(x for g in gaps for x in ("", g)), *reference_markdown(analyses)],
     )
     from sumo_ayss.report.measures import write_measures
 

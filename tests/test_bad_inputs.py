@@ -905,6 +905,34 @@ def _header_only(path: Path) -> None:
     path.write_text(path.read_text().splitlines()[0] + "\n")
 
 
+def _flat_returns(path: Path) -> None:
+    """Every SPCP candidate scored 0.0 (a cut-in whose ODD pins the VUT's speed at 0)."""
+    lines = path.read_text().splitlines()
+    col = lines[0].split(",").index("mean_return")
+    rows = [line.split(",") for line in lines[1:]]
+    for r in rows:
+        r[col] = "0.0"
+    path.write_text("\n".join([lines[0], *(",".join(r) for r in rows)]) + "\n")
+
+
+def _keep_rows(path: Path, keep: Callable[[list[str], int], bool]) -> None:
+    """Keep the rows ``keep(cells, index)`` of a CSV table (header kept)."""
+    lines = path.read_text().splitlines()
+    rows = [line for i, line in enumerate(lines[1:]) if keep(line.split(","), i)]
+    path.write_text("\n".join([lines[0], *rows]) + "\n")
+
+
+def _lose_vut(path: Path) -> None:
+    """``crossplay.csv`` without any row driven against pi2."""
+    _keep_rows(path, lambda cells, i: cells[0] != "pi2")
+
+
+def _lose_one_row(path: Path) -> None:
+    """``crossplay.csv`` less its very last row (one cell one scenario short)."""
+    n = len(path.read_text().splitlines()) - 1
+    _keep_rows(path, lambda cells, i: i != n - 1)
+
+
 PI1 = "car_following/pi1/seed_0"
 #: (id, file under the output folder, damage, expected part of the console warning); the
 #: report and ``rank --no-run`` exit 0 with a warning on the console, and non-zero with
@@ -915,6 +943,14 @@ CASE_FOLDER_DAMAGE: list[tuple[str, str, Corruption, str]] = [
     ("nan in crossplay.csv", "car_following/crossplay.csv", _nan_cell, "NaN not allowed"),
     ("text in eval.csv", f"{PI1}/eval.csv", _text_cell, "eval.csv: 1 candidate row(s)"),
     ("header-only ayss.csv", f"{PI1}/ayss.csv", _header_only, "ayss.csv: no rows"),
+    ("every candidate the same", f"{PI1}/eval.csv", _flat_returns, "scored exactly the same"),
+    ("one VUT's cross-play rows lost", "car_following/crossplay.csv", _lose_vut, "rows of VUT pi2"),
+    (
+        "one cross-play row lost",
+        "car_following/crossplay.csv",
+        _lose_one_row,
+        "pi2/seed_1: 19 of 20",
+    ),
     ("config only", "car_following/pi3/seed_0", lambda p: None, "eval.csv missing"),
 ]
 
@@ -955,6 +991,10 @@ def test_report_warns_on_the_console_naming_a_damaged_file(
     warned = [line for line in err.splitlines() if line.startswith("WARNING: ")]
     assert any(expected in line and str(damaged) in line for line in warned), err
     assert (tmp_path / "report" / "report.html").is_file()
+    summary = (tmp_path / "report" / "summary.md").read_text(encoding="utf-8")
+    gap = "No crossplay-mode rows for car_following: "  # the leaderboard says why, once
+    no_rows = name.endswith("crossplay.csv") or name.endswith("pi3/seed_0")  # pi3: no rows
+    assert summary.count(gap) == (1 if no_rows else 0), summary
     with pytest.raises(SystemExit) as info:
         main([*args, "--strict"])
     code = info.value.code
@@ -972,8 +1012,8 @@ def _rank_pipeline(tmp_path: Path) -> Path:
 
 @pytest.mark.parametrize(
     ("name", "damage", "expected"),
-    [c[1:] for c in CASE_FOLDER_DAMAGE[:5]],
-    ids=[c[0] for c in CASE_FOLDER_DAMAGE[:5]],
+    [c[1:] for c in CASE_FOLDER_DAMAGE[:-1]],
+    ids=[c[0] for c in CASE_FOLDER_DAMAGE[:-1]],
 )
 def test_rank_no_run_warns_on_the_console_naming_a_damaged_file(
     tmp_path: Path,
@@ -995,6 +1035,14 @@ def test_rank_no_run_warns_on_the_console_naming_a_damaged_file(
     with pytest.raises(SystemExit) as info:
         main([*args, "--strict"])
     assert info.value.code not in (0, None)
+    md = (tmp_path / "runs" / "ranking.md").read_text(encoding="utf-8")
+    if name.endswith("crossplay.csv"):  # the cross-play rows are missing, and it says why
+        assert "| crossplay |" not in md
+        why = [line for line in md.splitlines() if line.startswith("No crossplay-mode rows")]
+        assert len(why) == 1 and "car_following" in why[0] and str(damaged) in why[0], md
+        assert "exposure-mode rows stand in their place" in why[0]
+    else:
+        assert "| crossplay |" in md and "No crossplay-mode rows" not in md
 
 
 def test_a_garbled_table_or_json_file_is_a_table_error_naming_it(tmp_path: Path) -> None:

@@ -270,13 +270,23 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -
         return
     opponents = {(v, int(r.seed)) for v, rs in out.runs.items() for r in rs if r.seed is not None}
     if set(m.vuts) != set(out.runs) or set(m.opponents) != opponents:
+        lost = [f"VUT {v}" for v in out.runs if v not in m.vuts] + [
+            f"opponent {v}/seed_{s}" for v, s in sorted(opponents - set(m.opponents))
+        ]
         out.crossplay_gap = CrossplayGap(
             "not_these_runs",
             path=found.path,
             vuts=tuple(m.vuts),
             n_opponents=len(m.opponents),
             n_runs=len(opponents),
+            lost="; ".join(lost),
         )
+        if lost:  # a table that lost rows (or was never extended): a problem, named
+            out.problems.append(
+                f"{found.path}: no rows of {'; '.join(lost)} (the table holds VUTs "
+                f"{', '.join(m.vuts)} and {len(m.opponents)} opponents; the case has "
+                f"{len(out.runs)} VUTs and {len(opponents)} runs)"
+            )
         return
     out.crossplay, out.crossplay_path = m, found.path
     out.crossplay_diagonal = found.diagonal

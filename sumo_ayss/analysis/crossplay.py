@@ -203,7 +203,7 @@ def crossplay_matrix(
     if counts.min() == 0 or counts.min() != counts.max():
         raise ConfigError(
             "cross-play table: not every opponent drove the same number of scenarios against "
-            f"every VUT (per-cell counts {int(counts.min())}..{int(counts.max())})"
+            f"every VUT; rows lost: {short_cells(vuts, opps, counts)}"
         )
     return CrossplayMatrix(
         vuts,
@@ -216,6 +216,43 @@ def crossplay_matrix(
         preventable=None if preventable is None else sums["prev"].astype(np.int64),
         labelled=None if preventable is None else sums["lab"].astype(np.int64),
     )
+
+
+def short_cells(
+    vuts: Sequence[str], opponents: Sequence[tuple[str, int]], counts: npt.NDArray[np.float64]
+) -> str:
+    """Which VUTs, opponents or single cells hold fewer rows than the fullest cell, in words.
+
+    A VUT whose every cell is short is named once ("VUT pi2: 0 of 400 rows"), so is an
+    opponent short against every VUT; the other short cells are named one by one (the first
+    :data:`_SHOWN`). ``counts[i, j]``: rows of opponent j against VUT i.
+    """
+    full = int(counts.max())
+    short = counts < full
+    parts = []
+    rows_short = [i for i in range(len(vuts)) if short[i].all()]
+    cols_short = [j for j in range(len(opponents)) if short[:, j].all()] if len(vuts) > 1 else []
+    for i in rows_short:
+        got = int(counts[i].sum())
+        parts.append(f"VUT {vuts[i]}: {got} of {full * len(opponents)} rows")
+    for j in cols_short:
+        o = f"{opponents[j][0]}/seed_{opponents[j][1]}"
+        parts.append(f"opponent {o}: {int(counts[:, j].sum())} of {full * len(vuts)} rows")
+    covered = np.zeros_like(short)
+    covered[rows_short, :] = True
+    covered[:, cols_short] = True
+    cells = [
+        f"{vuts[i]} vs {opponents[j][0]}/seed_{opponents[j][1]}: {int(counts[i, j])} of {full}"
+        for i, j in zip(*np.nonzero(short & ~covered), strict=True)
+    ]
+    parts += cells[:_SHOWN]
+    if len(cells) > _SHOWN:
+        parts.append(f"and {len(cells) - _SHOWN} more cells")
+    return "; ".join(parts)
+
+
+#: Short cells named one by one in :func:`short_cells`.
+_SHOWN = 5
 
 
 @dataclass(frozen=True)
@@ -264,6 +301,9 @@ class CrossplayGap:
         vuts: ``"not_these_runs"``: the table's VUTs.
         n_opponents: ``"not_these_runs"``: the table's opponents.
         n_runs: ``"not_these_runs"``: the case's runs with a seed.
+        lost: ``"not_these_runs"``: what of these runs the table holds no row of, in words
+            (``"VUT pi2; opponent pi1/seed_1"``); "" when it holds every one (it is of
+            other runs besides).
     """
 
     reason: Literal["one_vut", "not_found", "not_these_runs"]
@@ -273,6 +313,7 @@ class CrossplayGap:
     vuts: tuple[str, ...] = ()
     n_opponents: int = 0
     n_runs: int = 0
+    lost: str = ""
 
 
 def rank_crossplay(

@@ -88,6 +88,11 @@ def crossplay_gap_text(gap: CrossplayGap) -> str:
             f"no cross-play for this case: its runs here are of one VUT only ({gap.vut}), and "
             "cross-play compares two or more"
         )
+    if gap.reason == "not_these_runs" and gap.lost:
+        return (
+            f"the cross-play table {gap.path} has no rows of {gap.lost} (damaged, or not yet "
+            f"extended to every run); run {CROSSPLAY_COMMAND} --force"
+        )
     if gap.reason == "not_these_runs":
         return (
             f"the cross-play table {gap.path} is not of these runs (VUTs {', '.join(gap.vuts)}; "
@@ -95,6 +100,13 @@ def crossplay_gap_text(gap: CrossplayGap) -> str:
             f"run {CROSSPLAY_COMMAND} again once every job is done"
         )
     return gap.loader or NO_CROSSPLAY_TABLE
+
+
+def _gap(a: CaseAnalysis) -> str:
+    """Why the case has no cross-play ranking, one sentence."""
+    if a.crossplay_gap is not None:
+        return crossplay_gap_text(a.crossplay_gap)
+    return "the cross-play table ranks fewer than two VUTs"
 
 
 def crossplay_verdict(a: CaseAnalysis) -> CaseVerdict:
@@ -117,10 +129,7 @@ def crossplay_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
     from sumo_ayss.analysis.seeds import SeedComparison
 
     if v.mode != NAME:
-        if a.crossplay_gap is not None:
-            reason = crossplay_gap_text(a.crossplay_gap)
-        else:
-            reason = "the cross-play table ranks fewer than two VUTs"
+        reason = _gap(a)
         shown = get_mode(v.mode).headline(a, v)
         return f"[{NAME} mode] {reason}. Shown instead, labelled: {shown}"
     assert isinstance(v.top, SeedComparison)
@@ -175,5 +184,6 @@ CROSSPLAY = register_mode(
         companion_lines=_companion_lines,
         closing_lines=paper_verdict_lines,
         runs_crossplay=True,
+        gap_text=_gap,
     )
 )

@@ -25,6 +25,7 @@ __all__ = [
     "Standing",
     "get_mode",
     "headline_text",
+    "missing_rows_line",
     "mode_names",
     "register_mode",
     "registered_modes",
@@ -120,6 +121,8 @@ class Mode:
             the headline (e.g. the other modes' rankings).
         closing_lines: Verdict-callout lines after the premise check, when this mode was
             asked for.
+        gap_text: Why the mode has no ranking of a case, one sentence
+            (:func:`missing_rows_line`); None: a generic sentence.
     """
 
     name: str
@@ -139,6 +142,7 @@ class Mode:
     closing_lines: Callable[[CaseAnalysis], list[str]]
     runs_crossplay: bool = False
     needs_safety_index: bool = False
+    gap_text: Callable[[CaseAnalysis], str] | None = None
 
     def __post_init__(self) -> None:
         require(
@@ -191,6 +195,21 @@ def get_mode(name: str) -> Mode:
 def headline_text(a: CaseAnalysis) -> str:
     """The case's headline: its verdict (``a.verdict``) worded by the mode asked for."""
     return get_mode(a.mode).headline(a, a.verdict)
+
+
+def missing_rows_line(a: CaseAnalysis) -> str | None:
+    """One line saying why the mode asked for (``a.mode``) has no rows for the case and
+    which mode's rows stand in their place, for ``ranking.md``, the report's leaderboard
+    and the terminal; None when it has them."""
+    mode = get_mode(a.mode)
+    if mode.available(a):
+        return None
+    why = mode.gap_text(a) if mode.gap_text is not None else "this mode has no ranking of it"
+    why = why.rstrip(". ")
+    instead = (
+        f"; the {a.ranking_mode}-mode rows stand in their place" if a.ranking_mode != a.mode else ""
+    )
+    return f"No {a.mode}-mode rows for {a.case}: {why}{instead}."
 
 
 def mode_names() -> tuple[str, ...]:

@@ -26,8 +26,9 @@ from sumo_ayss.util.errors import AyssError
 
 #: ``--strict``'s help, also quoted by ``rank --strict``.
 STRICT_HELP = (
-    "exit non-zero when an input file is missing, unreadable or empty (each is printed as a "
-    "WARNING line naming the file, and listed in the report); for CI"
+    "exit non-zero when an input file is missing, unreadable, empty or damaged, or every "
+    "SPCP candidate of a run scored the same (each is printed as a WARNING line naming the "
+    "file, and listed in the report); for CI"
 )
 
 

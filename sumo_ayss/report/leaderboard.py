@@ -24,7 +24,14 @@ from dataclasses import dataclass
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.reference import CAREFUL_HUMAN, ReferenceComparison
-from sumo_ayss.modes import CROSSPLAY, EXPOSURE, Standing, get_mode, headline_text
+from sumo_ayss.modes import (
+    CROSSPLAY,
+    EXPOSURE,
+    Standing,
+    get_mode,
+    headline_text,
+    missing_rows_line,
+)
 from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p, rank_labels
 from sumo_ayss.report.blocks import Table
 from sumo_ayss.report.sections.common import crash_cell, mobility_cell
@@ -164,12 +171,14 @@ def leaderboard_table(a: CaseAnalysis, level: float) -> Table | None:
     score = f"{mode.score_name}, {mode.unit(a)}" if a.ranking_mode == "paper" else mode.score_name
     columns = [c for c in COLUMNS if not (c.optional and all(c.cell(r) == "—" for r in rows))]
     head = tuple(c.header.replace("{score}", score).replace("95 %", pct) for c in columns)
+    gap = missing_rows_line(a)
     return Table(
         f"{a.info.title}: leaderboard ({a.ranking_mode} mode), safest first",
         head,
         tuple(tuple(c.cell(r) for c in columns) for r in rows),
         tuple(c.numeric for c in columns),
-        f"vs next: how much safer than the VUT ranked next, as the paired difference the test "
+        (f"{gap} " if gap else "")
+        + f"vs next: how much safer than the VUT ranked next, as the paired difference the test "
         f"is about, with its {pct} interval (none with fewer than three seeds, never past "
         "what a difference of two scores can be); 'safer than' when the test's p, adjusted by "
         "Holm over the ranking's adjacent claims, is below 0.05, else 'tied' (a tie shares "
@@ -198,6 +207,8 @@ def leaderboard_text(analyses: Sequence[CaseAnalysis], width: int = 80) -> str:
         rows = leaderboard_rows(a)
         lines.append(f"{a.case}: leaderboard ({a.ranking_mode} mode), safest first")
         lines.append(f"  score: {get_mode(a.ranking_mode).score_name}")
+        if rows and (gap := missing_rows_line(a)) is not None:
+            lines += textwrap.wrap(gap, width, initial_indent="  ", subsequent_indent="  ")
         if not rows:
             lines += textwrap.wrap(
                 f"no ranking: {headline_text(a)}",

@@ -342,10 +342,9 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
         matrix = read_crossplay_matrix(path, scale)
     except (TableError, ConfigError) as exc:
         text = str(exc)  # a TableError names the file already
+        problem = text if text.startswith(str(path)) else f"{path}: {text}"
         return CrossplayInput(
-            path=path,
-            missing=f"the cross-play table is unreadable ({exc})",
-            problem=text if text.startswith(str(path)) else f"{path}: {text}",
+            path=path, missing=f"the cross-play table is unreadable ({problem})", problem=problem
         )
     reference = None
     if folder.crossplay_reference_csv.is_file():

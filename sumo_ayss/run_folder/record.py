@@ -300,6 +300,20 @@ def _training(
     return Training(total, every, key, len(rows), spcp_step, int(last["step"]), gap, improving)
 
 
+def _all_same(mean_return: NDArray[np.float64]) -> str | None:
+    """A sentence when two or more SPCP candidates all scored exactly the same mean
+    reward: the opponent's actions changed nothing it is paid for (e.g. an ODD that pins
+    the VUT's speed at 0), so which one is the SPCP is arbitrary; None otherwise."""
+    if mean_return.size < 2 or not np.all(mean_return == mean_return[0]):
+        return None
+    return (
+        f"{EVAL_CSV}: all {mean_return.size} SPCP candidates scored exactly the same mean "
+        f"reward ({float(mean_return[0]):.4f}): the opponent's actions changed nothing it is "
+        "paid for (e.g. an ODD that pins the VUT's speed), so the SPCP is an arbitrary "
+        "candidate and its scores carry no signal"
+    )
+
+
 def _eval_curve(rows: Sequence[Mapping[str, Any]], n_dropped: int) -> EvalCurve:
     def col(name: str) -> NDArray[np.float64]:
         return np.array([r[name] for r in rows], dtype=np.float64)
@@ -427,6 +441,8 @@ def read_run(path: str | Path) -> RunRecord:
     versions = r.attempt(folder.versions, _read_versions, needed=False)  # optional
     if curve is not None and len(curve) == 0 and not n_dropped:
         r.problems.append(f"{EVAL_CSV}: no rows (header only), so no learning curve")
+    if curve is not None and (same := _all_same(curve.mean_return)) is not None:
+        r.problems.append(same)
     if ayss is not None and len(ayss) == 0:
         r.problems.append(f"{AYSS_CSV}: no rows (header only), so no AYSS sample")
     if ayss is not None and ayss.indicator_name is not None:

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from sumo_ayss.analysis.crossplay import crossplay_matrix, rank_crossplay
+from sumo_ayss.analysis.crossplay import crossplay_matrix, rank_crossplay, short_cells
 from sumo_ayss.analysis.seeds import compare_seeds, kendall_tau
 from sumo_ayss.modes.crossplay import crossplay_sentence
 from sumo_ayss.util.errors import ConfigError
@@ -77,6 +77,29 @@ def test_matrix_means_and_balance():
     ret[3] = math.nan
     with pytest.raises(ConfigError, match="harm has non-finite"):
         crossplay_matrix(vut, ov, os_, ret, col)
+
+
+def test_short_cells_name_the_vut_or_opponent_that_lost_rows():
+    vuts = ("pi1", "pi2", "pi3")
+    opps = (("pi1", 0), ("pi2", 0), ("pi3", 0), ("pi1", 1))
+    full = np.full((3, 4), 100.0)
+    lost_vut = full.copy()
+    lost_vut[1, :] = [0, 0, 0, 50]
+    assert short_cells(vuts, opps, lost_vut) == "VUT pi2: 50 of 400 rows"
+    lost_opp = full.copy()
+    lost_opp[:, 3] = 0
+    assert short_cells(vuts, opps, lost_opp) == "opponent pi1/seed_1: 0 of 300 rows"
+    one = full.copy()
+    one[2, 1] = 99
+    assert short_cells(vuts, opps, one) == "pi3 vs pi2/seed_0: 99 of 100"
+    many = np.full((3, 4), 100.0)
+    many[0, :3] = many[1, :3] = 99  # 6 cells, no whole VUT or opponent
+    text = short_cells(vuts, opps, many)
+    assert text.count(" of 100") == 5 and text.endswith("and 1 more cells")
+    m0 = np.arange(12.0).reshape(2, 6)  # via the matrix: the error names the cell
+    vut, ov, os_, ret, col = _table(m0)
+    with pytest.raises(ConfigError, match=r"rows lost: v1 vs v1/seed_2: 1 of 2$"):
+        crossplay_matrix(vut[:-1], ov[:-1], os_[:-1], ret[:-1], col[:-1])
 
 
 def test_seed_blocks_average_each_seeds_opponents():

@@ -50,3 +50,23 @@ def test_missing_files_are_problems_and_the_stages_get_an_error(tmp_path: Path) 
     assert run.config is None and run.problems[0].startswith("config.yaml unreadable")
     with pytest.raises(CheckpointError, match=r"config\.yaml: unreadable run configuration"):
         run.experiment  # noqa: B018
+
+
+def test_candidates_that_all_scored_the_same_are_a_problem(tmp_path: Path) -> None:
+    """A cut-in whose ODD pins the VUT's speed at 0 scores every candidate 0.0000: which
+    one is the SPCP is arbitrary, and the record says so (issue 38)."""
+    from sumo_ayss.run_folder import read_eval_table, write_eval_table
+
+    folder = make_run(tmp_path, "cut_in", "pi1", 0)
+    rows = read_eval_table(folder / "eval.csv")
+    write_eval_table(folder / "eval.csv", [{**r, "mean_return": 0.0} for r in rows])
+    (problem,) = read_run(folder).problems
+    assert problem.startswith(f"eval.csv: all {len(rows)} SPCP candidates scored exactly the same")
+    assert "(0.0000)" in problem
+    write_eval_table(folder / "eval.csv", [{**rows[0], "mean_return": 0.0}])
+    assert read_run(folder).problems == ()  # one candidate: nothing to compare
+    write_eval_table(
+        folder / "eval.csv",
+        [{**r, "mean_return": 0.0} for r in rows[:-1]] + [{**rows[-1], "mean_return": 1e-9}],
+    )
+    assert read_run(folder).problems == ()  # not exactly the same
