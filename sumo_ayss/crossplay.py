@@ -38,6 +38,7 @@ from sumo_ayss.run_folder import (
     CROSSPLAY_SCHEMA,
     OUTCOME_SCHEMA,
     CaseFolder,
+    CellStore,
     CrossplayOpponent,
     CrossplayRecord,
     CrossplayStage,
@@ -153,14 +154,21 @@ def run_case(
     else:
         to_play = list(runs)
     outcomes = {(r.experiment.env.vut, r.config_seed): _outcome_table(r, n, seed) for r in to_play}
+    sha = {(o.vut, o.seed): o.spcp_sha256 for o in pool}
     opponents = [
-        Opponent(r.experiment.env.vut, r.config_seed, functools.partial(load_spcp, r))
+        Opponent(
+            r.experiment.env.vut,
+            r.config_seed,
+            functools.partial(load_spcp, r),
+            sha[(r.experiment.env.vut, r.config_seed)],
+        )
         for r in to_play
     ]
+    cells = _cells(folder.crossplay_partial, force)
     t0 = time.perf_counter()
     with controller_imports(trust_controller):
         table = run_crossplay(
-            envs, opponents, n=n, seed=seed, progress=progress, reference=reference
+            envs, opponents, n=n, seed=seed, progress=progress, reference=reference, cells=cells
         )
     wall_s = time.perf_counter() - t0
     checks = tuple(diagonal_check(table, v, s, out) for (v, s), out in outcomes.items())
@@ -174,6 +182,7 @@ def run_case(
     write_table(folder.crossplay_csv, table)
     record = dataclasses.replace(requested, vuts=tuple(envs), wall_s=wall_s, diagonal=checks)
     write_crossplay_json(folder.crossplay_json, record)
+    cells.clear()  # the whole table is written: its cells are no longer needed
     check_diagonal(checks, case)
     _reference_rows(runs, folder, references, n, seed, trust_controller, progress, reference)
     return folder.crossplay_csv
@@ -237,14 +246,22 @@ def _reference_rows(
         base = reference_config(base, name, own_body=True)
     envs = {name: dataclasses.replace(base, vut=name) for name in references}
     opponents = [
-        Opponent(r.experiment.env.vut, r.config_seed, functools.partial(load_spcp, r)) for r in runs
+        Opponent(
+            r.experiment.env.vut,
+            r.config_seed,
+            functools.partial(load_spcp, r),
+            _sha256(r.folder.spcp_zip),
+        )
+        for r in runs
     ]
+    cells = _cells(folder.crossplay_reference_partial, False)
     t0 = time.perf_counter()
     with controller_imports(trust_controller):
         table = run_crossplay(
-            envs, opponents, n=n, seed=seed, progress=progress, reference=label_with
+            envs, opponents, n=n, seed=seed, progress=progress, reference=label_with, cells=cells
         )
     write_table(path, table)
+    cells.clear()
     logger.info(
         "%s: reference drivers %s against %d opponents in %.1f s",
         folder.path,
@@ -252,6 +269,17 @@ def _reference_rows(
         len(opponents),
         time.perf_counter() - t0,
     )
+
+
+def _cells(path: Path, force: bool) -> CellStore:
+    """The finished cells of an interrupted run of this table (:class:`~sumo_ayss.run_folder.
+    CellStore`); ``force`` drops them first (every cell is driven again)."""
+    cells = CellStore(path)
+    if force:
+        cells.clear()
+    elif held := cells.count():
+        logger.info("%s: %d finished cells of an interrupted run are kept", path, held)
+    return cells
 
 
 def _done(stage: CrossplayStage) -> bool:

@@ -34,6 +34,8 @@ above the case's run folders, holds the cross-play and discriminability stages' 
 ``crossplay.csv``           write_/read_table               one row per (VUT, opponent SPCP,
                             (:data:`CROSSPLAY_SCHEMA`)      scenario)
 ``crossplay.json``          write_/read_crossplay_json      settings, opponents, wall time
+``crossplay.partial/``      :class:`CellStore`              finished cells of an unfinished
+                                                            table, removed once it is written
 ``discriminability.json``   write_discriminability /        where the VUTs' responses differ
 ``discriminability.csv``    read_discriminability_json      over the AYSS box
 ``adaptive.json``           write_/read_adaptive            adaptive seeding: looks and seeds
@@ -69,6 +71,7 @@ from sumo_ayss.run_folder.crossplay import (
     write_crossplay_json,
     write_inevitable,
 )
+from sumo_ayss.run_folder.crossplay_cells import CellStore
 from sumo_ayss.run_folder.discriminability import (
     read_discriminability_json,
     write_discriminability,
@@ -89,6 +92,8 @@ from sumo_ayss.run_folder.layout import (
     CONFIG_YAML,
     CROSSPLAY_CSV,
     CROSSPLAY_JSON,
+    CROSSPLAY_PARTIAL,
+    CROSSPLAY_REFERENCE_PARTIAL,
     DISCRIMINABILITY_CSV,
     DISCRIMINABILITY_JSON,
     DISCRIMINABILITY_PNG,
@@ -223,6 +228,8 @@ __all__ = [
     "CONFIG_YAML",
     "CROSSPLAY_CSV",
     "CROSSPLAY_JSON",
+    "CROSSPLAY_PARTIAL",
+    "CROSSPLAY_REFERENCE_PARTIAL",
     "CROSSPLAY_SCHEMA",
     "DISCRIMINABILITY_CSV",
     "DISCRIMINABILITY_JSON",
@@ -262,6 +269,7 @@ __all__ = [
     "AyssSamples",
     "AyssStage",
     "CaseFolder",
+    "CellStore",
     "Column",
     "CrossplayOpponent",
     "CrossplayRecord",

@@ -113,6 +113,10 @@ INEVITABLE_JSON = "inevitable.json"
 """Which of the case's scenarios are inevitable-collision states (written by cross-play)."""
 CROSSPLAY_JSON = "crossplay.json"
 """Cross-play record: settings, opponents with their SPCP's SHA-256, wall time."""
+CROSSPLAY_PARTIAL = "crossplay.partial"
+"""The finished cells of a cross-play table not yet written whole (one file each)."""
+CROSSPLAY_REFERENCE_PARTIAL = "crossplay_reference.partial"
+"""The same for the reference drivers' table."""
 ADAPTIVE_JSON = "adaptive.json"
 
 # -- written by the discriminability stage, in the case folder too ------------------------
@@ -279,6 +283,17 @@ class CaseFolder:
     def inevitable_json(self) -> Path:
         """``inevitable.json``: the scenarios no braking survives (:func:`read_inevitable`)."""
         return self.path / INEVITABLE_JSON
+
+    @property
+    def crossplay_partial(self) -> Path:
+        """``crossplay.partial/``: the finished cells of a cross-play table not yet written
+        whole (:class:`~.crossplay_cells.CellStore`)."""
+        return self.path / CROSSPLAY_PARTIAL
+
+    @property
+    def crossplay_reference_partial(self) -> Path:
+        """``crossplay_reference.partial/``: the same for ``crossplay_reference.csv``."""
+        return self.path / CROSSPLAY_REFERENCE_PARTIAL
 
     @property
     def crossplay_reference_csv(self) -> Path:

@@ -35,6 +35,7 @@ import dataclasses
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -47,7 +48,14 @@ from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
 from sumo_ayss.scenarios.rollout import Policy, run_episodes
 from sumo_ayss.util.errors import ConfigError, DiagonalMismatchError
 
-__all__ = ["DIAGONAL_COLUMNS", "Opponent", "check_diagonal", "diagonal_check", "run_crossplay"]
+__all__ = [
+    "DIAGONAL_COLUMNS",
+    "CellCache",
+    "Opponent",
+    "check_diagonal",
+    "diagonal_check",
+    "run_crossplay",
+]
 
 
 @dataclass(frozen=True)
@@ -64,6 +72,23 @@ class Opponent:
     vut: str
     seed: int
     load: Callable[[PairEnv], Policy]
+    identity: str = ""
+    """What tells this SPCP from another of the same run (the SHA-256 of its ``spcp.zip``);
+    "" when unknown: its cells are then never kept across runs (:class:`CellCache`)."""
+
+
+class CellCache(Protocol):
+    """Where finished (VUT, opponent) cells are kept, so that an interrupted cross-play
+    resumes from the cells it finished (:class:`~sumo_ayss.run_folder.CellStore`). ``key``
+    holds everything the cell's rows depend on."""
+
+    def load(self, key: Sequence[Any]) -> list[dict[str, Any]] | None:
+        """The finished cell's rows, or None."""
+        ...
+
+    def save(self, key: Sequence[Any], rows: Sequence[dict[str, Any]]) -> None:
+        """Keep a finished cell's rows."""
+        ...
 
 
 def _same_but_vut(envs: Mapping[str, EnvConfig]) -> None:
@@ -87,6 +112,7 @@ def run_crossplay(
     seed: int,
     progress: Callable[[str], None] | None = None,
     reference: str | None = DEFAULT_REFERENCE,
+    cells: CellCache | None = None,
 ) -> Table:
     """Every opponent against every VUT on ``n`` common scenarios.
 
@@ -100,6 +126,8 @@ def run_crossplay(
         reference: The reference driver that replays each crash to label it preventable
             or not (:func:`~sumo_ayss.scenarios.preventability.label_crashes`, after the
             block's env closed, on its SUMO seed); None: no labels (NaN).
+        cells: Where each finished cell is kept as soon as it is done and read back
+            instead of driven again (an opponent with an ``identity`` only); None: none.
 
     Returns:
         The cross-play table, VUTs in the given order, then opponents, then scenarios.
@@ -118,7 +146,15 @@ def run_crossplay(
     for vut, cfg in envs.items():
         scenarios = sample_initial_conditions(cfg.odd, n, seed)
         for k, opp in enumerate(opponents):
+            key = (vut, repr(cfg), opp.vut, opp.seed, opp.identity, n, seed, reference)
+            kept = cells.load(key) if cells is not None and opp.identity else None
+            if kept is not None:  # a finished cell of an interrupted run: the same rows
+                rows += kept
+                if progress is not None:
+                    progress(f"{vut} vs SPCP {opp.vut}/seed_{opp.seed}: kept from an earlier run")
+                continue
             t0 = time.perf_counter()
+            start = len(rows)
             env = make_env(cfg, sumo_seed=opp.seed)  # as the outcome stage: a fresh SUMO
             try:
                 if k not in policies:
@@ -155,6 +191,8 @@ def run_crossplay(
                         "crash_preventable": float(labels[j]),
                     }
                 )
+            if cells is not None and opp.identity:
+                cells.save(key, rows[start:])
             if progress is not None:
                 mean = float(np.mean([e.episode_return for e in episodes]))
                 crashes = sum(e.collided for e in episodes)
