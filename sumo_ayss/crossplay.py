@@ -13,6 +13,12 @@ outcome scenarios (``evaluate.n_outcome`` of the outcome seed) and writes, per c
   with the same settings and SPCPs skips the case (the stage contract,
   :class:`~sumo_ayss.run_folder.CrossplayStage`).
 
+Until the table is written whole, each finished (VUT, opponent) cell is kept as its own
+file in ``<out>/<case>/crossplay.partial/`` (``crossplay_reference.partial/`` for the
+reference drivers; :class:`~sumo_ayss.run_folder.CellStore`): a stage interrupted mid-case
+(Ctrl-C, SIGKILL) resumes from the cells it finished, and the finished table is
+byte-identical to an undisturbed run's. ``--force`` drops them.
+
 (file names, writers and readers: :mod:`sumo_ayss.run_folder`).
 
 It then prints the cross-play ranking (:mod:`sumo_ayss.analysis.crossplay`) and, with the
