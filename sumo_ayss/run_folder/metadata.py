@@ -230,6 +230,8 @@ class SpcpChoice:
         criterion: Name of the selection criterion.
         reason: The selection's own sentence.
         checkpoint: The candidate's model, relative to the run folder.
+        no_signal: Every one of two or more candidates scored the same on the criterion
+            (the selection could not tell them apart; False in files written before).
     """
 
     step: int
@@ -237,6 +239,7 @@ class SpcpChoice:
     criterion: str
     reason: str
     checkpoint: str = ""
+    no_signal: bool = False
 
 
 def write_spcp(path: Path, selection: Any, checkpoint: str, row: Mapping[str, Any]) -> None:
@@ -269,6 +272,7 @@ def read_spcp(path: Path) -> SpcpChoice:
         criterion=str(data.get("criterion", "")),
         reason=str(data.get("reason", "")),
         checkpoint=str(data.get("checkpoint", "")),
+        no_signal=data.get("no_signal") is True,
     )
 
 

@@ -300,17 +300,22 @@ def _training(
     return Training(total, every, key, len(rows), spcp_step, int(last["step"]), gap, improving)
 
 
-def _all_same(mean_return: NDArray[np.float64]) -> str | None:
-    """A sentence when two or more SPCP candidates all scored exactly the same mean
-    reward: the opponent's actions changed nothing it is paid for (e.g. an ODD that pins
-    the VUT's speed at 0), so which one is the SPCP is arbitrary; None otherwise."""
-    if mean_return.size < 2 or not np.all(mean_return == mean_return[0]):
+def _all_same(curve: EvalCurve | None, spcp: SpcpChoice | None) -> str | None:
+    """A sentence when two or more SPCP candidates all scored exactly the same (their mean
+    reward in ``eval.csv``, or the selection's criterion as ``spcp.json`` records): the
+    opponent's actions changed nothing it is paid for (e.g. an ODD that pins the VUT's speed
+    at 0), so which one is the SPCP is arbitrary; None otherwise."""
+    returns = curve.mean_return if curve is not None else np.array([])
+    if returns.size >= 2 and np.all(returns == returns[0]):
+        what, value, n = "mean reward", float(returns[0]), f" {returns.size}"
+    elif spcp is not None and spcp.no_signal:
+        what, value, n = spcp.criterion, spcp.score, ""
+    else:
         return None
     return (
-        f"{EVAL_CSV}: all {mean_return.size} SPCP candidates scored exactly the same mean "
-        f"reward ({float(mean_return[0]):.4f}): the opponent's actions changed nothing it is "
-        "paid for (e.g. an ODD that pins the VUT's speed), so the SPCP is an arbitrary "
-        "candidate and its scores carry no signal"
+        f"{EVAL_CSV}: all{n} SPCP candidates scored exactly the same {what} ({value:.4f}): "
+        "the opponent's actions changed nothing it is paid for (e.g. an ODD that pins the "
+        "VUT's speed), so the SPCP is an arbitrary candidate and its scores carry no signal"
     )
 
 
@@ -441,7 +446,7 @@ def read_run(path: str | Path) -> RunRecord:
     versions = r.attempt(folder.versions, _read_versions, needed=False)  # optional
     if curve is not None and len(curve) == 0 and not n_dropped:
         r.problems.append(f"{EVAL_CSV}: no rows (header only), so no learning curve")
-    if curve is not None and (same := _all_same(curve.mean_return)) is not None:
+    if (same := _all_same(curve, spcp)) is not None:
         r.problems.append(same)
     if ayss is not None and len(ayss) == 0:
         r.problems.append(f"{AYSS_CSV}: no rows (header only), so no AYSS sample")

@@ -4,9 +4,11 @@ stage cannot do without is asked for and refused naming the file."""
 from __future__ import annotations
 
 import dataclasses
+import json
 from pathlib import Path
 
 import pytest
+import yaml
 
 from sumo_ayss.run_folder import OUTCOME_CSV, RunRecord, read_run
 from sumo_ayss.util.errors import CheckpointError
@@ -70,3 +72,32 @@ def test_candidates_that_all_scored_the_same_are_a_problem(tmp_path: Path) -> No
         [{**r, "mean_return": 0.0} for r in rows[:-1]] + [{**rows[-1], "mean_return": 1e-9}],
     )
     assert read_run(folder).problems == ()  # not exactly the same
+    spcp = json.loads((folder / "spcp.json").read_text())
+    (folder / "spcp.json").write_text(json.dumps({**spcp, "no_signal": True}))
+    (problem,) = read_run(folder).problems  # the selection's own criterion said so
+    assert "scored exactly the same mean_reward" in problem
+
+
+@pytest.mark.sumo
+def test_a_cut_in_whose_odd_pins_the_vut_at_rest_is_a_problem_of_its_record(
+    tmp_path: Path,
+) -> None:
+    """The issue's own case, trained with real SUMO: every candidate scores 0.0000."""
+    from sumo_ayss.config import load_experiment
+    from sumo_ayss.train import train
+    from tests.helpers import tiny_experiment
+
+    exp = tiny_experiment()
+    odd = {"pov_speed_mps": [10.0, 30.0], "vut_speed_mps": [0.0, 0.0], "gap_m": [0.0, 25.0]}
+    exp["env"] = {"case": "cut_in", "vut": "pi1", "odd": odd}
+    path = tmp_path / "pinned.yaml"
+    path.write_text(yaml.safe_dump(exp))
+    train(load_experiment(path), seed=0, out=tmp_path / "runs")
+    run = read_run(tmp_path / "runs" / "cut_in" / "pi1" / "seed_0")
+    assert run.eval_curve is not None and set(run.eval_curve.mean_return.tolist()) == {0.0}
+    same = [p for p in run.problems if "scored exactly the same" in p]
+    assert same == [
+        "eval.csv: all 3 SPCP candidates scored exactly the same mean reward (0.0000): the "
+        "opponent's actions changed nothing it is paid for (e.g. an ODD that pins the VUT's "
+        "speed), so the SPCP is an arbitrary candidate and its scores carry no signal"
+    ]
