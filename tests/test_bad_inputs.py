@@ -1045,6 +1045,30 @@ def test_rank_no_run_warns_on_the_console_naming_a_damaged_file(
         assert "| crossplay |" in md and "No crossplay-mode rows" not in md
 
 
+def test_pipeline_warns_on_the_console_and_fails_under_strict(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The pipeline's end prints the analyses' problems as rank and report do (here the
+    grid runner is replaced by the analyses it hands on: a run whose candidates all scored
+    the same)."""
+    import sumo_ayss.pipeline as pipeline
+    from sumo_ayss.rank import analyse
+
+    damaged = _case_folder(tmp_path / "runs", f"{PI1}/eval.csv", _flat_returns)
+    analyses = analyse(sorted((tmp_path / "runs").glob("*/*/seed_*")))
+    result = pipeline.PipelineResult([], None, [], analyses)
+    monkeypatch.setattr(pipeline, "run_pipeline", lambda cfg, **kw: result)
+    args = [str(_rank_pipeline(tmp_path)), "--no-live"]
+    with pytest.raises(SystemExit) as info:
+        pipeline.main(args)
+    assert info.value.code == 0
+    err = capsys.readouterr().err
+    assert f"WARNING: {damaged}: all 20 SPCP candidates scored exactly the same" in err, err
+    with pytest.raises(SystemExit) as info:
+        pipeline.main([*args, "--strict"])
+    assert isinstance(info.value.code, str) and "--strict: 1 problem(s)" in info.value.code
+
+
 def test_a_garbled_table_or_json_file_is_a_table_error_naming_it(tmp_path: Path) -> None:
     from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, read_table
     from sumo_ayss.run_folder.jsonio import read_json
