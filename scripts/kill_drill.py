@@ -102,12 +102,33 @@ def kill_at(pipe: Path, instant_s: float, log: Path) -> bool:
             return True
 
 
+def kill_after_cells(pipe: Path, cells: int, log: Path) -> bool:
+    """Start the command in its own process group and SIGKILL the group as soon as the
+    cross-play stage has kept ``cells`` finished cells; False when it ended before."""
+    partial = pipe.parent / "runs" / "car_following" / "crossplay.partial"
+    with log.open("ab") as f:
+        proc = subprocess.Popen(command(pipe), cwd=ROOT, stdout=f, stderr=f, start_new_session=True)
+        while proc.poll() is None:
+            if len(list(partial.glob("cell_*.csv"))) >= cells:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+                return True
+            time.sleep(0.02)
+        return False
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--kills", type=int, default=20)
     p.add_argument("--seed", type=int, default=0, help="seed of the kill instants")
     p.add_argument("--work", type=Path, default=Path("/tmp/kill_drill"))
     p.add_argument("--n-outcome", type=int, default=30)
+    p.add_argument(
+        "--cell-kills",
+        type=int,
+        default=0,
+        help="more kills, each once cross-play has kept a random number (1..7) of its 8 cells",
+    )
     args = p.parse_args(argv)
     if args.work.exists():
         shutil.rmtree(args.work)
@@ -120,32 +141,42 @@ def main(argv: list[str] | None = None) -> int:
     print(f"undisturbed: {wall:.1f} s, {len(expected)} files compared", flush=True)
     rng = random.Random(args.seed)
     results = []
-    for k in range(args.kills):
+    for k in range(args.kills + args.cell_kills):
         folder = args.work / f"kill_{k:02d}"
         pipe = write_study(folder, args.n_outcome)
-        instant = rng.uniform(0.0, wall)
         log = folder / "log.txt"
-        killed = kill_at(pipe, instant, log)
+        if k < args.kills:
+            instant = rng.uniform(0.0, wall)
+            killed = kill_at(pipe, instant, log)
+        else:  # a kill in the middle of a cross-play case
+            instant = float(rng.randint(1, 7))
+            killed = kill_after_cells(pipe, int(instant), log)
         at_kill = state(folder / "runs")
-        code, rerun_s = run(pipe, log)
+        rerun_log = folder / "rerun.txt"
+        code, rerun_s = run(pipe, rerun_log)
+        kept = rerun_log.read_text(errors="replace").count("kept from an earlier run")
         got = outputs(folder / "runs")
         differ = sorted(n for n in expected.keys() | got.keys() if expected.get(n) != got.get(n))
         ok = code == 0 and not differ
         results.append(
             {
                 "kill": k,
-                "instant_s": round(instant, 2),
+                "instant_s": round(instant, 2) if k < args.kills else None,
+                "after_cells": int(instant) if k >= args.kills else None,
                 "killed": killed,
                 "at_kill": at_kill,
                 "rerun_exit": code,
                 "rerun_s": round(rerun_s, 1),
+                "rerun_kept_cells": kept,
                 "differ": differ,
                 "ok": ok,
             }
         )
+        when = f"at {instant:6.1f} s" if k < args.kills else f"after {int(instant)} cells"
+        verdict = "equal" if not differ else "DIFFERS: " + ", ".join(differ)
         print(
-            f"kill {k:2d} at {instant:6.1f} s ({at_kill}): rerun exit {code} in "
-            f"{rerun_s:.1f} s, {'equal' if not differ else 'DIFFERS: ' + ', '.join(differ)}",
+            f"kill {k:2d} {when} ({at_kill}): rerun exit {code} in "
+            f"{rerun_s:.1f} s ({kept} cells kept), {verdict}",
             flush=True,
         )
         if ok:
