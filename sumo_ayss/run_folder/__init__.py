@@ -71,7 +71,7 @@ from sumo_ayss.run_folder.crossplay import (
     write_crossplay_json,
     write_inevitable,
 )
-from sumo_ayss.run_folder.crossplay_cells import CellStore
+from sumo_ayss.run_folder.crossplay_partial import CellStore
 from sumo_ayss.run_folder.discriminability import (
     read_discriminability_json,
     write_discriminability,

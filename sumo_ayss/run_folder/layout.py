@@ -287,7 +287,7 @@ class CaseFolder:
     @property
     def crossplay_partial(self) -> Path:
         """``crossplay.partial/``: the finished cells of a cross-play table not yet written
-        whole (:class:`~.crossplay_cells.CellStore`)."""
+        whole (:class:`~.crossplay_partial.CellStore`)."""
         return self.path / CROSSPLAY_PARTIAL
 
     @property
