@@ -66,11 +66,13 @@ class Opponent:
 
 
 def _same_but_vut(envs: Mapping[str, EnvConfig]) -> None:
-    """Refuses a pool whose VUT env configs differ in anything but the VUT."""
+    """Refuses a pool whose VUT env configs differ in anything but the VUT (the VUT's name
+    and definition, and the catalog of the study its run was made in: a VUT added to a
+    finished study comes with a larger catalog than the runs before it)."""
     items = list(envs.items())
     ref_name, ref = items[0]
     for name, cfg in items[1:]:
-        if dataclasses.replace(cfg, vut=ref.vut) != ref:
+        if dataclasses.replace(cfg, vut=ref.vut, vuts=ref.vuts) != ref:
             raise ConfigError(
                 f"cross-play: the env configs of {ref_name!r} and {name!r} differ in more "
                 "than the VUT (case, ODD, reward, actuator or timing); cross-play needs one "
