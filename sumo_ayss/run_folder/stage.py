@@ -65,6 +65,7 @@ __all__ = [
     "write_done_marker",
 ]
 
+
 def fingerprint(*parts: Any) -> str:
     """16 hex digits of SHA-256 over ``parts`` in order: a :class:`~pathlib.Path` counts
     by its file's bytes, anything else by its JSON (sorted keys; ``str()`` of what JSON
@@ -303,7 +304,8 @@ class AyssStage(_SettingsStage):
 class CrossplayStage:
     """Every SPCP of a case against every VUT. ``crossplay.json`` records the inputs (the
     scenario set, the opponents with their SPCP's SHA-256, how they were driven); a record
-    without the diagonal check (written before it) is not done."""
+    without the diagonal check (written before it), or of other VUTs (other names, or, where
+    it names them, other definitions), is not done."""
 
     folder: CaseFolder
     requested: CrossplayRecord
@@ -321,7 +323,8 @@ class CrossplayStage:
         if not self.folder.crossplay_json.is_file():
             return None
         done = read_crossplay_json(self.folder.crossplay_json)
-        return fingerprint(done.inputs()) if done.diagonal else None
+        fresh = done.diagonal and done.same_vuts(self.requested)
+        return fingerprint(done.inputs()) if fresh else None
 
 
 @dataclass(frozen=True)

@@ -46,7 +46,14 @@ from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, DiagonalCheck, Table, table_f
 from sumo_ayss.scenarios.rollout import Policy, run_episodes
 from sumo_ayss.util.errors import ConfigError, DiagonalMismatchError
 
-__all__ = ["DIAGONAL_COLUMNS", "Opponent", "check_diagonal", "diagonal_check", "run_crossplay"]
+__all__ = [
+    "DIAGONAL_COLUMNS",
+    "Opponent",
+    "check_diagonal",
+    "check_one_world",
+    "diagonal_check",
+    "run_crossplay",
+]
 
 
 @dataclass(frozen=True)
@@ -65,7 +72,7 @@ class Opponent:
     load: Callable[[PairEnv], Policy]
 
 
-def _same_but_vut(envs: Mapping[str, EnvConfig]) -> None:
+def check_one_world(envs: Mapping[str, EnvConfig]) -> None:
     """Refuses a pool whose VUT env configs differ in anything but the VUT (the VUT's name
     and definition, and the catalog of the study its run was made in: a VUT added to a
     finished study comes with a larger catalog than the runs before it)."""
@@ -107,7 +114,7 @@ def run_crossplay(
         raise ConfigError("cross-play needs at least one VUT and one opponent SPCP")
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise ConfigError(f"n: expected an integer >= 1, got {n!r}")
-    _same_but_vut(envs)
+    check_one_world(envs)
     rows: list[dict[str, object]] = []
     # Each opponent is loaded once (0.48 s a load here under load, against 15 ms for a fresh
     # SUMO): its greedy policy depends on the spaces only, the same for every VUT of the pool.

@@ -29,7 +29,9 @@ def _with_catalog(cfg: ExperimentConfig, vuts: dict[str, VehicleType]) -> Experi
 def test_another_vuts_definition_is_not_part_of_a_run() -> None:
     base = ExperimentConfig()  # pi1 in the built-in catalog
     grown = _with_catalog(base, {**base.env.vuts, "ob40": OB40})
-    redefined = _with_catalog(base, {**base.env.vuts, "ob40": dataclasses.replace(OB40, model="EIDM")})
+    redefined = _with_catalog(
+        base, {**base.env.vuts, "ob40": dataclasses.replace(OB40, model="EIDM")}
+    )
     alone = _with_catalog(base, {"pi1": base.env.vuts["pi1"]})
     for other in (grown, redefined, alone):
         assert run_identity(other, 0) == run_identity(base, 0)
@@ -44,9 +46,13 @@ def test_the_runs_own_definition_is_named_and_its_description_is_not() -> None:
     diffs = identity_differences(base, 0, changed, 0)
     assert diffs == ["env.vuts[env.vut].params.accel: 3.0 -> 2.0"]
     assert is_redefinition(diffs)
-    retitled = _with_catalog(base, {**base.env.vuts, "pi1": dataclasses.replace(pi1, description="x")})
+    retitled = _with_catalog(
+        base, {**base.env.vuts, "pi1": dataclasses.replace(pi1, description="x")}
+    )
     assert identity_differences(base, 0, retitled, 0) == []
-    longer = dataclasses.replace(base, train=dataclasses.replace(base.train, total_timesteps=300_000))
+    longer = dataclasses.replace(
+        base, train=dataclasses.replace(base.train, total_timesteps=300_000)
+    )
     mixed = identity_differences(base, 0, dataclasses.replace(longer, env=changed.env), 0)
     assert len(mixed) == 2 and not is_redefinition(mixed)
     assert identity_differences(base, 0, base, 1) == ["seed: 0 -> 1"]
