@@ -105,7 +105,7 @@ def stale_record(cfg: PipelineConfig, case: str) -> str | None:
         f"{', '.join(n for n, _ in record.vuts)}"
         + (f" ({', '.join(redefined)} since redefined)" if redefined else "")
         + f"; the grid's are {', '.join(n for n, _ in now)}: the record is ignored and "
-        f"seeding starts over at {len(cfg.seeds)} seeds per VUT"
+        f"seeding starts over from grid.seeds ({len(cfg.seeds)} per VUT)"
     )
 
 

@@ -39,8 +39,8 @@ class AdaptiveRecord:
         alpha: The procedure's false-positive rate.
         seeds: Every seed the case's VUTs were trained on so far, in the order added.
         looks: Every look so far, in order.
-        vuts: ``(name, definition key)`` of every VUT looked at, in grid order (empty in
-            records written before it).
+        vuts: ``(name, definition key)`` of every VUT looked at (stored as a JSON object;
+            empty in records written before it).
     """
 
     first_seeds: tuple[int, ...]
@@ -64,9 +64,9 @@ class AdaptiveRecord:
         )
 
     def same_vuts(self, vuts: tuple[tuple[str, str], ...]) -> bool:
-        """Whether this record looked at the VUTs ``vuts`` (``(name, key)`` in grid order);
+        """Whether this record looked at the VUTs ``vuts`` (``(name, key)``, in any order);
         a record that does not name its VUTs (written before they were) is taken as is."""
-        return not self.vuts or self.vuts == tuple(vuts)
+        return not self.vuts or dict(self.vuts) == dict(vuts)
 
 
 def write_adaptive(path: str | Path, record: AdaptiveRecord) -> None:

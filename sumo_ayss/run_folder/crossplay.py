@@ -154,11 +154,6 @@ class CrossplayRecord:
         so that a cell of one may stand for the same cell of the other."""
         return (self.n, self.seed, self.rollout) == (other.n, other.seed, other.rollout)
 
-    def extended_by(self, other: CrossplayRecord) -> bool:
-        """Whether ``other`` is this run with more opponents (same scenarios, same rollout,
-        every opponent of this one among them): only the new ones need driving."""
-        return self.same_scenarios(other) and set(self.opponents) < set(other.opponents)
-
 
 def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
     """Write ``crossplay.json``."""
