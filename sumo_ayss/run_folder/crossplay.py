@@ -287,7 +287,9 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
         The :class:`~sumo_ayss.analysis.crossplay.CrossplayInput`: the matrix, its path and
         its diagonal check, or why there is none (no table, runs in several case folders or
         on different harm scales, an unreadable table or one whose design is not complete
-        and balanced, or a table whose diagonal did not reproduce the outcome tables).
+        and balanced, a table whose diagonal did not reproduce the outcome tables, or one
+        of other VUTs than the runs': a study whose VUTs changed and whose cross-play
+        could not run).
     """
     from sumo_ayss.analysis.crossplay import CrossplayInput
 
@@ -319,6 +321,13 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
                 missing=f"the cross-play record is unreadable ({exc})",
                 problem=str(exc),  # names the file
             )
+        if sorted(record.vuts) != sorted(runs):
+            why = (
+                f"the cross-play table is stale: it drove VUTs {', '.join(record.vuts)}, the "
+                f"runs are of {', '.join(runs)} (the pipeline drives the missing cells when "
+                "every job of the case is done)"
+            )
+            return CrossplayInput(path=path, missing=why, problem=f"{path}: {why}")
         diagonal = tuple((d.vut, d.seed, d.n, d.n_equal) for d in record.diagonal)
         bad = [d for d in record.diagonal if not d.ok]
         if bad:

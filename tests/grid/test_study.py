@@ -16,8 +16,8 @@ import yaml
 
 from sumo_ayss.config import PROJECT_ROOT, to_dict
 from sumo_ayss.crossplay import run_case
-from sumo_ayss.grid.adaptive import case_seeds, read_record, stale_record
-from sumo_ayss.grid.study import same_vehicles
+from sumo_ayss.grid.adaptive import case_seeds, grid_vuts, read_record, stale_record
+from sumo_ayss.grid.study import prepare_out, same_vehicles
 from sumo_ayss.pipeline import final_messages, load_pipeline, plan_jobs, run_pipeline
 from sumo_ayss.run_folder import (
     AdaptiveRecord,
@@ -201,3 +201,9 @@ def test_a_stale_adaptive_record_is_ignored_and_said_so(tmp_path: Path) -> None:
     line = stale_record(cfg, "car_following")
     assert line is not None and "looked at VUTs ob40, pi1" in line and "pi1 since redefined" in line
     assert "the grid's are pi1, pi2: the record is ignored" in line
+    assert f"NOTE: {line}" in prepare_out(cfg, plan_jobs(cfg))  # printed at the end
+    write_adaptive(
+        record, AdaptiveRecord((0,), 4, 0.05, (0, 1), (), grid_vuts(cfg, "car_following"))
+    )
+    assert stale_record(cfg, "car_following") is None
+    assert case_seeds(cfg, "car_following") == (0, 1)  # this grid's record: its added seed
