@@ -30,6 +30,7 @@ import functools
 import hashlib
 import logging
 import time
+from collections import Counter
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -50,18 +51,20 @@ from sumo_ayss.run_folder import (
     is_done,
     load_crossplay,
     read_crossplay_json,
+    read_inevitable,
     read_outcome_json,
     read_run,
     read_table,
     run_dir_for,
     table_from_rows,
     write_crossplay_json,
+    write_inevitable,
     write_table,
 )
 from sumo_ayss.run_folder.crossplay_cells import CellPlan, merged_rows, plan_cells
 from sumo_ayss.run_folder.identity import vut_key
 from sumo_ayss.util.errors import AyssError, CheckpointError, TableError
-from sumo_ayss.vuts.catalog import controller_imports
+from sumo_ayss.vuts.catalog import DEFAULT_REFERENCE, controller_imports
 
 logger = logging.getLogger(__name__)
 
@@ -96,6 +99,8 @@ def run_case(
     force: bool = False,
     trust_controller: bool = False,
     progress: Callable[[str], None] | None = None,
+    reference: str | None = DEFAULT_REFERENCE,
+    references: Sequence[str] = (DEFAULT_REFERENCE,),
 ) -> Path:
     """Cross-play of one case's runs; writes and returns the case folder's ``crossplay.csv``.
 
@@ -107,6 +112,12 @@ def run_case(
     every SPCP's episodes against its own VUT are compared with its run's ``outcome.csv``
     (:func:`~sumo_ayss.scenarios.crossplay.diagonal_check`); the result goes into
     ``crossplay.json``.
+
+    ``references`` (reference drivers, :data:`~sumo_ayss.vuts.catalog.REFERENCE_VUTS`) then
+    drive against the whole pool into ``crossplay_reference.csv`` (none: no file).
+    ``reference`` labels every crash preventable or not
+    (:mod:`sumo_ayss.scenarios.preventability`; None: no labels). It is not part of the
+    stage's settings: a table made without labels is kept (``--force`` relabels).
 
     Raises:
         DiagonalMismatchError: If an SPCP did not reproduce its outcome table (the table
@@ -137,7 +148,11 @@ def run_case(
     requested = CrossplayRecord(case, n, seed, pool, tuple(envs), 0.0, vut_keys=keys)
     if not force and _done(CrossplayStage(folder, requested)):
         logger.info("%s: cross-play done with these settings and SPCPs; skipped", case_dir)
-        check_diagonal(read_crossplay_json(folder.crossplay_json).diagonal, case)
+        done = read_crossplay_json(folder.crossplay_json)
+        check_diagonal(done.diagonal, case)
+        _reference_rows(
+            runs, folder, references, n, seed, trust_controller, progress, reference, done, pool
+        )
         return folder.crossplay_csv
     plan = None if force else _reusable(folder, requested)
     if plan is not None:
@@ -163,7 +178,12 @@ def run_case(
         ]
         with controller_imports(trust_controller):
             part = run_crossplay(
-                {v: envs[v] for v in vuts}, opponents, n=n, seed=seed, progress=progress
+                {v: envs[v] for v in vuts},
+                opponents,
+                n=n,
+                seed=seed,
+                progress=progress,
+                reference=reference,
             )
         rows += part.rows()
     wall_s = time.perf_counter() - t0 + (plan.wall_s if plan is not None else 0.0)
@@ -172,12 +192,127 @@ def run_case(
     for o, out in outcomes.items():
         found[(o.vut, o.seed)] = diagonal_check(table, o.vut, o.seed, out)
     checks = tuple(found[(o.vut, o.seed)] for o in pool if (o.vut, o.seed) in found)
+    # The reference table first: its cells are matched through the record written after it.
+    earlier = None if force else _record(folder)
+    _reference_rows(
+        runs, folder, references, n, seed, trust_controller, progress, reference, earlier, pool
+    )
     folder.path.mkdir(parents=True, exist_ok=True)
     write_table(folder.crossplay_csv, table)
     record = dataclasses.replace(requested, wall_s=wall_s, diagonal=checks)
     write_crossplay_json(folder.crossplay_json, record)
     check_diagonal(checks, case)
     return folder.crossplay_csv
+
+
+def _inevitable(env: Any, folder: CaseFolder, n: int, seed: int) -> None:
+    """``inevitable.json``: which of the ``n`` scenarios are inevitable-collision states
+    (a second per thousand scenarios; kept when it holds this scenario set)."""
+    from sumo_ayss.envs.odd import sample_initial_conditions
+    from sumo_ayss.scenarios.inevitable import ics_flags, pov_strategies
+
+    path = folder.inevitable_json
+    if path.is_file():
+        try:
+            if read_inevitable(path)[:2] == (n, seed):
+                return
+        except TableError:
+            pass
+    flags = ics_flags(env, sample_initial_conditions(env.odd, n, seed))
+    write_inevitable(path, n, seed, flags, tuple(pov_strategies(env.case)))
+
+
+def _reference_rows(
+    runs: Sequence[RunRecord],
+    folder: CaseFolder,
+    references: Sequence[str],
+    n: int,
+    seed: int,
+    trust_controller: bool,
+    progress: Callable[[str], None] | None,
+    label_with: str | None,
+    earlier: CrossplayRecord | None,
+    pool: tuple[CrossplayOpponent, ...],
+) -> None:
+    """Drive the reference drivers against the whole pool (``crossplay_reference.csv``):
+    seconds, since they need no opponents of their own. Each (reference, opponent) cell the
+    file already holds is kept where its opponent is still the same SPCP (its SHA-256 in
+    ``earlier``, the case's record, which is written after this file: a kill between the
+    two drives a cell again, never keeps a stale one); only the others are driven, and the
+    file is written in the order a run over the whole pool writes it."""
+    from sumo_ayss.evaluate import load_spcp
+    from sumo_ayss.scenarios.crossplay import Opponent, run_crossplay
+    from sumo_ayss.scenarios.preventability import reference_config
+
+    _inevitable(runs[0].experiment.env, folder, n, seed)
+    path = folder.crossplay_reference_csv
+    if not references:
+        return
+    kept = _kept_reference_rows(path, references, n, seed, earlier, pool)
+    cells = {(r["vut"], r["opponent_vut"], r["opponent_seed"]) for r in kept}
+    to_drive = {
+        name: tuple(o for o in pool if (name, o.vut, o.seed) not in cells) for name in references
+    }
+    to_drive = {name: opps for name, opps in to_drive.items() if opps}
+    if not to_drive and len(kept) == n * len(pool) * len(references) and path.is_file():
+        same = table_from_rows(CROSSPLAY_SCHEMA, merged_rows(kept, references, pool))
+        if read_table(path, CROSSPLAY_SCHEMA).equals(same):
+            return  # exactly these references against exactly this pool
+    base = runs[0].experiment.env
+    for name in references:  # one catalog holding every reference: one world for all
+        base = reference_config(base, name, own_body=True)
+    by_run = {(o.vut, o.seed): r for o, r in zip(pool, runs, strict=True)}
+    rows = list(kept)
+    t0 = time.perf_counter()
+    for opps, names in _groups(to_drive).items():
+        envs = {name: dataclasses.replace(base, vut=name) for name in names}
+        opponents = [
+            Opponent(o.vut, o.seed, functools.partial(load_spcp, by_run[(o.vut, o.seed)]))
+            for o in opps
+        ]
+        with controller_imports(trust_controller):
+            part = run_crossplay(
+                envs, opponents, n=n, seed=seed, progress=progress, reference=label_with
+            )
+        rows += part.rows()
+    write_table(path, table_from_rows(CROSSPLAY_SCHEMA, merged_rows(rows, references, pool)))
+    logger.info(
+        "%s: reference drivers %s against %d opponents in %.1f s (%d cells kept)",
+        folder.path,
+        ", ".join(references),
+        len({o for opps in to_drive.values() for o in opps}),
+        time.perf_counter() - t0,
+        len(cells),
+    )
+
+
+def _kept_reference_rows(
+    path: Path,
+    references: Sequence[str],
+    n: int,
+    seed: int,
+    earlier: CrossplayRecord | None,
+    pool: tuple[CrossplayOpponent, ...],
+) -> list[dict[str, Any]]:
+    """The rows of ``crossplay_reference.csv`` whose reference is asked for and whose
+    opponent is, by ``earlier``'s SHA-256, an SPCP of ``pool`` (under its current name);
+    none without a usable file or record of this scenario set."""
+    if earlier is None or (earlier.n, earlier.seed) != (n, seed) or not path.is_file():
+        return []
+    try:
+        old = read_table(path, CROSSPLAY_SCHEMA)
+    except TableError:
+        return []
+    then = {(o.vut, o.seed): o.spcp_sha256 for o in earlier.opponents}
+    now = {(o.seed, o.spcp_sha256): o for o in pool}
+    kept = []
+    for row in old.rows():
+        sha = then.get((row["opponent_vut"], row["opponent_seed"]))
+        o = now.get((row["opponent_seed"], sha)) if sha is not None else None
+        if o is not None and row["vut"] in references:
+            kept.append({**row, "opponent_vut": o.vut})
+    per_cell = Counter((r["vut"], r["opponent_vut"], r["opponent_seed"]) for r in kept)
+    return [r for r in kept if per_cell[(r["vut"], r["opponent_vut"], r["opponent_seed"])] == n]
 
 
 def _done(stage: CrossplayStage) -> bool:
@@ -187,6 +322,14 @@ def _done(stage: CrossplayStage) -> bool:
     except TableError as exc:
         logger.warning("%s; cross-play of %s runs again", exc, stage.folder.path)
         return False
+
+
+def _record(folder: CaseFolder) -> CrossplayRecord | None:
+    """The case's ``crossplay.json``, None when missing or unreadable."""
+    try:
+        return read_crossplay_json(folder.crossplay_json)
+    except TableError:
+        return None
 
 
 def _reusable(folder: CaseFolder, requested: CrossplayRecord) -> CellPlan | None:
@@ -307,6 +450,8 @@ def main(argv: Sequence[str] | None = None) -> None:
                 force=args.force,
                 trust_controller=args.trust_controller,
                 progress=functools.partial(print, f"{case}:", flush=True),
+                reference=cfg.evaluate.reference,
+                references=cfg.evaluate.reference_rows,
             )
             matrix = read_matrix(runs)
             rows, _pairs = rank_crossplay(matrix, blocks=args.blocks)

@@ -33,6 +33,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from sumo_ayss.cli import prog
 from sumo_ayss.config import DEFAULT_AYSS_SEED, AyssConfig, to_dict
 from sumo_ayss.envs import make_env
@@ -50,11 +52,17 @@ from sumo_ayss.run_folder import (
     write_table,
 )
 from sumo_ayss.scenarios.ayss import run_ayss
-from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_N, DEFAULT_OUTCOME_SEED, run_outcome
+from sumo_ayss.scenarios.outcome import (
+    DEFAULT_OUTCOME_N,
+    DEFAULT_OUTCOME_SEED,
+    OutcomeResult,
+    run_outcome,
+)
+from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.util.errors import AyssError, CheckpointError
 from sumo_ayss.util.paths import portable_path
-from sumo_ayss.vuts.catalog import controller_imports
+from sumo_ayss.vuts.catalog import REFERENCE_VUTS, controller_imports
 
 __all__ = ["EvaluationResult", "evaluate_run", "load_spcp", "main"]
 
@@ -118,14 +126,42 @@ def _should_run(stage: OutcomeStage | AyssStage, force: bool) -> bool:
 
 def _outcome_stage(
     env: PairEnv, policy: Policy, run: RunRecord, n: int, seed: int, progress: bool
-) -> None:
+) -> OutcomeResult:
+    """The outcome rollouts (written by :func:`_write_outcome` once labelled)."""
     if seed == run.experiment.train.eval_seed:
         logger.warning(
             "outcome seed %d equals train.eval_seed: the SPCP is scored on the scenarios it "
             "was selected on",
             seed,
         )
-    result = run_outcome(env, policy, n=n, seed=seed, progress=progress)
+    return run_outcome(env, policy, n=n, seed=seed, progress=progress)
+
+
+def _write_outcome(
+    run: RunRecord, result: OutcomeResult, n: int, seed: int, reference: str | None
+) -> None:
+    """Label the crashes (a replay each, with ``reference`` in the VUT's place; None: no
+    labels) and write ``outcome.csv`` and ``outcome.json``."""
+    if reference is not None:
+        t0 = time.perf_counter()
+        labels = label_crashes(
+            run.experiment.env,
+            result.scenarios,
+            [e.collided for e in result.episodes],
+            [e.actions for e in result.episodes],
+            sumo_seed=run.config_seed,
+            reference=reference,
+        )
+        result = result.labelled(labels)
+        crashed = labels[~np.isnan(labels)]
+        logger.info(
+            "outcome: %d crashes replayed with %s: %d preventable, %d unpreventable (%.1f s)",
+            crashed.size,
+            reference,
+            int((crashed == 1.0).sum()),
+            int((crashed == 0.0).sum()),
+            time.perf_counter() - t0,
+        )
     folder = run.folder
     write_table(folder.outcome_csv, result.table)
     write_outcome_json(
@@ -170,6 +206,7 @@ def evaluate_run(
     progress: bool = True,
     policy: Policy | None = None,
     trust_controller: bool = False,
+    reference: str | None = DEFAULT_REFERENCE,
 ) -> EvaluationResult:
     """Run the outcome and AYSS stages on a run folder (see the module docstring).
 
@@ -184,6 +221,8 @@ def evaluate_run(
         policy: Use this policy instead of ``<run>/spcp.zip`` (e.g. a scripted one).
         trust_controller: Allow importing the run's user-controller VUT (runs its code); a
             run whose VUT is a controller cannot be evaluated without it.
+        reference: The reference driver that replays every outcome crash to label it
+            preventable or not (:mod:`sumo_ayss.scenarios.preventability`); None: no labels.
 
     Returns:
         The output paths and which stages ran.
@@ -193,7 +232,9 @@ def evaluate_run(
     """
     record = run if isinstance(run, RunRecord) else read_run(run)
     with controller_imports(trust_controller):
-        return _evaluate_run(record, n_outcome, outcome_seed, ayss, force, progress, policy)
+        return _evaluate_run(
+            record, n_outcome, outcome_seed, ayss, force, progress, policy, reference
+        )
 
 
 def _evaluate_run(
@@ -204,22 +245,26 @@ def _evaluate_run(
     force: bool,
     progress: bool,
     policy: Policy | None,
+    reference: str | None,
 ) -> EvaluationResult:
     cfg = run.experiment  # raises if config.yaml is missing or invalid
     ayss_cfg = ayss if ayss is not None else AyssConfig()
     f = run.folder
     do_outcome = _should_run(OutcomeStage(f, n_outcome, outcome_seed), force)
     do_ayss = _should_run(AyssStage(f, ayss_cfg), force)
+    outcome: OutcomeResult | None = None
     if do_outcome or do_ayss:
         env = make_env(cfg.env, sumo_seed=run.config_seed)
         try:
             pol = policy if policy is not None else load_spcp(run, env)
             if do_outcome:
-                _outcome_stage(env, pol, run, n_outcome, outcome_seed, progress)
+                outcome = _outcome_stage(env, pol, run, n_outcome, outcome_seed, progress)
             if do_ayss:
                 _ayss_stage(env, pol, run, ayss_cfg, progress)
         finally:
             env.close()
+    if outcome is not None:  # the replays need the process's SUMO: after the env closed
+        _write_outcome(run, outcome, n_outcome, outcome_seed, reference)
     return EvaluationResult(
         f.path, f.outcome_csv, f.outcome_json, f.ayss_csv, f.ayss_json, do_outcome, do_ayss
     )
@@ -260,6 +305,13 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
         action="store_true",
         help="import the run's user-controller VUT (runs code the run folder names)",
     )
+    parser.add_argument(
+        "--reference",
+        choices=[*sorted(REFERENCE_VUTS), "none"],
+        default=DEFAULT_REFERENCE,
+        help="reference driver that replays every outcome crash to label it preventable or "
+        f"not (default {DEFAULT_REFERENCE}; none: no labels)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     return parser.parse_args(argv)
 
@@ -285,6 +337,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             outcome_seed=args.seed if args.seed is not None else DEFAULT_OUTCOME_SEED,
             ayss=ayss,
             force=args.force,
+            reference=None if args.reference == "none" else args.reference,
             progress=not args.no_progress,
             trust_controller=args.trust_controller,
         )

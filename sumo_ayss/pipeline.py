@@ -314,6 +314,8 @@ def run_crossplay_stage(
                 seed=DEFAULT_OUTCOME_SEED,
                 trust_controller=True,  # the pipeline's own runs, from the user's configs
                 progress=functools.partial(_crossplay_progress, case),
+                reference=cfg.evaluate.reference,
+                references=cfg.evaluate.reference_rows,
             )
         except AyssError as e:  # never fatal: the report says the table is missing
             logger.warning("cross-play of %s failed: %s", case, e)

@@ -202,10 +202,12 @@ def write_ranking(
     out: Path,
     checks: Sequence[OrderCheck] = (),
     expected: Sequence[str] = (),
+    notes: Sequence[str] = (),
 ) -> tuple[Path, Path]:
     """``ranking.csv`` and ``ranking.md`` in the study folder ``out`` (written atomically),
     and with a known order, ``order_check.json`` (see :func:`order_check`;
-    :mod:`sumo_ayss.run_folder.study`)."""
+    :mod:`sumo_ayss.run_folder.study`). ``notes``: more ``ranking.md`` lines (the VUTs
+    against the careful human)."""
     from sumo_ayss.util.atomic import atomic_write_text
 
     study = StudyFolder(out)
@@ -234,6 +236,7 @@ def write_ranking(
             f"{'yes' if c.ends_significant else 'no'} (p = {c.ends_p:.3g}); "
             f"significant adjacent pairs: {c.significant_adjacent} of {c.adjacent}.",
         ]
+    lines += notes
     atomic_write_text(study.ranking_md, "\n".join(lines) + "\n")
     if checks:
         write_order_check(study.order_check_json, OrderChecks(tuple(expected), tuple(checks)))
@@ -319,7 +322,15 @@ def main(argv: Sequence[str] | None = None) -> None:
         print("interrupted: no job runs any more; rerun the same command to resume", flush=True)
         sys.exit(130)
     checks = order_checks(analyses, cfg.expected_order)
-    csv_path, md = write_ranking(ranking_rows(analyses), cfg.out, checks, cfg.expected_order)
+    from sumo_ayss.report.sections.reference import reference_markdown
+
+    csv_path, md = write_ranking(
+        ranking_rows(analyses),
+        cfg.out,
+        checks,
+        cfg.expected_order,
+        reference_markdown(analyses),
+    )
     from sumo_ayss.report.measures import write_measures
 
     write_measures(cfg.out, analyses)  # measures.csv: the safety measures (issue 27)

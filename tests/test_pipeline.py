@@ -12,11 +12,13 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
 from sumo_ayss.config import PROJECT_ROOT, AyssConfig, ExperimentConfig
 from sumo_ayss.pipeline import load_pipeline, plan_jobs, run_pipeline
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA, read_table
 from sumo_ayss.util.errors import ConfigError
 from tests.helpers import TINY_AGENT
 
@@ -101,9 +103,27 @@ def test_crossplay_mode_runs_the_crossplay_stage_and_reports_it(tmp_path: Path) 
     assert "no cross-play table" not in text
     assert "(i) Cross-play ranking" in text and "Ranking by cross-play harm H" in text
     assert (report.parent / "car_following_crossplay_by_opponent.png").is_file()
+    # The reference drivers drove against the whole pool; every crash carries its label.
+    ref = read_table(case / "crossplay_reference.csv", CROSSPLAY_SCHEMA)
+    assert sorted(set(ref["vut"].tolist())) == ["cc_driver", "fsm", "rss"]
+    assert len(ref) == 3 * 2 * 10
+    for table in (
+        ref,
+        read_table(case / "crossplay.csv", CROSSPLAY_SCHEMA),
+        read_table(case / "pi1" / "seed_0" / "outcome.csv", OUTCOME_SCHEMA),
+    ):
+        label = table["crash_preventable"]
+        assert np.isin(label[table["collided"]], [0.0, 1.0]).all()
+        assert np.isnan(label[~table["collided"]]).all()
+    assert "(k) Against the careful human" in text and "the careful human (cc_driver)" in text
+    ics = json.loads((case / "inevitable.json").read_text())
+    assert ics["n"] == 10 and ics["seed"] == 4242 and ics["strategies"] == ["brake"]
+    assert "are inevitable-collision states" in text
     before = (case / "crossplay.csv").stat().st_mtime_ns
+    ref_before = (case / "crossplay_reference.csv").stat().st_mtime_ns
     run_pipeline(cfg, live=False)  # a rerun skips every finished stage, cross-play included
     assert (case / "crossplay.csv").stat().st_mtime_ns == before
+    assert (case / "crossplay_reference.csv").stat().st_mtime_ns == ref_before
 
 
 @pytest.mark.sumo

@@ -33,6 +33,12 @@ from sumo_ayss.analysis.crossplay import (
 from sumo_ayss.analysis.harm import HARM_RANGE, VutOutcome, vut_outcomes
 from sumo_ayss.analysis.premise import Premise, premise_check
 from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex, rank, safety_index
+from sumo_ayss.analysis.reference import (
+    CAREFUL_HUMAN,
+    ReferenceReading,
+    ScenarioSet,
+    read_against_reference,
+)
 from sumo_ayss.analysis.seeds import SeedComparison, SeedRankRow, SeedScores, rank_seeds
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
 from sumo_ayss.cases import Case, case_info
@@ -168,6 +174,10 @@ class CaseAnalysis:
         outcomes: ``{mode: {vut: VutOutcome}}`` for the modes that read outcomes
             (``"crossplay"``, ``"exposure"``): crashes with their interval and mobility,
             shown beside the harm score.
+        references: ``{reference driver: its reading}``: every VUT against each reference
+            driver that drove in cross-play (:mod:`.reference`), the careful human first.
+        scenario_set: The share of the case's scenarios that are inevitable-collision
+            states, or None (not computed for this table).
     """
 
     case: str
@@ -192,6 +202,8 @@ class CaseAnalysis:
     crossplay_gap: CrossplayGap | None = None
     crossplay_diagonal: tuple[tuple[str, int, int, int], ...] = ()
     outcomes: dict[str, dict[str, VutOutcome]] = field(default_factory=dict)
+    references: dict[str, ReferenceReading] = field(default_factory=dict)
+    scenario_set: ScenarioSet | None = None
 
     @property
     def ranking_mode(self) -> str:
@@ -274,6 +286,21 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -
     out.crossplay_rows, out.crossplay_pairs = rank_crossplay(
         m, blocks=options.crossplay_blocks, level=options.level, alpha=options.welch_alpha
     )
+    if found.inevitable is not None and found.inevitable[0] == m.n_scenarios:
+        out.scenario_set = ScenarioSet.of(m.n_scenarios, len(found.inevitable[2]), options.level)
+    if found.reference is not None:
+        for name in sorted(found.reference.vuts, key=lambda v: (v != CAREFUL_HUMAN, v)):
+            try:
+                out.references[name] = read_against_reference(
+                    m,
+                    found.reference,
+                    name,
+                    blocks=options.crossplay_blocks,
+                    level=options.level,
+                    alpha=options.welch_alpha,
+                )
+            except ConfigError as exc:
+                out.problems.append(f"{found.path}: reference {name}: {exc}")
 
 
 def analyse_case(

@@ -72,6 +72,11 @@ class CrossplayMatrix:
             NaN where not given.
         mobility: ``mobility[i, j]`` = mean of the episodes' VUT mean speed [m/s]; NaN where
             the table does not record it.
+        preventable: ``preventable[i, j]`` = the cell's collisions labelled preventable (a
+            careful reference driver replaying them avoided contact,
+            :mod:`sumo_ayss.scenarios.preventability`); None: no labels given.
+        labelled: ``labelled[i, j]`` = the cell's collisions that carry a label (the rest
+            were not labelled: an older table); None: no labels given.
     """
 
     vuts: tuple[str, ...]
@@ -81,6 +86,16 @@ class CrossplayMatrix:
     n_scenarios: int
     returns: npt.NDArray[np.float64]
     mobility: npt.NDArray[np.float64]
+    preventable: npt.NDArray[np.int64] | None = None
+    labelled: npt.NDArray[np.int64] | None = None
+
+    def preventable_crashes(self, vut: str) -> tuple[int, int]:
+        """``(preventable, labelled)`` collisions of ``vut`` against the whole pool;
+        ``(0, 0)`` without labels."""
+        if self.preventable is None or self.labelled is None:
+            return 0, 0
+        i = self.vuts.index(vut)
+        return int(self.preventable[i].sum()), int(self.labelled[i].sum())
 
     def scores(self, blocks: str = "seed") -> list[SeedScores]:
         """Per VUT: block -> its mean harm H(opponent, VUT), for :func:`rank_seeds`.
@@ -129,6 +144,7 @@ def crossplay_matrix(
     *,
     episode_return: npt.ArrayLike | None = None,
     mobility: npt.ArrayLike | None = None,
+    preventable: npt.ArrayLike | None = None,
 ) -> CrossplayMatrix:
     """Reduces the cross-play table's columns (one entry per episode) to the matrix.
 
@@ -138,6 +154,8 @@ def crossplay_matrix(
         collided: Whether each episode ended in a collision.
         episode_return: Each episode's reward sum (kept for comparison), or None.
         mobility: Each episode's VUT mean speed [m/s] (NaN: not recorded), or None.
+        preventable: Each episode's crash label (1 preventable, 0 unpreventable, NaN no
+            crash or not labelled), or None.
 
     Raises:
         ConfigError: If the lengths differ, a harm or return is not finite, or the design is
@@ -149,6 +167,10 @@ def crossplay_matrix(
     n = len(vut)
     ret = np.full(n, np.nan) if episode_return is None else np.asarray(episode_return, float)
     mob = np.full(n, np.nan) if mobility is None else np.asarray(mobility, dtype=np.float64)
+    lab = np.full(n, np.nan) if preventable is None else np.asarray(preventable, np.float64)
+    if lab.size != n:
+        raise ConfigError("cross-play columns: lengths differ")
+    lab = np.where(crash > 0, lab, np.nan)  # a label without a crash means nothing
     if not (len(opponent_vut) == len(opponent_seed) == h.size == crash.size == n):
         raise ConfigError("cross-play columns: lengths differ")
     if ret.size != n or mob.size != n:
@@ -166,7 +188,7 @@ def crossplay_matrix(
     vi = {v: i for i, v in enumerate(vuts)}
     oi = {o: j for j, o in enumerate(opps)}
     shape = (len(vuts), len(opps))
-    sums = {key: np.zeros(shape) for key in ("harm", "crash", "ret", "mob")}
+    sums = {key: np.zeros(shape) for key in ("harm", "crash", "ret", "mob", "prev", "lab")}
     counts = np.zeros(shape)
     for k in range(n):
         i, j = vi[str(vut[k])], oi[(str(opponent_vut[k]), int(opponent_seed[k]))]
@@ -174,6 +196,9 @@ def crossplay_matrix(
         sums["crash"][i, j] += crash[k]
         sums["ret"][i, j] += ret[k]
         sums["mob"][i, j] += mob[k]
+        if not math.isnan(lab[k]):
+            sums["lab"][i, j] += 1
+            sums["prev"][i, j] += lab[k] == 1.0
         counts[i, j] += 1
     if counts.min() == 0 or counts.min() != counts.max():
         raise ConfigError(
@@ -188,6 +213,8 @@ def crossplay_matrix(
         n_scenarios=int(counts[0, 0]),
         returns=sums["ret"] / counts,
         mobility=sums["mob"] / counts,
+        preventable=None if preventable is None else sums["prev"].astype(np.int64),
+        labelled=None if preventable is None else sums["lab"].astype(np.int64),
     )
 
 
@@ -207,6 +234,10 @@ class CrossplayInput:
         diagonal: The diagonal check of the table's record, one ``(vut, seed, n, n_equal)``
             per run: its SPCP against its own VUT reproduced ``n_equal`` of the ``n``
             episodes of its outcome table; empty when the record predates the check.
+        reference: The reference drivers' rows against the same pool
+            (``crossplay_reference.csv``), or None (no such table, or unreadable).
+        inevitable: ``(n, seed, indices)`` of the scenario set and its inevitable-collision
+            states (``inevitable.json``), or None.
     """
 
     matrix: CrossplayMatrix | None = None
@@ -214,6 +245,8 @@ class CrossplayInput:
     missing: str = ""
     problem: str = ""
     diagonal: tuple[tuple[str, int, int, int], ...] = ()
+    reference: CrossplayMatrix | None = None
+    inevitable: tuple[int, int, tuple[int, ...]] | None = None
 
 
 @dataclass(frozen=True)

@@ -262,8 +262,10 @@ class EpisodeMeasures:
         r157_ttc_lane_intrusion_s: Cut-in: 1-D TTC [s] when the POV's near side is 0.3 m
             inside the VUT's lane (:mod:`sumo_ayss.analysis.r157`); NaN without it.
         r157_must_avoid: 1 if the R157 cut-in condition says the collision must be avoided
-            (:func:`sumo_ayss.analysis.r157.must_avoid`), 0 if not, NaN without an
-            intrusion 0.3 m deep.
+            (:func:`sumo_ayss.analysis.r157.must_avoid`, constant 0.35 s), 0 if not, NaN
+            without an intrusion 0.3 m deep.
+        r157_closing_mps: Cut-in: ``v_vut - v_pov`` [m/s] at that intrusion (> 0 closing
+            in), so that the condition can be read with another constant; NaN without it.
     """
 
     min_ttc_s: float
@@ -278,6 +280,7 @@ class EpisodeMeasures:
     impact_speed_mps: float = math.nan
     r157_ttc_lane_intrusion_s: float = math.nan
     r157_must_avoid: float = math.nan
+    r157_closing_mps: float = math.nan
 
     def as_row(self) -> dict[str, float]:
         """``{column name: value}`` for a table row."""
@@ -432,4 +435,5 @@ def episode_measures(tr: PairTrajectory) -> EpisodeMeasures:
         impact_speed_mps=impact,
         r157_ttc_lane_intrusion_s=r157.ttc_s,
         r157_must_avoid=must_avoid(r157.ttc_s, r157.closing_mps),
+        r157_closing_mps=r157.closing_mps,
     )

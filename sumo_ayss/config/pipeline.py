@@ -19,7 +19,7 @@ from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.config.yaml_io import read_yaml
 from sumo_ayss.util.frozen import FrozenMap
 from sumo_ayss.util.validation import check_choice, check_seed, require, suggest
-from sumo_ayss.vuts.catalog import VehicleType
+from sumo_ayss.vuts.catalog import DEFAULT_REFERENCE, REFERENCE_VUTS, VehicleType
 
 
 @dataclass(frozen=True)
@@ -61,10 +61,23 @@ class EvaluateConfig:
     """Monte Carlo settings of the AYSS stage (section ``evaluate.ayss``)."""
     n_ayss: int | None = None
     """Shorthand for ``ayss.n_samples`` (Monte Carlo draws), or None: ``ayss`` decides."""
+    reference: str | None = DEFAULT_REFERENCE
+    """The reference driver that replays every crash of the outcome and cross-play stages
+    to label it preventable or not (``cc_driver``, ``fsm``, ``rss``;
+    :mod:`sumo_ayss.scenarios.preventability`); None (YAML ``null``): no labels."""
+    reference_rows: tuple[str, ...] = tuple(REFERENCE_VUTS)
+    """Reference drivers that drive against the pooled opponents in cross-play
+    (``crossplay_reference.csv``): every VUT is then compared with each (the careful human
+    first). Empty: none."""
 
     def __post_init__(self) -> None:
         s = self.SECTION
         require(self.n_outcome >= 1, f"{s}.n_outcome must be >= 1, got {self.n_outcome}")
+        if self.reference is not None:
+            check_choice(f"{s}.reference", self.reference, sorted(REFERENCE_VUTS))
+        object.__setattr__(self, "reference_rows", tuple(self.reference_rows))
+        for i, name in enumerate(self.reference_rows):
+            check_choice(f"{s}.reference_rows[{i}]", name, sorted(REFERENCE_VUTS))
         if self.n_ayss is None or self.n_ayss == self.ayss.n_samples:
             return
         require(self.n_ayss >= 1, f"{s}.n_ayss must be >= 1, got {self.n_ayss}")

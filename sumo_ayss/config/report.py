@@ -45,6 +45,10 @@ class ReportOptions:
             premise check ("same overall outcome"), reward per episode.
         premise_crash_rate: Tolerance on the spread of crash rates, fraction.
         premise_final_headway_m: Tolerance on the spread of mean final headways, m.
+        r157_time_s: Constant term of UN R157's cut-in condition, TTC > v_rel / (2 · 6 m/s²)
+            + this [s]: 0.35 (the regulation as its implementations quote it, default) or
+            0.45 (esmini's and JRC-FSM's code, + 0.1 s); the report shows both
+            (:mod:`sumo_ayss.analysis.r157`).
     """
 
     SECTION: ClassVar[str] = "report"
@@ -61,9 +65,11 @@ class ReportOptions:
     premise_reward: float = 1.0
     premise_crash_rate: float = 0.02
     premise_final_headway_m: float = 2.0
+    r157_time_s: float = 0.35
 
     def __post_init__(self) -> None:
         s = self.SECTION
+        check_number(f"{s}.r157_time_s", self.r157_time_s, low=0.0)
         check_choice(f"{s}.mode", self.mode, mode_names())
         check_choice(f"{s}.crossplay_blocks", self.crossplay_blocks, list(CROSSPLAY_BLOCKS))
         for name in ("premise_reward", "premise_crash_rate", "premise_final_headway_m"):

@@ -25,6 +25,7 @@ from sumo_ayss.run_folder import (
     write_progress,
 )
 from sumo_ayss.util.errors import ControllerError
+from sumo_ayss.vuts.catalog import DEFAULT_REFERENCE
 
 logger = logging.getLogger("sumo_ayss.pipeline")
 
@@ -53,6 +54,8 @@ class JobSpec:
     """Outcome episodes (``evaluate.n_outcome``)."""
     ayss: AyssConfig
     """Monte Carlo settings of the AYSS stage (``evaluate.ayss``)."""
+    reference: str | None = DEFAULT_REFERENCE
+    """The reference driver that labels the outcome's crashes (``evaluate.reference``)."""
 
     def __post_init__(self) -> None:
         if (self.experiment.env.case, self.experiment.env.vut) != (self.case, self.vut):
@@ -117,6 +120,7 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
                 force=True,
                 progress=False,
                 trust_controller=True,  # the pipeline's own runs, from the user's configs
+                reference=spec.reference,
             )
             evaluation.mark_done()
             stages["evaluate"] = "done"

@@ -13,6 +13,7 @@ from sumo_ayss.config import ExperimentConfig, PipelineConfig, load_experiment
 from sumo_ayss.grid.jobs import JobSpec
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.validation import suggest
+from sumo_ayss.vuts.catalog import REFERENCE_VUTS
 
 __all__ = ["case_experiment", "plan_jobs", "plan_seed"]
 
@@ -50,6 +51,7 @@ def _job(cfg: PipelineConfig, exp: ExperimentConfig, case: str, vut: str, seed: 
         out=str(cfg.out),
         n_outcome=cfg.evaluate.n_outcome,
         ayss=cfg.evaluate.ayss,
+        reference=cfg.evaluate.reference,
     )
 
 
@@ -69,6 +71,12 @@ def case_experiment(cfg: PipelineConfig, case: str) -> ExperimentConfig:
     if cfg.vuts:
         exp = dataclasses.replace(
             exp, env=dataclasses.replace(exp.env, vuts={**exp.env.vuts, **cfg.vuts})
+        )
+    refs = {v: REFERENCE_VUTS[v] for v in cfg.grid.vuts if v in REFERENCE_VUTS}
+    refs = {v: vt for v, vt in refs.items() if v not in exp.env.vuts}
+    if refs:  # a reference driver named in the grid is a built-in VUT of every case
+        exp = dataclasses.replace(
+            exp, env=dataclasses.replace(exp.env, vuts={**exp.env.vuts, **refs})
         )
     for vut in cfg.grid.vuts:
         if vut not in exp.env.vuts:

@@ -30,6 +30,7 @@ from sumo_ayss.analysis.measure_ranking import (
     measure_rankings,
     r157_rows,
 )
+from sumo_ayss.analysis.r157 import R157_TIME_MARGIN_S, R157_TIME_S, must_avoid_column
 from sumo_ayss.modes import CROSSPLAY, EXPOSURE
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, StudyFolder, read_table, write_measures_csv
 from sumo_ayss.util.errors import AyssError
@@ -49,8 +50,13 @@ class CaseMeasures:
         primary_order: The primary ranking, safest first.
         rankings: One per measure (:func:`~sumo_ayss.analysis.measure_ranking.
             measure_rankings`).
-        r157: The R157 cut-in share per VUT (cut-in only, else empty).
+        r157: The R157 cut-in share per VUT with the constant ``r157_time_s`` (cut-in only,
+            else empty).
         values: ``{measure column: {vut: finite values}}`` for the figure.
+        r157_time_s: The constant term [s] of R157's condition behind ``r157``.
+        r157_alt_s: The other constant shown beside it (0.45 s for 0.35 s, and back).
+        r157_alt: The share with ``r157_alt_s``; empty where the tables do not hold the
+            closing speed at the intrusion (written before ``r157_closing_mps``).
     """
 
     case: str
@@ -61,6 +67,9 @@ class CaseMeasures:
     rankings: tuple[MeasureRanking, ...]
     r157: tuple[R157Row, ...]
     values: dict[str, dict[str, np.ndarray]]
+    r157_time_s: float = R157_TIME_S
+    r157_alt_s: float = R157_TIME_MARGIN_S
+    r157_alt: tuple[R157Row, ...] = ()
 
 
 def _primary(a: CaseAnalysis) -> tuple[str, tuple[str, ...]]:
@@ -94,11 +103,22 @@ def _pool_columns(a: CaseAnalysis) -> tuple[str, dict[str, np.ndarray]] | None:
 
 
 def _measure_columns() -> list[str]:
-    return [m.column for m in MEASURES] + ["r157_must_avoid"]
+    return [m.column for m in MEASURES] + [
+        "r157_must_avoid",
+        "r157_ttc_lane_intrusion_s",
+        "r157_closing_mps",
+    ]
 
 
-def case_measures(a: CaseAnalysis, *, level: float = 0.95) -> CaseMeasures | str:
-    """The measures of case ``a``, or one sentence saying why there are none."""
+def case_measures(
+    a: CaseAnalysis, *, level: float = 0.95, r157_time_s: float = R157_TIME_S
+) -> CaseMeasures | str:
+    """The measures of case ``a``, or one sentence saying why there are none.
+
+    ``r157_time_s``: the constant term of R157's cut-in condition (``report.r157_time_s``);
+    the share is also computed with the other of 0.35 s / 0.45 s where the tables hold the
+    closing speed (:attr:`CaseMeasures.r157_alt`).
+    """
     try:
         found = _pool_columns(a)
     except AyssError as e:
@@ -122,19 +142,31 @@ def case_measures(a: CaseAnalysis, *, level: float = 0.95) -> CaseMeasures | str
         level=level,
     )
     r157: tuple[R157Row, ...] = ()
-    if not np.isnan(cols["r157_must_avoid"]).all():
-        r157 = tuple(
-            r157_rows(
-                cols["vut"], cols["r157_must_avoid"], cols["collided"], vuts=vuts, level=level
-            )
+    r157_alt: tuple[R157Row, ...] = ()
+    alt_s = R157_TIME_MARGIN_S if r157_time_s == R157_TIME_S else R157_TIME_S
+    for time_s in (r157_time_s, alt_s):
+        must = must_avoid_column(
+            cols["r157_ttc_lane_intrusion_s"],
+            cols["r157_closing_mps"],
+            cols["r157_must_avoid"],
+            time_s,
         )
+        if np.isnan(must).all():
+            continue
+        rows = tuple(r157_rows(cols["vut"], must, cols["collided"], vuts=vuts, level=level))
+        if time_s == r157_time_s:
+            r157 = rows
+        else:
+            r157_alt = rows
     values = {
         m.column: {
             v: cols[m.column][(cols["vut"] == v) & np.isfinite(cols[m.column])] for v in vuts
         }
         for m in MEASURES
     }
-    return CaseMeasures(a.case, pool, vuts, mode, order, tuple(rankings), r157, values)
+    return CaseMeasures(
+        a.case, pool, vuts, mode, order, tuple(rankings), r157, values, r157_time_s, alt_s, r157_alt
+    )
 
 
 def _rows(m: CaseMeasures) -> list[dict[str, object]]:

@@ -65,7 +65,9 @@ from sumo_ayss.run_folder.crossplay import (
     load_crossplay,
     read_crossplay_json,
     read_crossplay_matrix,
+    read_inevitable,
     write_crossplay_json,
+    write_inevitable,
 )
 from sumo_ayss.run_folder.discriminability import (
     read_discriminability_json,
@@ -305,6 +307,7 @@ __all__ = [
     "read_done_marker",
     "read_eval_rows",
     "read_eval_table",
+    "read_inevitable",
     "read_json",
     "read_json_object",
     "read_latest",
@@ -333,6 +336,7 @@ __all__ = [
     "write_discriminability",
     "write_done_marker",
     "write_eval_table",
+    "write_inevitable",
     "write_json",
     "write_latest",
     "write_measures_csv",

@@ -272,7 +272,39 @@ def read_crossplay_matrix(path: Path, scale: HarmScale) -> CrossplayMatrix:
         c["collided"],
         episode_return=c["episode_return"],
         mobility=c["vut_mean_speed_mps"],
+        preventable=c["crash_preventable"],
     )
+
+
+def write_inevitable(
+    path: Path, n: int, seed: int, ics: Sequence[bool], strategies: Sequence[str]
+) -> None:
+    """``inevitable.json``: the scenario set (``n`` draws of ``seed``) and the indices of its
+    inevitable-collision states (:mod:`sumo_ayss.scenarios.inevitable`)."""
+    write_json(
+        path,
+        {
+            "n": int(n),
+            "seed": int(seed),
+            "ics": [i for i, flag in enumerate(ics) if flag],
+            "strategies": list(strategies),
+        },
+    )
+
+
+def read_inevitable(path: Path) -> tuple[int, int, tuple[int, ...]]:
+    """``(n, seed, ICS scenario indices)`` of an ``inevitable.json``.
+
+    Raises:
+        TableError: If the file is missing, unreadable or malformed.
+    """
+    data = read_json(path)
+    n = _field(data, "n", int, str(path))
+    seed = _field(data, "seed", int, str(path))
+    ics = _field(data, "ics", list, str(path))
+    if not all(isinstance(i, int) and 0 <= i < n for i in ics):
+        raise TableError(f"{path}: ics must list scenario indices in [0, {n})")
+    return n, seed, tuple(ics)
 
 
 def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
@@ -349,4 +381,20 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
             missing=f"the cross-play table is unreadable ({exc})",
             problem=text if text.startswith(str(path)) else f"{path}: {text}",
         )
-    return CrossplayInput(matrix, path, diagonal=diagonal)
+    reference = None
+    if folder.crossplay_reference_csv.is_file():
+        try:
+            reference = read_crossplay_matrix(folder.crossplay_reference_csv, scale)
+        except (TableError, ConfigError) as exc:  # the ranking stands without it
+            return CrossplayInput(
+                matrix, path, diagonal=diagonal, problem=f"reference rows unreadable: {exc}"
+            )
+    ics: tuple[int, int, tuple[int, ...]] | None = None
+    if folder.inevitable_json.is_file():
+        try:
+            ics = read_inevitable(folder.inevitable_json)
+        except TableError as exc:
+            return CrossplayInput(
+                matrix, path, diagonal=diagonal, reference=reference, problem=str(exc)
+            )
+    return CrossplayInput(matrix, path, diagonal=diagonal, reference=reference, inevitable=ics)

@@ -107,9 +107,13 @@ JOB_LOG = "job.log"
 # -- written by cross-play, in the case folder <out>/<case>/ above the run folders ----------
 CROSSPLAY_CSV = "crossplay.csv"
 """One row per (VUT, opponent SPCP, scenario) (:data:`~.schemas.CROSSPLAY_SCHEMA`)."""
+CROSSPLAY_REFERENCE_CSV = "crossplay_reference.csv"
+"""The reference drivers against the same opponents and scenarios (same schema)."""
+INEVITABLE_JSON = "inevitable.json"
+"""Which of the case's scenarios are inevitable-collision states (written by cross-play)."""
 CROSSPLAY_JSON = "crossplay.json"
-ADAPTIVE_JSON = "adaptive.json"
 """Cross-play record: settings, opponents with their SPCP's SHA-256, wall time."""
+ADAPTIVE_JSON = "adaptive.json"
 
 # -- written by the discriminability stage, in the case folder too ------------------------
 DISCRIMINABILITY_JSON = "discriminability.json"
@@ -270,6 +274,17 @@ class CaseFolder:
     def crossplay_json(self) -> Path:
         """``crossplay.json``."""
         return self.path / CROSSPLAY_JSON
+
+    @property
+    def inevitable_json(self) -> Path:
+        """``inevitable.json``: the scenarios no braking survives (:func:`read_inevitable`)."""
+        return self.path / INEVITABLE_JSON
+
+    @property
+    def crossplay_reference_csv(self) -> Path:
+        """``crossplay_reference.csv``: the reference drivers against the same opponents
+        and scenarios (:data:`~.schemas.CROSSPLAY_SCHEMA`; they have no SPCPs of their own)."""
+        return self.path / CROSSPLAY_REFERENCE_CSV
 
     @property
     def adaptive_json(self) -> Path:

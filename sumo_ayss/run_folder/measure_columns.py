@@ -86,4 +86,10 @@ EPISODE_MEASURE_COLUMNS: tuple[Column, ...] = (
         "1 if UN R157's cut-in TTC condition says the collision must be avoided, 0 if not, "
         "NaN without an intrusion",
     ),
+    _measure(
+        "r157_closing_mps",
+        "m/s",
+        "cut-in: VUT speed minus POV speed at the R157 lane intrusion (> 0 closing in; NaN: "
+        "no such intrusion)",
+    ),
 )

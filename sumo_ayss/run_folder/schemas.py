@@ -51,6 +51,21 @@ EPISODE_HARM_COLUMNS: tuple[Column, ...] = (
     ),
 )
 
+#: The crash label of both episode tables (:mod:`sumo_ayss.scenarios.preventability`);
+#: files written before it read as NaN throughout: "not labelled".
+EPISODE_LABEL_COLUMNS: tuple[Column, ...] = (
+    Column(
+        "crash_preventable",
+        "float",
+        "-",
+        "a crash replayed with the reference driver in the VUT's place (the POV's actions "
+        "open loop): 1 = the reference avoided contact (preventable), 0 = it collided too "
+        "(unpreventable); empty without a crash, and throughout in files not labelled",
+        nullable=True,
+        since=True,
+    ),
+)
+
 #: ``<run>/outcome.csv``: one row per episode of the outcome stage (paper Tables II, III).
 OUTCOME_SCHEMA = TableSchema(
     "outcome",
@@ -81,6 +96,7 @@ OUTCOME_SCHEMA = TableSchema(
         Column("n_steps", "int", "-", "decisions taken (25 for a full 5 s episode)"),
         *EPISODE_HARM_COLUMNS,
         *EPISODE_MEASURE_COLUMNS,
+        *EPISODE_LABEL_COLUMNS,
     ),
 )
 
@@ -174,5 +190,6 @@ CROSSPLAY_SCHEMA = TableSchema(
         Column("n_steps", "int", "-", "decisions in the episode"),
         *EPISODE_HARM_COLUMNS,
         *EPISODE_MEASURE_COLUMNS,
+        *EPISODE_LABEL_COLUMNS,
     ),
 )

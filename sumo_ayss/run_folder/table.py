@@ -197,7 +197,12 @@ def _check_names(schema: TableSchema, names: Sequence[str], where: str) -> None:
 
 
 def _coerce_columns(schema: TableSchema, columns: Mapping[str, Any]) -> dict[str, npt.NDArray[Any]]:
-    """Arrays of the schema's dtypes, checked for length, NaN, inf and choices."""
+    """Arrays of the schema's dtypes, checked for length, NaN, inf and choices; a column
+    marked ``since`` that is left out is NaN throughout (not recorded), as in a file."""
+    late = [c.name for c in schema.columns if c.since and c.name not in columns]
+    if late and columns:
+        n = len(next(iter(columns.values())))
+        columns = {**columns, **{name: np.full(n, math.nan) for name in late}}
     _check_names(schema, list(columns), f"table {schema.name}")
     out: dict[str, npt.NDArray[Any]] = {}
     for col in schema.columns:

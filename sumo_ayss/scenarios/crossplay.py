@@ -43,6 +43,7 @@ from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, DiagonalCheck, Table, table_from_rows
+from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
 from sumo_ayss.scenarios.rollout import Policy, run_episodes
 from sumo_ayss.util.errors import ConfigError, DiagonalMismatchError
 
@@ -94,6 +95,7 @@ def run_crossplay(
     n: int,
     seed: int,
     progress: Callable[[str], None] | None = None,
+    reference: str | None = DEFAULT_REFERENCE,
 ) -> Table:
     """Every opponent against every VUT on ``n`` common scenarios.
 
@@ -104,6 +106,9 @@ def run_crossplay(
         seed: Seed of :func:`~sumo_ayss.envs.odd.sample_initial_conditions` (the outcome
             stage's).
         progress: Called with one line per (VUT, opponent) done.
+        reference: The reference driver that replays each crash to label it preventable
+            or not (:func:`~sumo_ayss.scenarios.preventability.label_crashes`, after the
+            block's env closed, on its SUMO seed); None: no labels (NaN).
 
     Returns:
         The cross-play table, VUTs in the given order, then opponents, then scenarios.
@@ -130,6 +135,18 @@ def run_crossplay(
                 episodes = run_episodes(env, policies[k], scenarios)
             finally:
                 env.close()
+            labels = (
+                label_crashes(
+                    cfg,
+                    scenarios,
+                    [e.collided for e in episodes],
+                    [e.actions for e in episodes],
+                    sumo_seed=opp.seed,
+                    reference=reference,
+                )
+                if reference is not None
+                else np.full(len(episodes), np.nan)
+            )
             for j, e in enumerate(episodes):
                 rows.append(
                     {
@@ -144,6 +161,7 @@ def run_crossplay(
                         "near_miss_pay": e.near_miss_pay,
                         "vut_mean_speed_mps": e.vut_mean_speed_mps,
                         **e.measure_row(),
+                        "crash_preventable": float(labels[j]),
                     }
                 )
             if progress is not None:
@@ -165,6 +183,7 @@ DIAGONAL_COLUMNS = (
     "near_miss_pay",
     "vut_mean_speed_mps",
     *MEASURE_NAMES,
+    "crash_preventable",
 )
 
 

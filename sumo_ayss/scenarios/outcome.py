@@ -21,6 +21,7 @@ OUTCOME_SCHEMA`); :func:`summarize_outcome` reduces it to
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Sequence
@@ -168,9 +169,12 @@ def summarize_outcome(table: Table, case: str, level: float = 0.95) -> OutcomeSu
 
 
 def outcome_table(
-    scenarios: Sequence[InitialCondition], episodes: Sequence[EpisodeResult]
+    scenarios: Sequence[InitialCondition],
+    episodes: Sequence[EpisodeResult],
+    labels: npt.ArrayLike | None = None,
 ) -> Table:
-    """The outcome table of episodes run from ``scenarios`` (same order, same length)."""
+    """The outcome table of episodes run from ``scenarios`` (same order, same length);
+    ``labels``: each episode's ``crash_preventable`` (None: not labelled, NaN)."""
     if len(scenarios) != len(episodes):
         raise ConfigError(f"{len(scenarios)} scenarios but {len(episodes)} episodes")
     return Table(
@@ -188,6 +192,9 @@ def outcome_table(
             "near_miss_pay": [e.near_miss_pay for e in episodes],
             "vut_mean_speed_mps": [e.vut_mean_speed_mps for e in episodes],
             **measure_columns(episodes),
+            "crash_preventable": (
+                np.full(len(episodes), math.nan) if labels is None else np.asarray(labels, float)
+            ),
         },
     )
 
@@ -202,6 +209,8 @@ class OutcomeResult:
         seed: Seed of the scenario set.
         n: Number of scenarios.
         wall_s: Wall-clock time of the rollouts [s].
+        scenarios: The initial conditions, in order.
+        episodes: The episodes (with their recorded actions), in order.
     """
 
     table: Table
@@ -209,6 +218,13 @@ class OutcomeResult:
     seed: int
     n: int
     wall_s: float
+    scenarios: tuple[InitialCondition, ...] = ()
+    episodes: tuple[EpisodeResult, ...] = ()
+
+    def labelled(self, labels: npt.ArrayLike) -> OutcomeResult:
+        """This result with the crashes' ``crash_preventable`` labels in its table."""
+        table = outcome_table(self.scenarios, self.episodes, labels)
+        return dataclasses.replace(self, table=table)
 
 
 def run_outcome(
@@ -244,4 +260,5 @@ def run_outcome(
     episodes = [run_episode(base, policy, ic) for ic in bar]
     wall = time.perf_counter() - t0
     table = outcome_table(scenarios, episodes)
-    return OutcomeResult(table, summarize_outcome(table, base.config.case, level), seed, n, wall)
+    summary = summarize_outcome(table, base.config.case, level)
+    return OutcomeResult(table, summary, seed, n, wall, tuple(scenarios), tuple(episodes))

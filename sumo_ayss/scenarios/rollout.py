@@ -40,6 +40,9 @@ class EpisodeResult:
         measures: The episode's surrogate safety measures (:func:`run_episode` records
             them; ``None`` where the episode was not recorded, e.g. training's vec-env
             evaluation).
+        actions: The POV's actions, in order (:func:`run_episode` records them; empty
+            where not recorded): what a counterfactual replays open loop
+            (:mod:`sumo_ayss.scenarios.preventability`).
     """
 
     episode_return: float
@@ -51,6 +54,7 @@ class EpisodeResult:
     vut_mean_speed_mps: float = math.nan
     # Not part of equality: the same episode tabulated from a vec env has no trajectory.
     measures: EpisodeMeasures | None = field(default=None, compare=False)
+    actions: tuple[int, ...] = field(default=(), compare=False)
 
     def measure_row(self) -> dict[str, float]:
         """The measures as table columns (NaN throughout when not recorded)."""
@@ -87,15 +91,18 @@ def run_episode(env: PairEnv, policy: Policy, ic: InitialCondition) -> EpisodeRe
     obs, reset_info = base.reset(options={"initial_condition": ic})
     rewards: list[float] = []
     infos: list[dict[str, Any]] = []
+    actions: list[int] = []
     while True:
         action = int(np.asarray(policy(obs[None, :])).reshape(-1)[0])
+        actions.append(action)
         obs, reward, terminated, truncated, info = base.step(action)
         rewards.append(float(reward))
         infos.append(info)
         if terminated or truncated:
             break
     result = episode_result(rewards, infos)
-    return dataclasses.replace(result, measures=measures_of(base.config, reset_info, infos))
+    measures = measures_of(base.config, reset_info, infos)
+    return dataclasses.replace(result, measures=measures, actions=tuple(actions))
 
 
 def episode_result(rewards: Sequence[float], infos: Sequence[Mapping[str, Any]]) -> EpisodeResult:

@@ -338,7 +338,7 @@ class VehiclePair:
         _set_speed(self.vut, speed_mps)
 
     def vut_sensing(self, range_m: float) -> VutSensing:
-        """What the VUT's own sensors see now: its speed and lane, and its leader.
+        """What the VUT's own sensors see now: its speed and lane, its leader, its objects.
 
         The leader is the POV when (a) its body reaches into the VUT's lane — its lateral
         extent, centre ± width / 2, overlaps the lane between the lane's edges; during a
@@ -352,8 +352,11 @@ class VehiclePair:
         minGap. Lane positions of neighbouring lanes are compared directly, which holds on
         the straight built-in roads.
 
+        The object list (:class:`SensedObject`) holds the POV in any lane while its gap
+        lies within ``[-range_m, range_m]``: what a real vehicle's object list reports.
+
         Args:
-            range_m: Sensor range [m]: a leader farther than this is not seen.
+            range_m: Sensor range [m]: a leader or object farther than this is not seen.
 
         Returns:
             The reading; without a leader ``gap_m`` is ``inf`` and ``leader_speed_mps``
@@ -367,18 +370,27 @@ class VehiclePair:
             pov_pos, pov_speed = _get_lane_pos(pov), _get_speed(pov)
             pov_lane = _get_lane_index(pov)
             centres, widths = self._lane_geometry()
-            d = (centres[pov_lane] + _get_lateral_lane_pos(pov)) - (
-                centres[vut_lane] + _get_lateral_lane_pos(vut)
-            )
-            reach = 0.5 * (widths[vut_lane] + libsumo.vehicle.getWidth(pov))
-            gap = pov_pos - libsumo.vehicle.getLength(pov) - vut_pos
+            pov_centre = centres[pov_lane] + _get_lateral_lane_pos(pov)
+            d = pov_centre - (centres[vut_lane] + _get_lateral_lane_pos(vut))
+            pov_width = libsumo.vehicle.getWidth(pov)
+            pov_length = libsumo.vehicle.getLength(pov)
+            reach = 0.5 * (widths[vut_lane] + pov_width)
+            gap = pov_pos - pov_length - vut_pos
+            lateral = _get_lateral_speed(pov) - _get_lateral_speed(vut)
         except SUMO_ERRORS as e:
             raise SimulationError(
                 f"pair {self.prefix}: reading the VUT's sensors failed: {e}"
             ) from e
+        lane_width = widths[vut_lane]
+        objects: tuple[SensedObject, ...] = ()
+        if -range_m <= gap <= range_m:
+            offset = pov_centre - centres[vut_lane]  # from the VUT's lane centre line
+            objects = (
+                SensedObject(gap, offset, pov_speed - vut_speed, lateral, pov_length, pov_width),
+            )
         if abs(d) < reach and pov_pos > vut_pos and gap <= range_m:
-            return VutSensing(time_s, vut_speed, vut_lane, gap, pov_speed)
-        return VutSensing(time_s, vut_speed, vut_lane, math.inf, math.nan)
+            return VutSensing(time_s, vut_speed, vut_lane, gap, pov_speed, objects, lane_width)
+        return VutSensing(time_s, vut_speed, vut_lane, math.inf, math.nan, objects, lane_width)
 
     def _lane_geometry(self) -> tuple[list[float], list[float]]:
         """Lateral centre of each lane of the edge from lane 0's centre [m] (+ left), widths."""
@@ -411,6 +423,8 @@ class VutSensing(NamedTuple):
         gap_m: Bumper-to-bumper gap to the leader [m], leader rear minus VUT front;
             ``inf`` without a leader.
         leader_speed_mps: The leader's speed [m/s]; NaN without a leader.
+        objects: The other vehicles within sensor range, in any lane (an object list).
+        lane_width_m: Width of the VUT's lane [m]; NaN where unknown.
     """
 
     time_s: float
@@ -418,3 +432,28 @@ class VutSensing(NamedTuple):
     lane_index: int
     gap_m: float
     leader_speed_mps: float
+    objects: tuple[SensedObject, ...] = ()
+    lane_width_m: float = math.nan
+
+
+class SensedObject(NamedTuple):
+    """One vehicle of the VUT's object list, in the VUT's road frame.
+
+    Attributes:
+        gap_m: Longitudinal gap [m], the object's rear bumper minus the VUT's front bumper:
+            > 0 ahead; <= 0 while the object is beside (or behind) the VUT's front.
+        lateral_offset_m: The object's centre line from the centre line of the VUT's lane
+            [m], + = left (0: centred in the VUT's lane; about one lane width: centred in
+            the next lane).
+        rel_speed_mps: Object's longitudinal speed minus the VUT's [m/s]; < 0 closing in.
+        lateral_speed_mps: Object's lateral speed relative to the VUT [m/s], + = left.
+        length_m: Object's length [m].
+        width_m: Object's width [m].
+    """
+
+    gap_m: float
+    lateral_offset_m: float
+    rel_speed_mps: float
+    lateral_speed_mps: float
+    length_m: float
+    width_m: float

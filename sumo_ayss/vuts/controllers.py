@@ -17,7 +17,30 @@ field               unit     meaning
 ``rel_speed_mps``   m/s      leader speed minus own speed: > 0 the gap opens, < 0 it
                              closes; 0.0 when there is no leader
 ``lane_index``      -        own lane, 0 = rightmost
+``objects``         -        the object list: every other vehicle within
+                             ``sensor_range_m`` (gap in ``[-range, range]``), in any lane,
+                             as :class:`~sumo_ayss.sim.pair.SensedObject` (below)
+``lane_width_m``    m        width of the own lane (NaN where unknown)
 ==================  =======  ===========================================================
+
+An entry of ``objects`` is what a real vehicle's object list holds, in the own road frame:
+
+=======================  =====  ==========================================================
+``gap_m``                m      object rear bumper minus own front bumper (> 0 ahead,
+                                <= 0 beside or behind)
+``lateral_offset_m``     m      object centre line from the own lane's centre line,
+                                + = left (about one lane width: centred in the next lane)
+``rel_speed_mps``        m/s    object longitudinal speed minus own (< 0 closing in)
+``lateral_speed_mps``    m/s    object lateral speed relative to own, + = left
+``length_m``,            m      the object's body
+``width_m``
+=======================  =====  ==========================================================
+
+A cut-in is visible in ``objects`` before it reaches ``gap_m``: the object's
+``lateral_offset_m`` shrinks toward 0 at ``lateral_speed_mps`` while it is still in the next
+lane. A controller that reads only the leader fields keeps working unchanged (the two new
+fields come last, with defaults). The reference drivers (:mod:`sumo_ayss.vuts.reference`)
+read the object list.
 
 "Leader" is the vehicle ahead whose body reaches into the own lane, so a cut-in counts from
 the moment the cutting-in vehicle crosses the lane edge (see
@@ -60,7 +83,7 @@ import math
 import numbers
 from typing import Any, NamedTuple, Protocol, runtime_checkable
 
-from sumo_ayss.sim.pair import VehiclePair, VutSensing
+from sumo_ayss.sim.pair import SensedObject, VehiclePair, VutSensing
 from sumo_ayss.util.errors import ControllerError
 from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
 
@@ -69,6 +92,7 @@ __all__ = [
     "Controller",
     "ControllerError",
     "ControllerInput",
+    "SensedObject",
     "bound_acceleration",
     "commanded_speed",
 ]
@@ -84,6 +108,8 @@ class ControllerInput(NamedTuple):
         gap_m: Bumper-to-bumper gap to the leader [m]; ``inf`` without a leader.
         rel_speed_mps: Leader speed minus own speed [m/s]; > 0 opening; 0 without leader.
         lane_index: Own lane index (0 = rightmost).
+        objects: The object list: other vehicles within sensor range, any lane.
+        lane_width_m: Width of the own lane [m]; NaN where unknown.
     """
 
     time_s: float
@@ -92,6 +118,8 @@ class ControllerInput(NamedTuple):
     gap_m: float
     rel_speed_mps: float
     lane_index: int
+    objects: tuple[SensedObject, ...] = ()
+    lane_width_m: float = math.nan
 
     @property
     def has_leader(self) -> bool:
@@ -103,7 +131,9 @@ class ControllerInput(NamedTuple):
         """Build from a sim-layer reading (NaN leader speed -> relative speed 0)."""
         lead = math.isfinite(s.gap_m)
         rel = s.leader_speed_mps - s.speed_mps if lead else 0.0
-        return cls(s.time_s, dt_s, s.speed_mps, s.gap_m, rel, s.lane_index)
+        return cls(
+            s.time_s, dt_s, s.speed_mps, s.gap_m, rel, s.lane_index, s.objects, s.lane_width_m
+        )
 
 
 @runtime_checkable

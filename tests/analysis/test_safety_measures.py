@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from sumo_ayss.analysis.r157 import must_avoid, r157_share, required_ttc_s
+from sumo_ayss.analysis.r157 import must_avoid, must_avoid_column, r157_share, required_ttc_s
 from sumo_ayss.analysis.safety_measures import (
     MEASURE_NAMES,
     PairTrajectory,
@@ -205,6 +205,19 @@ def test_r157_condition() -> None:
     assert (share.n_required, share.n_handled) == (3, 2)
     assert share.share == pytest.approx(2 / 3)
     assert math.isnan(r157_share([0.0], [False]).share)
+
+
+def test_r157_constant_is_a_parameter_and_old_tables_keep_their_reading() -> None:
+    # 12 m/s closing: 1.35 s with c = 0.35, 1.45 s with the implementations' 0.45.
+    assert required_ttc_s(12.0, 0.45) == pytest.approx(1.45)
+    assert must_avoid(1.4, 12.0, 0.35) == 1.0 and must_avoid(1.4, 12.0, 0.45) == 0.0
+    ttc = [1.4, 1.4, math.nan]
+    closing = [12.0, math.nan, math.nan]  # the 2nd from a table before r157_closing_mps
+    stored = [1.0, 1.0, math.nan]
+    assert must_avoid_column(ttc, closing, stored, 0.45).tolist()[0] == 0.0
+    assert math.isnan(must_avoid_column(ttc, closing, stored, 0.45)[1])  # not known
+    assert must_avoid_column(ttc, closing, stored, 0.35)[1] == 1.0  # the stored 0.35 reading
+    assert math.isnan(must_avoid_column(ttc, closing, stored, 0.35)[2])
 
 
 def test_bad_trajectories_are_refused() -> None:

@@ -23,6 +23,7 @@ from sumo_ayss.scenarios.crossplay import (
     run_crossplay,
 )
 from sumo_ayss.scenarios.outcome import run_outcome
+from sumo_ayss.scenarios.preventability import label_crashes
 from sumo_ayss.train import train
 from sumo_ayss.util.errors import CheckpointError, ConfigError, DiagonalMismatchError
 from tests.helpers import tiny_experiment
@@ -47,9 +48,18 @@ def test_each_cell_is_the_outcome_stage_of_that_policy_and_vut() -> None:
         for opp, sumo_seed, action in (("pi1", 3, BRAKE), ("pi2", 5, HOLD)):
             env = CarFollowingEnv(cfg, sumo_seed=sumo_seed)
             try:
-                ref = run_outcome(env, constant(action), n=N, seed=SEED).table
+                result = run_outcome(env, constant(action), n=N, seed=SEED)
             finally:
                 env.close()
+            # The outcome stage labels its crashes after the rollouts (evaluate.py), too.
+            labels = label_crashes(
+                cfg,
+                result.scenarios,
+                [e.collided for e in result.episodes],
+                [e.actions for e in result.episodes],
+                sumo_seed=sumo_seed,
+            )
+            ref = result.labelled(labels).table
             rows = (table["vut"] == vut) & (table["opponent_vut"] == opp)
             assert table["scenario"][rows].tolist() == list(range(N))
             for col in DIAGONAL_COLUMNS:

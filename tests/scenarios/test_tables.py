@@ -39,6 +39,7 @@ def outcome_rows() -> list[dict[str, object]]:
             "near_miss_pay": 3.25 if i == 1 else 12.345678901234567,
             "vut_mean_speed_mps": 1.0 / 3.0 + i,
             **_measures(i),
+            "crash_preventable": 1.0 if i == 1 else 0.0,
         }
         for i in range(3)
     ]
@@ -151,7 +152,7 @@ def test_ragged_rows_bad_bools_and_missing_files_are_refused(tmp_path: Path) -> 
     write_table(path, table_from_rows(OUTCOME_SCHEMA, outcome_rows()))
     lines = path.read_text().splitlines()
     path.write_text("\n".join([*lines[:2], lines[2] + ",9", *lines[3:]]) + "\n")
-    with pytest.raises(TableError, match="row 1 has 24 cells, header has 23"):
+    with pytest.raises(TableError, match="row 1 has 26 cells, header has 25"):
         read_table(path, OUTCOME_SCHEMA)
     rows = [line.split(",") for line in lines]
     rows[1][OUTCOME_SCHEMA.names.index("collided")] = "2"
@@ -194,16 +195,18 @@ def test_json_summary_is_strict_json(tmp_path: Path) -> None:
 
 def test_a_file_written_before_a_late_column_reads_it_as_not_recorded(tmp_path: Path) -> None:
     """``near_miss_pay`` and ``vut_mean_speed_mps`` came later (issue 22), the safety
-    measures later still (issue 27): an older outcome.csv without them reads, with NaN
-    there; any other missing column is refused."""
+    measures later still (issue 27), the crash label last (issue 32): an older outcome.csv
+    without them reads, with NaN there ("not labelled"); any other missing column is
+    refused."""
     path = tmp_path / "old.csv"
     write_table(path, table_from_rows(OUTCOME_SCHEMA, outcome_rows()))
-    late = 2 + len(MEASURE_NAMES)
+    late = 2 + len(MEASURE_NAMES) + 1
     lines = [line.split(",")[:-late] for line in path.read_text().splitlines()]
     path.write_text("\n".join(",".join(r) for r in lines) + "\n")
     old = read_table(path, OUTCOME_SCHEMA)
     assert np.isnan(old["near_miss_pay"]).all() and np.isnan(old["vut_mean_speed_mps"]).all()
     assert all(np.isnan(old[name]).all() for name in MEASURE_NAMES)
+    assert np.isnan(old["crash_preventable"]).all()
     assert old["episode_return"].tolist() == [r["episode_return"] for r in outcome_rows()]
     path.write_text("\n".join(",".join(r[:-1]) for r in lines) + "\n")  # n_steps gone too
     with pytest.raises(TableError, match=r"missing column\(s\) \['n_steps'\]"):

@@ -30,6 +30,7 @@ from sumo_ayss.report.sections.outcome import (
     premise_sentence,
 )
 from sumo_ayss.report.sections.paper import paper_blocks
+from sumo_ayss.report.sections.reference import reference_blocks
 
 __all__ = ["case_blocks", "verdict_lines"]
 
@@ -56,6 +57,7 @@ def case_blocks(
     blocks += discriminability_blocks(case, list(a.runs), case_dirs, out_dir, colors)
     blocks += crossplay_blocks(a, colors, out_dir, options)
     blocks += measures_blocks(a, colors, out_dir, options)
+    blocks += reference_blocks(a)
     return blocks
 
 

@@ -11,8 +11,13 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from sumo_ayss.analysis.case import CaseAnalysis
-from sumo_ayss.analysis.measure_ranking import MeasureRanking
-from sumo_ayss.analysis.r157 import R157_DECEL_MPS2, R157_INTRUSION_DEPTH_M, R157_TIME_S
+from sumo_ayss.analysis.measure_ranking import MeasureRanking, R157Row
+from sumo_ayss.analysis.r157 import (
+    R157_DECEL_MPS2,
+    R157_INTRUSION_DEPTH_M,
+    R157_TIME_MARGIN_S,
+    R157_TIME_S,
+)
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.report.blocks import Block, FigureBlock, Heading, Paragraph, Table
@@ -31,7 +36,7 @@ def measures_blocks(
 ) -> list[Block]:
     """(j) Distribution table and figure per measure, the per-measure rankings, R157."""
     blocks: list[Block] = [Heading("(j) Surrogate safety measures", 3)]
-    m = case_measures(a, level=options.level)
+    m = case_measures(a, level=options.level, r157_time_s=options.r157_time_s)
     if not isinstance(m, CaseMeasures):
         return [*blocks, Paragraph(f"No safety measures: {m}.")]
     unit = "opponent SPCP" if m.pool == "cross-play" else "training seed"
@@ -112,30 +117,51 @@ def _order_text(r: MeasureRanking) -> str:
 
 
 def _r157_table(m: CaseMeasures, options: ReportOptions) -> Table:
+    alt = {q.vut: q for q in m.r157_alt}
+
+    def share(q: R157Row | None) -> str:
+        if q is None:
+            return "—"
+        return f"{fmt_num(q.share, 3)} ({fmt_num(q.lo, 3)} to {fmt_num(q.hi, 3)})"
+
     rows = tuple(
         (
             q.vut,
             str(q.n_intrusions),
             str(q.n_required),
             str(q.n_handled),
-            f"{fmt_num(q.share, 3)} ({fmt_num(q.lo, 3)} to {fmt_num(q.hi, 3)})",
+            share(q),
+            str(alt[q.vut].n_required) if q.vut in alt else "—",
+            share(alt.get(q.vut)),
         )
         for q in m.r157
     )
     note = (
         f"UN R157 §5.2.5.2 cut-in condition: TTC at lane intrusion > v_rel / (2 · "
-        f"{R157_DECEL_MPS2:g} m/s²) + {R157_TIME_S:g} s, read when the POV is "
-        f"{R157_INTRUSION_DEPTH_M:g} m inside the VUT's lane. The formula is taken from two "
-        "implementations that cite the regulation (esmini's ALKS R157 controller, the EC "
-        "JRC's JRC-FSM); the regulation's text itself was not retrieved and its other "
-        "conditions on the cut-in are not applied (sumo_ayss.analysis.r157)."
+        f"{R157_DECEL_MPS2:g} m/s²) + c, read when the POV is "
+        f"{R157_INTRUSION_DEPTH_M:g} m inside the VUT's lane, with c = {m.r157_time_s:g} s "
+        f"(report.r157_time_s) and, beside it, c = {m.r157_alt_s:g} s "
+        f"({R157_TIME_S:g} s is the regulation as its implementations' comments quote it; "
+        f"{R157_TIME_MARGIN_S:g} s adds the 0.1 s margin of their code). The formula is taken "
+        "from two implementations that cite the regulation (esmini's ALKS R157 controller, "
+        "the EC JRC's JRC-FSM); the regulation's text itself was not retrieved and its other "
+        "conditions on the cut-in are not applied (sumo_ayss.analysis.r157). — : the tables "
+        "predate the closing-speed column, so the other constant cannot be read."
     )
     return Table(
         f"Cut-ins R157 says must be handled, and the share handled without a collision "
         f"({100 * options.level:g} % Wilson interval)",
-        ("VUT", "intrusions ≥ 0.3 m", "must be handled", "handled", "share handled"),
+        (
+            "VUT",
+            "intrusions ≥ 0.3 m",
+            f"must be handled (c = {m.r157_time_s:g} s)",
+            "handled",
+            "share handled",
+            f"must be handled (c = {m.r157_alt_s:g} s)",
+            f"share handled (c = {m.r157_alt_s:g} s)",
+        ),
         rows,
-        (False, True, True, True, True),
+        (False, True, True, True, True, True, True),
         note,
     )
 
