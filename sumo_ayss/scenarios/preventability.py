@@ -33,7 +33,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -58,7 +59,13 @@ LABEL_PREVENTABLE = 1.0
 LABEL_UNPREVENTABLE = 0.0
 
 
-def reference_config(config: EnvConfig, reference: str, *, own_body: bool = False) -> EnvConfig:
+def reference_config(
+    config: EnvConfig,
+    reference: str,
+    *,
+    own_body: bool = False,
+    params: Mapping[str, Any] | None = None,
+) -> EnvConfig:
     """``config`` with the reference driver ``reference`` in the VUT's place and body.
 
     The reference's catalog entry (:data:`~sumo_ayss.vuts.catalog.REFERENCE_VUTS`) keeps its
@@ -76,6 +83,9 @@ def reference_config(config: EnvConfig, reference: str, *, own_body: bool = Fals
     if own_body:
         body = {}
     vt = dataclasses.replace(ref, params={**ref.params, **body})
+    if params and vt.controller is not None:
+        controller = dataclasses.replace(vt.controller, params={**vt.controller.params, **params})
+        vt = dataclasses.replace(vt, controller=controller)
     vuts = {**config.vuts, reference: vt}
     return dataclasses.replace(config, vuts=vuts, vut=reference)
 
@@ -105,6 +115,7 @@ def label_crashes(
     *,
     sumo_seed: int,
     reference: str = DEFAULT_REFERENCE,
+    params: Mapping[str, Any] | None = None,
 ) -> np.ndarray:
     """The ``crash_preventable`` value of each episode (same order as ``scenarios``).
 
@@ -115,6 +126,7 @@ def label_crashes(
         actions: Each episode's recorded POV actions.
         sumo_seed: SUMO's seed of the replays (the original episodes').
         reference: A reference driver's name (:data:`~sumo_ayss.vuts.catalog.REFERENCE_VUTS`).
+        params: Parameters replacing the reference controller's (None: its defaults).
 
     Returns:
         float64 array: 1.0 preventable, 0.0 unpreventable, NaN for an episode without a
@@ -131,7 +143,7 @@ def label_crashes(
     crashed = [i for i, c in enumerate(collided) if c]
     if not crashed:
         return labels
-    env = make_env(reference_config(config, reference), sumo_seed=sumo_seed)
+    env = make_env(reference_config(config, reference, params=params), sumo_seed=sumo_seed)
     try:
         for i in crashed:
             hit = counterfactual_collides(env, scenarios[i], actions[i])
