@@ -77,6 +77,7 @@ def full_rerun(out: Path, vuts: list[str], where: Path) -> bytes:
 
 
 @pytest.mark.sumo
+@pytest.mark.timeout(900)  # two studies and a third VUT at a tiny budget: ~2-5 min on 2 busy cores
 def test_add_a_vut_trains_only_its_runs_and_crossplay_equals_a_fresh_study(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
@@ -104,6 +105,7 @@ def test_add_a_vut_trains_only_its_runs_and_crossplay_equals_a_fresh_study(
 
 
 @pytest.mark.sumo
+@pytest.mark.timeout(900)  # a study, then three changes to it: ~2-5 min on 2 busy cores
 def test_drop_redefine_rename_one_vut_runs_only_its_work(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
