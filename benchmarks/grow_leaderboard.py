@@ -1,7 +1,8 @@
 """CPU-seconds of adding one VUT to a finished study, against running the grown study anew.
 
     python benchmarks/grow_leaderboard.py [--out runs/bench/grow_leaderboard] \
-        [--ladder configs/ladders/time_headway.yaml] [--add tau20] [--budget verdict]
+        [--ladder configs/ladders/time_headway.yaml] [--add tau20] [--budget verdict] \
+        [-- RANK_ARGS]     # e.g. -- --total-timesteps 600 --eval-every 300 (a smoke run)
 
 Three ``python -m sumo_ayss.rank`` runs of the ladder (every case, the named budget and its
 seeds), each a child process whose whole process tree's CPU-seconds are measured
@@ -60,13 +61,14 @@ def write_config(ladder: Path, budget: str, vuts: list[str], out: Path, path: Pa
     return path
 
 
-def measure(config: Path, force: bool) -> dict:
-    """Runs ``rank`` on ``config`` unless measured already; returns the measurement."""
+def measure(config: Path, force: bool, extra: list[str]) -> dict:
+    """Runs ``rank`` on ``config`` (with ``extra`` arguments) unless measured already;
+    returns the measurement."""
     record = config.with_suffix(".bench.json")
     if record.is_file() and not force:
         return json.loads(record.read_text())
     cpu0, t0 = _children_cpu_s(), time.perf_counter()
-    cmd = [sys.executable, "-m", "sumo_ayss.rank", str(config), "--no-live"]
+    cmd = [sys.executable, "-m", "sumo_ayss.rank", str(config), "--no-live", *extra]
     proc = subprocess.run(
         cmd, cwd=PROJECT_ROOT, env=os.environ.copy(), check=False, capture_output=True, text=True
     )
@@ -93,6 +95,7 @@ def main() -> None:
     p.add_argument("--add", default=None, help="the VUT added last (default: the ladder's last)")
     p.add_argument("--budget", default="verdict")
     p.add_argument("--force", action="store_true", help="measure again what was measured")
+    p.add_argument("rank_args", nargs="*", help="after --: passed to every rank run")
     a = p.parse_args()
     vuts = list(yaml.safe_load(a.ladder.read_text())["grid"]["vuts"])
     added = a.add or vuts[-1]
@@ -105,7 +108,7 @@ def main() -> None:
     rows = {}
     for step, (names, out) in steps.items():
         config = write_config(a.ladder, a.budget, names, out, a.out / f"{step}.yaml")
-        m = measure(config, a.force)
+        m = measure(config, a.force, a.rank_args)
         if m["returncode"] != 0:
             sys.exit(
                 f"rank failed on {config} (exit {m['returncode']}; {config.with_suffix('.log')})"
