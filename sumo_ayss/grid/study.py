@@ -129,7 +129,8 @@ def check_same_study(cfg: PipelineConfig, jobs: Sequence[JobSpec]) -> None:
                 if not d.startswith(f"{OWN_VUT}.")
             ]
             if diffs:
-                shown = "; ".join(diffs[:5]) + (f"; and {len(diffs) - 5} more" * (len(diffs) > 5))
+                more = f"; and {len(diffs) - 5} more" if len(diffs) > 5 else ""
+                shown = "; ".join(diffs[:5]) + more
                 raise ConfigError(
                     f"out: {out} holds runs made with other settings than this study's: "
                     f"{runs[0].relative_to(out)} differs in {shown} (stored -> asked); give "
