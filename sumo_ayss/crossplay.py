@@ -64,7 +64,8 @@ from sumo_ayss.run_folder import (
 from sumo_ayss.run_folder.crossplay_cells import CellPlan, merged_rows, plan_cells
 from sumo_ayss.run_folder.identity import vut_key
 from sumo_ayss.util.errors import AyssError, CheckpointError, TableError
-from sumo_ayss.vuts.catalog import DEFAULT_REFERENCE, controller_imports
+from sumo_ayss.vuts.catalog import controller_imports
+from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
 
 logger = logging.getLogger(__name__)
 
@@ -113,7 +114,7 @@ def run_case(
     (:func:`~sumo_ayss.scenarios.crossplay.diagonal_check`); the result goes into
     ``crossplay.json``.
 
-    ``references`` (reference drivers, :data:`~sumo_ayss.vuts.catalog.REFERENCE_VUTS`) then
+    ``references`` (reference drivers, :data:`~sumo_ayss.vuts.reference_types.REFERENCE_VUTS`) then
     drive against the whole pool into ``crossplay_reference.csv`` (none: no file).
     ``reference`` labels every crash preventable or not
     (:mod:`sumo_ayss.scenarios.preventability`; None: no labels). It is not part of the

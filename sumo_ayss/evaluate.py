@@ -62,7 +62,8 @@ from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.util.errors import AyssError, CheckpointError
 from sumo_ayss.util.paths import portable_path
-from sumo_ayss.vuts.catalog import REFERENCE_VUTS, controller_imports
+from sumo_ayss.vuts.catalog import controller_imports
+from sumo_ayss.vuts.reference_types import REFERENCE_VUTS
 
 __all__ = ["EvaluationResult", "evaluate_run", "load_spcp", "main"]
 

@@ -46,8 +46,9 @@ __all__ = [
     "read_against_reference",
 ]
 
-#: The careful-human reference's catalog name (:data:`sumo_ayss.vuts.catalog.REFERENCE_VUTS`),
-#: listed first wherever several references are read.
+#: The careful-human reference's catalog name
+#: (:data:`sumo_ayss.vuts.reference_types.REFERENCE_VUTS`), listed first wherever several
+#: references are read.
 CAREFUL_HUMAN = "cc_driver"
 
 Verdict = Literal["safer", "not distinguishable", "less safe", "untested"]

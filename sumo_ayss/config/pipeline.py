@@ -19,7 +19,8 @@ from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.config.yaml_io import read_yaml
 from sumo_ayss.util.frozen import FrozenMap
 from sumo_ayss.util.validation import check_choice, check_seed, require, suggest
-from sumo_ayss.vuts.catalog import DEFAULT_REFERENCE, REFERENCE_VUTS, VehicleType
+from sumo_ayss.vuts.catalog import VehicleType
+from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE, REFERENCE_VUTS
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ from sumo_ayss.run_folder import (
     write_progress,
 )
 from sumo_ayss.util.errors import ControllerError
-from sumo_ayss.vuts.catalog import DEFAULT_REFERENCE
+from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
 
 logger = logging.getLogger("sumo_ayss.pipeline")
 

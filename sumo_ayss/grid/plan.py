@@ -13,7 +13,7 @@ from sumo_ayss.config import ExperimentConfig, PipelineConfig, load_experiment
 from sumo_ayss.grid.jobs import JobSpec
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.validation import suggest
-from sumo_ayss.vuts.catalog import REFERENCE_VUTS
+from sumo_ayss.vuts.reference_types import REFERENCE_VUTS
 
 __all__ = ["case_experiment", "plan_jobs", "plan_seed"]
 

@@ -42,7 +42,7 @@ from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.util.errors import ConfigError
-from sumo_ayss.vuts.catalog import DEFAULT_REFERENCE, REFERENCE_VUTS
+from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE, REFERENCE_VUTS
 from sumo_ayss.vuts.vtype_params import CONTROLLED_BODY_PARAMS
 
 __all__ = [
@@ -68,7 +68,7 @@ def reference_config(
 ) -> EnvConfig:
     """``config`` with the reference driver ``reference`` in the VUT's place and body.
 
-    The reference's catalog entry (:data:`~sumo_ayss.vuts.catalog.REFERENCE_VUTS`) keeps its
+    The reference's catalog entry (:data:`~sumo_ayss.vuts.reference_types.REFERENCE_VUTS`) keeps its
     controller; its body (length, width, ...) is the VUT's where the VUT gives one, so that
     the replay's geometry is the original's (``own_body``: the reference's own 5 m x 1.8 m
     body instead, for its own row in cross-play). Entered into the catalog under
@@ -125,7 +125,8 @@ def label_crashes(
         collided: Whether each episode ended in a collision.
         actions: Each episode's recorded POV actions.
         sumo_seed: SUMO's seed of the replays (the original episodes').
-        reference: A reference driver's name (:data:`~sumo_ayss.vuts.catalog.REFERENCE_VUTS`).
+        reference: A reference driver's name
+            (:data:`~sumo_ayss.vuts.reference_types.REFERENCE_VUTS`).
         params: Parameters replacing the reference controller's (None: its defaults).
 
     Returns:

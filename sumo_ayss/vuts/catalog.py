@@ -125,9 +125,8 @@ class ControllerSpec:
         if not _CONTROLLER_IMPORTS.get() and not self.target.startswith("sumo_ayss."):
             raise ConfigError(
                 f"{where}.target {self.target!r}: this VUT is a user controller, and importing "
-                "it runs code named by the run folder (the package's own, sumo_ayss.*, is always "
-                "allowed); pass --trust-controller if you trust "
-                "the folder (see 'Trust model' in the README)"
+                "it runs code named by the run folder; pass --trust-controller if you trust "
+                "the folder (see 'Trust model' in the README; sumo_ayss.* is always allowed)"
             )
         module_part, _, attr_part = self.target.rpartition(":")
         try:
@@ -474,48 +473,6 @@ BUILTIN_VUTS: Mapping[str, VehicleType] = FrozenMap(
         "hwenv_pi2": _hwenv_idm(20.0),
     }
 )
-
-
-def _reference(target: str, description: str, max_decel_mps2: float) -> VehicleType:
-    # A reference driver of sumo_ayss.vuts.reference in SUMO's passenger body (5 m x 1.8 m).
-    return VehicleType(
-        model="IDM",
-        params={"length": 5.0, "width": 1.8, "minGap": 0.0},
-        description=description,
-        controller=ControllerSpec(
-            target=f"sumo_ayss.vuts.reference:{target}",
-            params={},
-            max_accel_mps2=3.0,
-            max_decel_mps2=max_decel_mps2,
-            max_speed_mps=40.0,
-        ),
-    )
-
-
-#: The reference drivers as VUTs (:mod:`sumo_ayss.vuts.reference`): R157's competent and
-#: careful human driver, JRC's Fuzzy Safety Model, RSS's proper response. Name one in
-#: ``grid.vuts`` (or add it to a catalog) to rank it; cross-play drives them against the
-#: pooled opponents; the preventability labels replay every crash with one
-#: (:mod:`sumo_ayss.scenarios.preventability`). Limits: 0.85 g (the CC driver's AEB),
-#: 0.774 g (FSM's cap), 8 m/s² (RSS's b_max).
-REFERENCE_VUTS: Mapping[str, VehicleType] = FrozenMap(
-    {
-        "cc_driver": _reference(
-            "CarefulDriver",
-            "R157 competent and careful human driver (reaction 0.75 s, 0.774 g in 0.6 s, AEB)",
-            0.85 * 9.81,
-        ),
-        "fsm": _reference(
-            "FuzzySafetyDriver", "JRC Fuzzy Safety Model (Mattas et al. 2020)", 0.774 * 9.81
-        ),
-        "rss": _reference(
-            "RssDriver", "RSS longitudinal proper response (rho 1 s, b_min 4 m/s²)", 8.0
-        ),
-    }
-)
-
-#: The reference driver that labels crashes preventable or not unless configured otherwise.
-DEFAULT_REFERENCE = "cc_driver"
 
 #: The POV: speed and lane are commanded by our actuator, SUMO's own checks are off, so the
 #: model only matters for length/width. maxSpeed 40 m/s = the upper end of the VUT ODD.

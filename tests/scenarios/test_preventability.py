@@ -18,7 +18,8 @@ from sumo_ayss.scenarios.preventability import (
 )
 from sumo_ayss.scenarios.rollout import run_episode
 from sumo_ayss.util.errors import ConfigError
-from sumo_ayss.vuts.catalog import REFERENCE_VUTS, ControllerSpec, VehicleType
+from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
+from sumo_ayss.vuts.reference_types import REFERENCE_VUTS
 
 #: A VUT that never brakes (holds its speed whatever happens).
 BLIND = VehicleType(

@@ -8,7 +8,6 @@ import pytest
 
 from sumo_ayss.sim.pair import SensedObject
 from sumo_ayss.util.errors import ConfigError
-from sumo_ayss.vuts.catalog import REFERENCE_VUTS
 from sumo_ayss.vuts.controllers import ControllerInput, bound_acceleration, commanded_speed
 from sumo_ayss.vuts.reference import (
     G_MPS2,
@@ -19,6 +18,7 @@ from sumo_ayss.vuts.reference import (
     rss_lateral_safe_distance_m,
     rss_safe_distance_m,
 )
+from sumo_ayss.vuts.reference_types import REFERENCE_VUTS
 
 DT = 0.2
 LANE_W = 3.2

@@ -96,11 +96,18 @@ HEADERS = (
 
 
 def _scenario_line(reading: ReferenceReading, case: str) -> str:
+    # Where the reference's harm falls among the VUTs' (harm = reference + difference).
+    harms = sorted((reading.harm + r.test.difference, r.vut) for r in reading.rows)
+    safer = [v for h, v in harms if h < reading.harm]
+    place = f"by harm it would rank {len(safer) + 1} of {len(harms) + 1}" + (
+        f", after {', '.join(safer)}" if safer else ", first"
+    )
     return (
         f"{_name(reading.reference)[:1].upper()}{_name(reading.reference)[1:]} crashed in "
         f"{crash_text(reading.crashes, reading.episodes, reading.crash_lo, reading.crash_hi)} "
-        f"of the {case} episodes against this pool (its harm {fmt_num(reading.harm, 3)}): "
-        "episodes it could not survive, a property of the scenario set and the opponents."
+        f"of the {case} episodes against this pool (its harm {fmt_num(reading.harm, 3)}; "
+        f"{place}): episodes it could not survive, a property of the scenario set and the "
+        "opponents."
     )
 
 
@@ -110,7 +117,7 @@ def scenario_set_line(a: CaseAnalysis) -> str:
     if ss is None:
         return ""
     return (
-        f"{ss.ics} of the {ss.n} {a.info.title} scenarios "
+        f"{ss.ics} of the {ss.n} {a.case.replace('_', '-')} scenarios "
         f"({100 * ss.share:.1f} %, {100 * ss.lo:.1f}–{100 * ss.hi:.1f} %) are "
         "inevitable-collision states: a vehicle braking at 0.85 g from the first instant "
         "still touches a POV that brakes at once (or cuts in at once). Crashes drawn there "
