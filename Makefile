@@ -14,6 +14,11 @@ TORCH  := torch==2.13.0
 # Extra pip arguments for torch. Off this machine, take the CPU build from PyTorch's index:
 #   make demo TORCH_PIP_ARGS="--index-url https://download.pytorch.org/whl/cpu"
 TORCH_PIP_ARGS ?=
+ifneq ($(strip $(TORCH_PIP_ARGS)),)
+ifneq ($(wildcard $(STAMP)),)
+$(warning TORCH_PIP_ARGS is ignored: .venv is already set up (make clean, then make again, to install torch with them))
+endif
+endif
 
 .PHONY: all demo test test-slow lint format typecheck bench networks clean
 

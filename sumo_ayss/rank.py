@@ -33,6 +33,7 @@ the bootstrap only in paper mode) and never runs cross-play.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -128,9 +129,18 @@ def _rows(a: CaseAnalysis, mode: Mode) -> list[dict[str, Any]]:
                 "episodes": o.episodes if o else "",
                 "mobility_mps": o.mobility if o else "",
                 "timid": o.timid if o else "",
+                "p_vs_next_adjusted": s.p_adjusted if s.p_adjusted is not None else "",
+                "margin_vs_next": _finite_or_empty(s.margin),
+                "margin_lo": _finite_or_empty(s.margin_lo),
+                "margin_hi": _finite_or_empty(s.margin_hi),
             }
         )
     return rows
+
+
+def _finite_or_empty(x: float) -> float | str:
+    """A number for a ``ranking.csv`` cell; "" for NaN (no value)."""
+    return x if math.isfinite(x) else ""
 
 
 def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
@@ -217,13 +227,14 @@ def write_ranking(
         "mean speed | vs next |",
         "|---|---|---:|---|---|---:|---|---|---|",
     ]
-    for r in rows:
+    labels, lines_of = _tie_labels(rows)
+    for i, r in enumerate(rows):
         mode = get_mode(r["mode"])
         digits = mode.digits
         ci = mode.interval_text(r["lo"], r["hi"], r["n_seeds"], digits)
         ci = f" ({ci})" if ci else ""
         lines.append(
-            f"| {r['case']} | {r['mode']} | {r['rank']} | {r['vut']} | "
+            f"| {r['case']} | {r['mode']} | {labels[i]} | {r['vut']} | "
             f"{fmt_num(r['score'], digits)}{ci} {r['unit']} | {r['n_seeds']} | {_crash_cell(r)} | "
             f"{_mobility_cell(r)} | {r['vs_next']} |"
         )
@@ -231,7 +242,8 @@ def write_ranking(
         lines += [
             "",
             f"Known order ({c.case}, {c.mode} mode), safest first: "
-            f"{' > '.join(expected)}. Ranking: {' > '.join(c.order)}. "
+            f"{' > '.join(expected)}. Ranking: "
+            f"{lines_of.get((c.case, c.mode), ' > '.join(c.order))}. "
             f"Kendall tau = {c.tau:.2f}; ends significantly different: "
             f"{'yes' if c.ends_significant else 'no'} (p = {c.ends_p:.3g}); "
             f"significant adjacent pairs: {c.significant_adjacent} of {c.adjacent}.",
@@ -241,6 +253,26 @@ def write_ranking(
     if checks:
         write_order_check(study.order_check_json, OrderChecks(tuple(expected), tuple(checks)))
     return study.ranking_csv, study.ranking_md
+
+
+def _tie_labels(
+    rows: Sequence[dict[str, Any]],
+) -> tuple[list[str], dict[tuple[str, str], str]]:
+    """Per row its rank as ``ranking.md`` shows it (a tie shares one, ``"2–3"``), and per
+    (case, mode) its ranking line (``"a > b ≈ c"``), from ``significant_vs_next``."""
+    from sumo_ayss.modes.formatting import rank_labels, ranking_line
+
+    groups: dict[tuple[str, str], list[int]] = {}
+    for i, r in enumerate(rows):
+        groups.setdefault((r["case"], r["mode"]), []).append(i)
+    labels = [""] * len(rows)
+    lines: dict[tuple[str, str], str] = {}
+    for key, idx in groups.items():
+        sig = [rows[i]["significant_vs_next"] in (True, "True") for i in idx[:-1]]
+        for i, label in zip(idx, rank_labels(sig), strict=True):
+            labels[i] = label
+        lines[key] = ranking_line([rows[i]["vut"] for i in idx], sig)
+    return labels, lines
 
 
 def _crash_cell(row: dict[str, Any]) -> str:

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from pathlib import Path
 
 import pytest
 
@@ -16,3 +17,50 @@ def cf_env() -> Iterator[CarFollowingEnv]:
         yield env
     finally:
         env.close()
+
+
+# ------------------------------------------------------------------ FMUs built from source
+
+
+@pytest.fixture(scope="session")
+def fmu_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder for the FMUs the tests build (once per session)."""
+    return tmp_path_factory.mktemp("fmus")
+
+
+@pytest.fixture(scope="session")
+def c_fmu(fmu_dir: Path) -> Callable[[int], Path]:
+    """``c_fmu(version)``: the time-gap ACC compiled from ``examples/fmu`` (FMI 2 or 3)."""
+    from examples.fmu.build_fmu import build_acc_fmu, compiler
+
+    if compiler() is None:
+        pytest.skip("no C compiler (cc, gcc or clang): the C FMU cannot be built here")
+    built: dict[int, Path] = {}
+
+    def get(version: int) -> Path:
+        if version not in built:
+            built[version] = build_acc_fmu(fmu_dir / f"acc_fmi{version}.fmu", version)
+        return built[version]
+
+    return get
+
+
+@pytest.fixture(scope="session")
+def py_fmu(fmu_dir: Path) -> Callable[[str], Path]:
+    """``py_fmu(name)``: ``acc`` (examples/fmu/acc_slave.py) or ``probe``
+    (tests/data/fmu/probe_slave.py) exported with pythonfmu."""
+    from examples.fmu.build_fmu import build_python_fmu
+    from sumo_ayss.config import PROJECT_ROOT
+
+    scripts = {
+        "acc": PROJECT_ROOT / "examples" / "fmu" / "acc_slave.py",
+        "probe": PROJECT_ROOT / "tests" / "data" / "fmu" / "probe_slave.py",
+    }
+    built: dict[str, Path] = {}
+
+    def get(name: str) -> Path:
+        if name not in built:
+            built[name] = build_python_fmu(scripts[name], fmu_dir / name)
+        return built[name]
+
+    return get

@@ -197,3 +197,40 @@ def test_rank_no_run_checks_the_known_order_in_every_mode_available(tmp_path, mo
     assert "| car_following | crossplay | 1 | cautious |" in main_md
     assert "[crossplay mode] cautious is safer than pi2" in main_md
     capsys.readouterr()
+
+
+def test_ranking_md_shows_a_tie_as_a_shared_rank_and_in_the_known_order_line(tmp_path) -> None:
+    from sumo_ayss.run_folder import OrderCheck
+
+    def row(rank: int, vut: str, sig: bool | str) -> dict:
+        return {
+            "case": "cut_in",
+            "mode": "crossplay",
+            "rank": rank,
+            "vut": vut,
+            "score": 0.1 * rank,
+            "lo": float("nan"),
+            "hi": float("nan"),
+            "n_seeds": 4,
+            "unit": "harm",
+            "p_vs_next": 0.3,
+            "significant_vs_next": sig,
+            "vs_next": "",
+            "crash_rate": "",
+            "crash_lo": "",
+            "crash_hi": "",
+            "crashes": "",
+            "episodes": "",
+            "mobility_mps": "",
+            "timid": "",
+        }
+
+    rows = [row(1, "b", True), row(2, "a", False), row(3, "c", "")]
+    check = OrderCheck(
+        "cut_in", "crossplay", ("b", "a", "c"), ("b", "a", "c"), 1.0, True, 0.01, 1, 2
+    )
+    _, md = write_ranking(rows, tmp_path, [check], ("b", "a", "c"))
+    text = md.read_text()
+    assert "| cut_in | crossplay | 1 | b |" in text
+    assert "| cut_in | crossplay | 2–3 | a |" in text and "| cut_in | crossplay | 2–3 | c |" in text
+    assert "Ranking: b > a ≈ c." in text

@@ -151,6 +151,26 @@ def test_controller_pipeline_block_adds_to_the_shipped_experiment(tmp_path: Path
     assert shipped.train.n_envs > 1  # the snippet alone would have given 1
 
 
+def test_black_box_pipeline_block_reads_an_fmu_and_a_process_vut(tmp_path: Path) -> None:
+    """The README's FMU and process YAML is read (no FMU opened, no process started)."""
+    from sumo_ayss.config.pipeline import load_pipeline
+    from sumo_ayss.pipeline import plan_jobs
+    from sumo_ayss.vuts.fmu_spec import FmuSpec
+    from sumo_ayss.vuts.process_spec import ProcessSpec
+
+    block = re.search(r"<!-- black-box-pipeline.*?-->\s*```yaml\n(.*?)```", README, re.S)
+    assert block, "README.md has no black-box-pipeline block"
+    path = tmp_path / "my_black_boxes.yaml"
+    path.write_text(block.group(1))
+    kinds = {
+        j.vut: type(j.experiment.env.vut_type.controller) for j in plan_jobs(load_pipeline(path))
+    }
+    assert kinds == {"acc_fmu": FmuSpec, "acc_proc": ProcessSpec}
+    fmu = next(j for j in plan_jobs(load_pipeline(path)) if j.vut == "acc_fmu")
+    spec = fmu.experiment.env.vut_type.controller
+    assert isinstance(spec, FmuSpec) and spec.path == str(tmp_path / "runs" / "fmus" / "acc.fmu")
+
+
 def test_readme_commands_exist_on_a_fresh_clone_and_write_only_ignored_folders() -> None:
     """Console scripts live in .venv/bin (not on PATH after `make`); outputs go to runs/,
     which git ignores."""
@@ -163,3 +183,35 @@ def test_readme_commands_exist_on_a_fresh_clone_and_write_only_ignored_folders()
     assert "runs/" in ignored
     for out in re.findall(r"--out (\S+)", README):
         assert out.startswith(("runs/", "DIR", "<")), f"--out {out}: not under runs/"
+
+
+def test_krauss_example_is_the_deterministic_vut_it_says() -> None:
+    """The README's Krauss block says ``sigma: 0.0``; SUMO's default speedDev 0.1 would still
+    draw a random speed factor, so the example must switch it off too (issue 35)."""
+    from sumo_ayss.vuts.catalog import VehicleType
+
+    block = re.search(r"```yaml\n(env:\n  vut: my_krauss\n.*?)```", README, re.S)
+    assert block, "README.md has no Krauss example"
+    spec = yaml.safe_load(block.group(1))["env"]["vuts"]["my_krauss"]
+    vtype = VehicleType(model=spec["model"], params=spec["params"])
+    assert vtype.random_draws() == ()
+
+
+def test_replay_export_example_reads_a_run_the_quick_start_makes() -> None:
+    """The OpenSCENARIO example exports a run folder the quick start writes (issue 35)."""
+    evaluate = next(a for a in quick_start_commands() if a[2] == "sumo_ayss.evaluate")
+    block = re.search(r"sumo_ayss\.replay export (\S+) \\\n\s+--outcome-row", README)
+    assert block, "README.md has no replay export example"
+    assert block.group(1) == evaluate[3]
+
+
+def test_readme_states_the_demos_own_budget() -> None:
+    """The demo's seeds and transitions as README states them are demo.yaml's (issue 35:
+    it said the demo was marked untrusted and that experiments use 100,000 transitions)."""
+    demo = yaml.safe_load((PROJECT_ROOT / "configs" / "demo.yaml").read_text())
+    intro = README.split("## Glossary")[0]
+    seeds = len(demo["grid"]["seeds"])
+    flat = " ".join(intro.split())
+    assert f"trains {demo['total_timesteps']:,} transitions per run with {seeds} seeds" in flat
+    assert "the experiments use 100,000" not in " ".join(README.split())
+    assert "not to be trusted" not in intro

@@ -40,7 +40,7 @@ from sumo_ayss.analysis.reference import (
     read_against_reference,
 )
 from sumo_ayss.analysis.seeds import SeedComparison, SeedRankRow, SeedScores, rank_seeds
-from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
+from sumo_ayss.analysis.significance import PairVerdict, family_adjusted, pair_verdict
 from sumo_ayss.cases import Case, case_info
 from sumo_ayss.modes import CROSSPLAY, EXPOSURE, PAPER, get_mode
 from sumo_ayss.util.errors import ConfigError
@@ -357,6 +357,7 @@ def analyse_case(
                 )
             except ConfigError as exc:
                 out.problems.append(f"{a} vs {b}: not comparable ({exc})")
+    out.pairs = family_adjusted(out.pairs, order)
     _exposure(out, options)
     premise_met = out.premise is None or not out.premise.metrics or out.premise.met
     out.paper_verdict = paper_verdict(PAPER.name, out.ranking, out.pairs, premise_met=premise_met)

@@ -18,6 +18,7 @@ Imports neither SUMO nor torch; reads no file.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -171,10 +172,19 @@ def _ranked(spec: MeasureSpec, rows: list[MeasureSummary]) -> tuple[list[Measure
     valued = [r for r in rows if r.n > 0]
     sign = -1.0 if spec.higher_is_safer else 1.0
     key = {r.vut: sign * r.median for r in valued}
+
+    def below(x: float, y: float) -> bool:
+        """``x < y`` beyond float noise: medians computed by different float paths
+        (5.999999999999997 vs 6.000000000000003) are a tie, not a ranking."""
+        return x < y and not math.isclose(x, y, rel_tol=1e-9, abs_tol=1e-12)
+
     ranks: dict[str, int] = {}
     for r in valued:
-        ranks[r.vut] = 1 + sum(1 for other in valued if key[other.vut] < key[r.vut])
-    ties = len(set(key.values())) < len(key)
+        ranks[r.vut] = 1 + sum(1 for other in valued if below(key[other.vut], key[r.vut]))
+    ties = any(
+        not below(key[a], key[b]) and not below(key[b], key[a])
+        for a, b in itertools.combinations(key, 2)
+    )
     out = [replace(r, rank=ranks.get(r.vut, 0)) for r in rows]
     return out, ties
 

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from sumo_ayss.analysis.crossplay import CrossplayMatrix
+from sumo_ayss.analysis.multiplicity import holm
 from sumo_ayss.analysis.seeds import SeedComparison, compare_seeds
 from sumo_ayss.analysis.stats import wilson_interval
 from sumo_ayss.util.errors import ConfigError
@@ -55,20 +56,9 @@ Verdict = Literal["safer", "not distinguishable", "less safe", "untested"]
 
 
 def holm_adjust(p_values: list[float]) -> list[float]:
-    """Holm's step-down adjusted p values (same order; NaN stays NaN and is not counted).
-
-    ``p_(i)`` sorted ascending over the m defined values: ``adj_(i) = max_{j <= i}
-    min(1, (m - j + 1) · p_(j))``. Rejecting where ``adj <= alpha`` controls the family-wise
-    error at ``alpha`` under any dependence (Holm 1979).
-    """
-    idx = [i for i, p in enumerate(p_values) if not math.isnan(p)]
-    m = len(idx)
-    out = [math.nan] * len(p_values)
-    running = 0.0
-    for rank, i in enumerate(sorted(idx, key=lambda k: p_values[k])):
-        running = max(running, min(1.0, (m - rank) * p_values[i]))
-        out[i] = running
-    return out
+    """Holm's step-down adjusted p values (same order; NaN stays NaN and is not counted):
+    the ranking's own procedure, :func:`sumo_ayss.analysis.multiplicity.holm`."""
+    return holm(p_values)
 
 
 @dataclass(frozen=True)

@@ -15,11 +15,15 @@ VUTs). With different seed sets the comparison falls back to Welch's t-test.
 Significance rule (:func:`compare_seeds`): two-sided p < ``alpha`` of that t-test, whose
 interval at ``level = 1 - alpha`` then excludes 0. Under normal seed-level errors the
 paired test is exact, so with no true difference it calls a difference in ``alpha`` of cases
-(checked on synthetic data in ``tests/analysis/test_seeds.py``).
+(checked on synthetic data in ``tests/analysis/test_seeds.py``). In a ranking
+(:func:`rank_seeds`) the claims against the next VUT form one family, adjusted by Holm's
+procedure (:mod:`.multiplicity`), so that all of a leaderboard's "safer than" claims together
+are wrong with probability at most ``alpha``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections.abc import Mapping, Sequence
@@ -28,7 +32,14 @@ from typing import Literal
 
 import numpy as np
 
-from sumo_ayss.analysis.seed_intervals import UNBOUNDED, Bounds, seed_mean_ci
+from sumo_ayss.analysis.multiplicity import chain_adjusted
+from sumo_ayss.analysis.seed_intervals import (
+    MIN_SEEDS_FOR_INTERVAL,
+    UNBOUNDED,
+    Bounds,
+    clip_interval,
+    seed_mean_ci,
+)
 from sumo_ayss.analysis.stats import check_level, student_t_sf, t_quantile
 from sumo_ayss.util.errors import ConfigError
 
@@ -103,7 +114,12 @@ class SeedComparison:
         n_a: Seeds of A.
         n_b: Seeds of B.
         level: Confidence level of the interval.
-        alpha: Significance threshold of ``p``.
+        alpha: Significance threshold of ``p`` (of ``p_family`` when there is one).
+        p_family: ``p`` adjusted for the family of claims of the ranking it belongs to
+            (:func:`~.multiplicity.chain_adjusted`: Holm over the adjacent pairs); None for
+            a comparison made on its own (then ``p`` decides).
+        family_size: Tests in that family (the ranking's adjacent pairs with a test); 0
+            without a family.
     """
 
     name_a: str
@@ -117,11 +133,18 @@ class SeedComparison:
     n_b: int
     level: float
     alpha: float
+    p_family: float | None = None
+    family_size: int = 0
+
+    @property
+    def p_decision(self) -> float:
+        """The p that decides significance: ``p_family`` in a ranking, else ``p``."""
+        return self.p if self.p_family is None else self.p_family
 
     @property
     def significant(self) -> bool:
-        """Whether ``p < alpha``."""
-        return math.isfinite(self.p) and self.p < self.alpha
+        """Whether the deciding p (:attr:`p_decision`) is below ``alpha``."""
+        return math.isfinite(self.p_decision) and self.p_decision < self.alpha
 
     def a_higher(self) -> bool | None:
         """True if A's score is significantly higher, False if lower, None if neither."""
@@ -131,15 +154,26 @@ class SeedComparison:
 
 
 def compare_seeds(
-    a: SeedScores, b: SeedScores, *, level: float = 0.95, alpha: float = 0.05
+    a: SeedScores,
+    b: SeedScores,
+    *,
+    level: float = 0.95,
+    alpha: float = 0.05,
+    bounds: Bounds = UNBOUNDED,
 ) -> SeedComparison:
     """Compares two VUTs' per-seed scores: paired t over shared seeds, else Welch.
+
+    The interval of ``A - B`` follows the per-VUT intervals' two rules
+    (:mod:`.seed_intervals`): none with fewer than :data:`MIN_SEEDS_FOR_INTERVAL` seeds on
+    either side (the test's p is still given, with its few degrees of freedom), and never
+    past what a difference of two scores in ``bounds`` can be (``±(high - low)``).
 
     Args:
         a: Scores of VUT A.
         b: Scores of VUT B.
         level: Confidence level of the interval of ``A - B``, in (0, 1).
         alpha: Significance threshold, in (0, 1).
+        bounds: The score's possible range (``(0, 1)`` for harm per episode).
 
     Returns:
         The :class:`SeedComparison`.
@@ -151,6 +185,16 @@ def compare_seeds(
     alpha = check_level(alpha, "alpha")
     if a.name == b.name:
         raise ConfigError(f"b.name: must differ from a.name ({a.name!r})")
+    c = _compare(a, b, level, alpha)
+    if min(c.n_a, c.n_b) < MIN_SEEDS_FOR_INTERVAL:
+        return dataclasses.replace(c, lo=math.nan, hi=math.nan)
+    width = float(bounds[1]) - float(bounds[0])
+    lo, hi = clip_interval(c.lo, c.hi, (-width, width) if math.isfinite(width) else UNBOUNDED)
+    return dataclasses.replace(c, lo=lo, hi=hi)
+
+
+def _compare(a: SeedScores, b: SeedScores, level: float, alpha: float) -> SeedComparison:
+    """:func:`compare_seeds` before its interval rules."""
     xa, xb = a.array, b.array
     diff = float(xa.mean() - xb.mean())
     nan = math.nan
@@ -246,7 +290,10 @@ def rank_seeds(
 
     Returns:
         ``(rows, pairs)``: the ranking, safest first (ties broken by name), and the
-        comparison of every pair in ranking order (A ranked above B).
+        comparison of every pair in ranking order (A ranked above B). Every comparison
+        carries its family-adjusted p (:func:`~.multiplicity.chain_adjusted`: Holm over the
+        adjacent pairs, a pair further apart claimed through the chain between them), which
+        decides its ``significant``; the raw ``p`` stays beside it.
 
     Raises:
         ConfigError: If ``scores`` is empty or names repeat.
@@ -258,8 +305,16 @@ def rank_seeds(
         raise ConfigError(f"scores: duplicate VUT names {names}")
     sign = -1.0 if higher_is_safer else 1.0
     order = sorted(scores, key=lambda s: (sign * float(s.array.mean()), s.name))
+    raw = {
+        (a.name, b.name): compare_seeds(a, b, level=level, alpha=alpha, bounds=bounds)
+        for a, b in itertools.combinations(order, 2)
+    }
+    names_in_order = [s.name for s in order]
+    adjacent = [raw[pair] for pair in itertools.pairwise(names_in_order)]
+    family = chain_adjusted(names_in_order, [c.p for c in adjacent])
+    size = sum(math.isfinite(c.p) for c in adjacent)
     pairs = [
-        compare_seeds(a, b, level=level, alpha=alpha) for a, b in itertools.combinations(order, 2)
+        dataclasses.replace(c, p_family=family[key], family_size=size) for key, c in raw.items()
     ]
     by_pair = {(p.name_a, p.name_b): p for p in pairs}
     rows = []

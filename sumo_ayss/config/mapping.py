@@ -20,19 +20,20 @@ from typing import Any, Literal
 from sumo_ayss.config.env import EnvConfig
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.validation import check_choice, unknown_key
-from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
+from sumo_ayss.vuts.catalog import DRIVER_KEYS, ControllerSpec, VehicleType
+from sumo_ayss.vuts.controller_spec import DEFAULT_CALL_DEADLINE_S
 
 
 def _anchor_controller(spec: ControllerSpec, base_dir: Path) -> ControllerSpec:
-    """A ``path/to/file.py:attr`` target made absolute against ``base_dir`` (the YAML
-    file's folder), like every other path of a configuration; module targets unchanged."""
-    module_part, _, attr = spec.target.rpartition(":")
-    if not module_part.endswith(".py"):
-        return spec
-    path = Path(module_part).expanduser()
-    if path.is_absolute():
-        return spec
-    return dataclasses.replace(spec, target=f"{(base_dir / path).resolve()}:{attr}")
+    """The spec's paths (a ``file.py`` target, an FMU, a process's folder) made absolute
+    against ``base_dir`` (the YAML file's folder), like every other path of a configuration."""
+    return spec.anchored(base_dir)
+
+
+def _names_black_box(value: Mapping[Any, Any]) -> bool:
+    """Whether a VUT entry is driven by an FMU or a process (a driver key other than
+    ``controller``, :data:`~sumo_ayss.vuts.catalog.DRIVER_KEYS`)."""
+    return any(value.get(key) is not None for key in DRIVER_KEYS if key != "controller")
 
 
 def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> Any:
@@ -42,15 +43,17 @@ def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> A
         if isinstance(value, ControllerSpec):
             return value
         return _anchor_controller(ControllerSpec.from_mapping(value, where), base_dir)
-    if dataclasses.is_dataclass(tp) and isinstance(tp, type):
-        if isinstance(value, tp):
-            return value
-        return build(tp, value, where, base_dir, default)
-    if tp is VehicleType:
+    if tp is VehicleType and isinstance(value, Mapping) and _names_black_box(value):
+        # An FMU or a process VUT: read whole by the catalog (its record is not a field of
+        # VehicleType's own, so the field-by-field build below would not know the key).
         vt = VehicleType.from_mapping(value, where)
         if vt.controller is None:
             return vt
         return dataclasses.replace(vt, controller=_anchor_controller(vt.controller, base_dir))
+    if dataclasses.is_dataclass(tp) and isinstance(tp, type):
+        if isinstance(value, tp):
+            return value
+        return build(tp, value, where, base_dir, default)
     if origin in (types.UnionType, typing.Union):
         if value is None and type(None) in args:
             return None
@@ -152,6 +155,8 @@ def _field_default(cls: type, name: str) -> Any:
 
 def to_dict(obj: Any) -> Any:
     """Plain YAML-safe form of a config (the exact resolved config a run used)."""
+    if isinstance(obj, VehicleType) and obj.controller is not None:
+        return _controlled_vut_dict(obj)
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         return {f.name: to_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
     if isinstance(obj, Mapping):
@@ -161,6 +166,24 @@ def to_dict(obj: Any) -> Any:
     if isinstance(obj, Path):
         return str(obj)
     return obj
+
+
+def _controlled_vut_dict(vt: VehicleType) -> dict[str, Any]:
+    """A VUT driven by a controller, an FMU or a process, under its own key (``controller``,
+    ``fmu``, ``process``). A Python controller keeps the form it always had (every field;
+    ``call_deadline_s`` only when it is not the default), so existing run files read the same."""
+    spec = vt.controller
+    assert spec is not None
+    out = {f.name: to_dict(getattr(vt, f.name)) for f in dataclasses.fields(vt)}
+    del out["controller"]
+    if type(spec) is ControllerSpec:
+        fields = {f.name: to_dict(getattr(spec, f.name)) for f in dataclasses.fields(spec)}
+        if spec.call_deadline_s == DEFAULT_CALL_DEADLINE_S:
+            del fields["call_deadline_s"]
+        out["controller"] = fields
+    else:
+        out[spec.yaml_key] = spec.to_dict()
+    return out
 
 
 def env_config_from_mapping(data: Mapping[str, Any], base_dir: Path | None = None) -> EnvConfig:

@@ -227,8 +227,10 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         return np.array(values, dtype=np.float32), reward, terminated, truncated, info
 
     def close(self) -> None:
-        """Close SUMO; safe to call twice. A vec-env member leaves the shared SUMO running."""
+        """Close SUMO and the VUT's law; safe to call twice. A vec-env member leaves the
+        shared SUMO running."""
         self._close_sim()
+        self._vut_law.close()
         self._pair = None
         super().close()
 

@@ -240,13 +240,19 @@ class GridProgress:
 
     def header(self) -> str:
         """``"2/8 done, 2 running, 4 queued, 0 failed, 1 retried; 3 min elapsed; ETA ≈ 9
-        min"`` (the retried count only when a job was retried)."""
+        min"`` (the retried count only when a job was retried; jobs handed over beyond the
+        workers as ``"N submitted (waiting for a CPU)"``)."""
         c = self.counts()
         elapsed = format_duration(time.time() - self.t0)
         retried = len(self.retried())
         again = f", {retried} retried" if retried else ""
+        # A backend that hands every job over at once (Ray) has more jobs "running" than
+        # CPUs: those beyond the workers are submitted, waiting for a CPU, not running.
+        running = min(c["running"], self.workers)
+        waiting = c["running"] - running
+        submitted = f", {waiting} submitted (waiting for a CPU)" if waiting else ""
         return (
-            f"{c['done']}/{len(self.statuses)} done, {c['running']} running, "
+            f"{c['done']}/{len(self.statuses)} done, {running} running{submitted}, "
             f"{c['queued']} queued, {c['failed']} failed{again}; {elapsed} elapsed; "
             f"{self.eta_text()}"
         )

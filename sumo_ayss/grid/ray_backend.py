@@ -108,7 +108,7 @@ def run_grid_ray(
         s.start()
         ref = task.remote(s.spec, pack(s.spec.run_dir))
         pending[ref] = s
-        logger.info(progress.line(s, f"started on Ray (try {s.attempts})"))
+        logger.info(progress.line(s, f"submitted to Ray (try {s.attempts})"))
 
     try:
         for s in statuses:

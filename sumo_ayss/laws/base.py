@@ -50,6 +50,10 @@ class VehicleLaw(ABC):
     def accel_mps2(self, pair: VehiclePair) -> float:
         """The vehicle's acceleration during the last SUMO step [m/s²]."""
 
+    def close(self) -> None:
+        """Release what the law holds outside SUMO (an FMU, a process); safe to call twice."""
+        return None  # most laws hold nothing outside SUMO
+
 
 class PovLaw(VehicleLaw):
     """How the POV follows the policy: a target speed [m/s] (and a target lane) -> SUMO."""

@@ -27,7 +27,7 @@ class ControllerVut(VutLaw):
         """Import and build ``config.vut``'s controller (errors name the config field)."""
         spec = config.vut_type.controller
         assert spec is not None
-        where = f"env.vuts.{config.vut}.controller"
+        where = f"env.vuts.{config.vut}.{spec.yaml_key}"
         return cls(ControlledVut(spec.build(where), spec, config.sim.step_length_s))
 
     def start(self, pair: VehiclePair, speed_mps: float) -> None:
@@ -43,3 +43,7 @@ class ControllerVut(VutLaw):
     def accel_mps2(self, pair: VehiclePair) -> float:
         """SUMO's acceleration of the VUT in the last step [m/s²] (the realised command)."""
         return pair.vut_accel_mps2()
+
+    def close(self) -> None:
+        """Release the controller's FMU instance or process, if it has one."""
+        self.driver.close()

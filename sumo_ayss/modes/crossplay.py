@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from sumo_ayss.modes.formatting import ranking_line
+from sumo_ayss.modes.formatting import fmt_p_family, ranking_line
 from sumo_ayss.modes.registry import Mode, Standing, get_mode, register_mode
 from sumo_ayss.modes.seed_level import (
     INTERVAL_NAME,
@@ -52,19 +52,22 @@ def _fmt(x: float) -> str:
 
 def crossplay_sentence(c: SeedComparison, blocks: str = "seed") -> str:
     """One quotable sentence for a cross-play comparison (A ranked above B)."""
-    unit = "training seeds (blocks of opponents)" if blocks == "seed" else "opponent SPCPs"
+    from sumo_ayss.analysis.seed_intervals import MIN_SEEDS_FOR_INTERVAL
+
+    unit = "training seeds" if blocks == "seed" else "opponent SPCPs"
+    note = "blocks of opponents; " if blocks == "seed" else ""
     pct = f"{100 * c.level:g} %"
     b_higher = c.difference < 0
     lo, hi = (-c.hi, -c.lo) if b_higher else (c.lo, c.hi)
     if math.isfinite(lo) and math.isfinite(hi):
-        ci = f"{_fmt(lo)}–{_fmt(hi)}" if lo >= 0 else f"{_fmt(lo)} to {_fmt(hi)}"
+        ci = f"{pct} CI " + (f"{_fmt(lo)}–{_fmt(hi)}" if lo >= 0 else f"{_fmt(lo)} to {_fmt(hi)}")
+    elif c.n_a < MIN_SEEDS_FOR_INTERVAL:
+        ci = f"no interval with {c.n_a} blocks"
     else:
         ci = "interval undefined"
-    if not math.isfinite(c.p):
-        p = "p undefined"
-    else:
-        p = "p < 0.001" if c.p < 0.001 else f"p = {c.p:.3f}"
-    stats = f"{pct} CI {ci}; paired t-test over {c.n_a} {unit}, {p}"
+    p = "p undefined" if not math.isfinite(c.p) else fmt_p_family(c.p, c.p_family, c.family_size)
+    df = f"{c.n_a - 1} degree{'s' if c.n_a != 2 else ''} of freedom"
+    stats = f"{ci}; paired t-test over {c.n_a} {unit} ({note}{df}), {p}"
     more = "more" if b_higher else "less"
     what = (
         f"the pooled SPCPs bring about {abs(c.difference):.3f} {more} harm per episode "
@@ -149,8 +152,13 @@ CROSSPLAY = register_mode(
             "difference between two VUTs is read within each opponent, so the search noise "
             "of one SPCP cancels; two VUTs are compared by a paired t-test over "
             "training-seed blocks (block s = the mean over seed s's opponents; "
-            "report.crossplay_blocks: opponent makes every opponent a block); significant "
-            "when p < alpha. Crash rate and mobility (mean VUT speed) stand beside the "
+            "or one block per opponent where the study's configuration asks for it). A VUT "
+            "is called safer than the next when that test's p, adjusted by Holm over the "
+            "ranking's adjacent pairs, is below the significance level (0.05 unless "
+            "configured: the claims of one leaderboard are then wrong together with "
+            "probability at most 5 %); else the two are tied. With few "
+            "blocks the test has few degrees of freedom (blocks − 1) and needs a difference "
+            "consistent across them. Crash rate and mobility (mean VUT speed) stand beside the "
             "score; a VUT far slower than the others is flagged TIMID."
         ),
         score_name="cross-play harm H per episode (lower = safer)",

@@ -79,8 +79,9 @@ EXPOSURE = register_mode(
             "seed; harm as in cross-play mode); a lower score is a safer VUT. Each training "
             "seed's SPCP is one observation; seeds are shared across VUTs (same seed "
             "values), so two VUTs are compared by a paired t-test on their per-seed "
-            "differences (Welch's t-test when the seed sets differ); significant when p < "
-            "alpha."
+            "differences (Welch's t-test when the seed sets differ); a VUT is called safer "
+            "than the next when that p, adjusted by Holm over the ranking's adjacent pairs, "
+            "is below the significance level (0.05 unless configured)."
         ),
         score_name="exposure harm per episode (lower = safer)",
         interval_name=INTERVAL_NAME,

@@ -15,7 +15,9 @@ __all__ = [
     "fmt_interval",
     "fmt_num",
     "fmt_p",
+    "fmt_p_family",
     "fmt_prob",
+    "rank_labels",
     "ranking_line",
     "seed_interval_text",
 ]
@@ -80,6 +82,27 @@ def fmt_p(p: float | None, *, cap_high: bool = False, undefined: str = "n/a") ->
     return f"= {p:.3f}"
 
 
+def fmt_p_family(
+    p: float | None, p_family: float | None, family_size: int, *, undefined: str = "n/a"
+) -> str:
+    """A raw p with its family-adjusted p beside it: ``"p = 0.017, adjusted p = 0.034 (Holm,
+    2 adjacent claims)"``; the raw p alone where no adjustment applies (no family, or a
+    family of one test whose adjusted p is the raw one).
+
+    Args:
+        p: The test's own p.
+        p_family: Its p adjusted for the ranking's family of claims
+            (:mod:`sumo_ayss.analysis.multiplicity`); None outside a family.
+        family_size: Tests in the family.
+        undefined: The text for an undefined p.
+    """
+    raw = f"p {fmt_p(p, undefined=undefined)}"
+    if p_family is None or (family_size <= 1 and (p_family == p or not _finite(p))):
+        return raw
+    claims = f"{family_size} adjacent claim{'s' if family_size != 1 else ''}"
+    return f"{raw}, adjusted p {fmt_p(p_family, undefined=undefined)} (Holm, {claims})"
+
+
 def fmt_prob(p: float | None) -> str:
     """A probability for a table cell: ``"0.953"``, ``"< 0.001"``, ``"> 0.999"``, ``"—"``."""
     return fmt_p(p, cap_high=True, undefined="—").removeprefix("= ")
@@ -101,22 +124,48 @@ def seed_interval_text(lo: float, hi: float, n_seeds: int, digits: int = 2) -> s
     return f"{n_seeds} seed{'s' if n_seeds != 1 else ''}: no interval"
 
 
+def _tie_groups(n: int, significant_next: Sequence[bool]) -> list[list[int]]:
+    """Positions 0..n-1 grouped where the ranking does not separate neighbours."""
+    if n == 0:
+        return []
+    if len(significant_next) != n - 1:
+        raise ValueError(f"{len(significant_next)} verdicts for {n} VUTs")
+    groups: list[list[int]] = [[0]]
+    for i, sig in enumerate(significant_next, start=1):
+        if sig:
+            groups.append([i])
+        else:
+            groups[-1].append(i)
+    return groups
+
+
 def ranking_line(names: Sequence[str], significant_next: Sequence[bool]) -> str:
     """``"a > b ≈ c"``: ``>`` where a VUT differs significantly from the next, ``≈`` where
-    not. VUTs joined by ``≈`` are listed by name, so that a tie reads the same in every
-    mode (the order inside it is not a finding).
+    not. Names keep the ranking's order inside a tie too, so that the first VUT named is
+    the leaderboard's first row everywhere (the order inside a tie is not a finding: the
+    ``≈`` and the leaderboard's shared rank, :func:`rank_labels`, say so).
 
     Args:
         names: VUTs safest first.
         significant_next: Per VUT but the last, whether it differs significantly from the
             next one.
     """
-    if not names:
-        return ""
-    groups: list[list[str]] = [[names[0]]]
-    for sig, name in zip(significant_next, names[1:], strict=True):
-        if sig:
-            groups.append([name])
-        else:
-            groups[-1].append(name)
-    return " > ".join(" ≈ ".join(sorted(g)) for g in groups)
+    groups = _tie_groups(len(names), significant_next)
+    return " > ".join(" ≈ ".join(names[i] for i in g) for g in groups)
+
+
+def rank_labels(significant_next: Sequence[bool]) -> list[str]:
+    """Each VUT's rank as a leaderboard shows it: ``"1"``, or ``"2–3"`` for every VUT of a
+    tie (neighbours the ranking does not separate) spanning ranks 2 to 3.
+
+    Args:
+        significant_next: Per VUT but the last, whether it differs significantly from the
+            next one (so ``len + 1`` VUTs).
+    """
+    n = len(significant_next) + 1
+    labels = [""] * n
+    for g in _tie_groups(n, significant_next):
+        text = str(g[0] + 1) if len(g) == 1 else f"{g[0] + 1}–{g[-1] + 1}"
+        for i in g:
+            labels[i] = text
+    return labels

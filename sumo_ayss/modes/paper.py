@@ -24,7 +24,15 @@ if TYPE_CHECKING:
     from sumo_ayss.analysis.significance import PairVerdict, SignificanceOptions
     from sumo_ayss.analysis.verdict import Verdict
 
-__all__ = ["PAPER", "pair_sentence", "paper_headline", "significance_rule", "verdict_sentence"]
+__all__ = [
+    "MIN_SEEDS_FOR_INTERVAL",
+    "PAPER",
+    "diff_interval",
+    "pair_sentence",
+    "paper_headline",
+    "significance_rule",
+    "verdict_sentence",
+]
 
 NAME = "paper"
 
@@ -46,6 +54,27 @@ def _fmt_h_range(h_range: tuple[float, float]) -> str:
     return f"h ≤ {hi:g} m" if lo == 0.0 else f"{lo:g} m ≤ h ≤ {hi:g} m"
 
 
+#: Fewest seeds per VUT for a printed bootstrap interval (as for the seed-level
+#: t-intervals: resampling two seeds cannot show the seed-to-seed spread).
+MIN_SEEDS_FOR_INTERVAL = 3
+
+
+def diff_interval(v: Verdict, lo: float | None = None, hi: float | None = None) -> str:
+    """The interval of a paired verdict's difference (``lo``/``hi``: the oriented bounds,
+    default ``diff_lo``/``diff_hi``), or "no interval with n seeds" under
+    :data:`MIN_SEEDS_FOR_INTERVAL` seeds on either side."""
+    n = min(v.n_seeds_a, v.n_seeds_b)
+    if n < MIN_SEEDS_FOR_INTERVAL:
+        return f"no interval with {n} seed{'s' if n != 1 else ''}"
+    return fmt_interval(v.diff_lo if lo is None else lo, v.diff_hi if hi is None else hi)
+
+
+def _ci(v: Verdict, pct: str, lo: float | None = None, hi: float | None = None) -> str:
+    """``"95 % CI 0.10–0.80"``, or "no interval with 2 seeds" (:func:`diff_interval`)."""
+    text = diff_interval(v, lo, hi)
+    return text if text.startswith("no interval") else f"{pct} CI {text}"
+
+
 def verdict_sentence(v: Verdict) -> str:
     """One quotable sentence stating a pairwise verdict and its statistics."""
     pct = f"{100.0 * v.level:g} %"
@@ -55,8 +84,7 @@ def verdict_sentence(v: Verdict) -> str:
             f"No significant difference in safety between {v.name_a} and "
             f"{v.name_b}: over {where}, the mean {v.indicator.name} of "
             f"{v.name_b}'s SPCPs minus {v.name_a}'s is "
-            f"{v.indicator.amount(v.difference)} ({pct} CI "
-            f"{fmt_interval(v.diff_lo, v.diff_hi)}; "
+            f"{v.indicator.amount(v.difference)} ({_ci(v, pct)}; "
             f"P({v.name_a} safer) {fmt_p(v.p_a_safer, cap_high=True)}; "
             f"{v.n_seeds_a} vs {v.n_seeds_b} seeds)."
         )
@@ -77,7 +105,7 @@ def _safer_sentence(v: Verdict, pct: str, where: str) -> str:
     n_s, n_o = (v.n_seeds_a, v.n_seeds_b) if a_safer else (v.n_seeds_b, v.n_seeds_a)
     return (
         f"{v.safer} is safer than {other}: its SPCPs {v.indicator.phrase(diff)} on "
-        f"average over {where} ({pct} CI {fmt_interval(lo, hi)}; "
+        f"average over {where} ({_ci(v, pct, lo, hi)}; "
         f"P({v.safer} safer) {fmt_p(p, cap_high=True)}; {n_s} vs {n_o} seeds)."
     )
 
@@ -85,10 +113,15 @@ def _safer_sentence(v: Verdict, pct: str, where: str) -> str:
 def pair_sentence(pair: PairVerdict) -> str:
     """One quotable sentence stating a verdict under the report's significance rule."""
     v = pair.verdict
+    adjusted = (
+        f", adjusted p {fmt_p(pair.p_family)} (Holm over the ranking's adjacent claims)"
+        if pair.p_family is not None and pair.p_family != v.p_seed_welch
+        else ""
+    )
     if v.significant and not pair.significant:
         neutral = verdict_sentence(dataclasses.replace(v, safer=None, significant=False))
         why = (
-            f"the seed-level Welch test gives p {fmt_p(v.p_seed_welch)} "
+            f"the seed-level Welch test gives p {fmt_p(v.p_seed_welch)}{adjusted} "
             f"(needs < {pair.welch_alpha:g})"
             if math.isfinite(v.p_seed_welch)
             else "the seed-level Welch test is undefined (it needs two seeds per VUT with spread)"
@@ -102,6 +135,8 @@ def pair_sentence(pair: PairVerdict) -> str:
         if math.isfinite(v.p_seed_welch)
         else "undefined (it needs two seeds per VUT with spread)"
     )
+    if math.isfinite(v.p_seed_welch):
+        welch += adjusted
     return f"{verdict_sentence(v)} Seed-level Welch test: {welch}."
 
 
@@ -113,7 +148,8 @@ def significance_rule(options: SignificanceOptions) -> str:
         "only when "
         f"BOTH the {pct} hierarchical-bootstrap interval of the difference of their safety "
         "indices excludes 0 AND the seed-level Welch t-test on the per-seed indices gives "
-        f"p < {options.welch_alpha:g}. With only a few seeds per VUT the bootstrap alone is "
+        f"p < {options.welch_alpha:g}, that p adjusted by Holm over the ranking's adjacent "
+        "pairs. With only a few seeds per VUT the bootstrap alone is "
         "anti-conservative (resampling a few seeds understates the seed-to-seed spread), so the "
         "Welch test, which treats each seed's SPCP as one observation, must agree."
     )
@@ -151,8 +187,12 @@ def _standings(a: CaseAnalysis) -> list[Standing]:
                 n_seeds=ranked.n_seeds,
                 next_vut=nxt,
                 significant=pair.significant if pair else None,
-                ranked_apart=bool(ranked.significant_vs_next),
+                ranked_apart=bool(pair.significant) if pair else False,
                 p=pair.verdict.p_seed_welch if pair else None,
+                p_adjusted=pair.p_family if pair else None,
+                margin=pair.verdict.difference if pair else math.nan,
+                margin_lo=pair.verdict.diff_lo if pair else math.nan,
+                margin_hi=pair.verdict.diff_hi if pair else math.nan,
                 test="Welch t" if pair else "",
                 # Tagged like the seed-level modes' sentences ("[exposure mode] ...").
                 vs_next=f"[{NAME} mode] {pair_sentence(pair)}" if pair else "",

@@ -7,6 +7,7 @@ configuration validates ``report.mode`` against this registry without loading nu
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -49,7 +50,16 @@ class Standing:
             None for the last, or when the two are not comparable.
         ranked_apart: Whether the ranking itself separates this VUT from the next (the
             order check counts these adjacent pairs).
-        p: p-value of the mode's test against ``next_vut``; None without a test.
+        p: Raw p-value of the mode's test against ``next_vut``; None without a test.
+        p_adjusted: That p adjusted for the ranking's family of claims (Holm over the
+            adjacent pairs, :mod:`sumo_ayss.analysis.multiplicity`), which decides
+            ``significant``; None without a test.
+        margin: How much safer this VUT is than ``next_vut``, in the score's unit and
+            oriented so that positive = safer (the paired difference the test is about;
+            NaN for the last or without one).
+        margin_lo: Lower bound of its interval at the report's level (NaN where the seeds
+            cannot support one, :mod:`sumo_ayss.analysis.seed_intervals`).
+        margin_hi: Upper bound.
         test: The test's name (``"paired t"``, ``"Welch t"``, ``"none"``); "" without one.
         n_a: Seeds of this VUT in that test.
         n_b: Seeds of the next VUT in that test.
@@ -70,6 +80,10 @@ class Standing:
     n_a: int = 0
     n_b: int = 0
     vs_next: str = ""
+    p_adjusted: float | None = None
+    margin: float = math.nan
+    margin_lo: float = math.nan
+    margin_hi: float = math.nan
 
 
 @dataclass(frozen=True)

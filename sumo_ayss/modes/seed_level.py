@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from sumo_ayss.modes.formatting import (
     fmt_interval,
     fmt_num,
-    fmt_p,
+    fmt_p_family,
     ranking_line,
     seed_interval_text,
 )
@@ -62,7 +62,11 @@ def verdict_sentence(
     """
     pct = f"{100 * c.level:g} %"
     if c.test == "paired t":
-        how = f"paired t-test over {c.n_a} shared seeds"
+        df = c.n_a - 1
+        how = (
+            f"paired t-test over {c.n_a} shared seeds ({df} degree{'s' if df != 1 else ''} "
+            "of freedom)"
+        )
     elif c.test == "Welch t":
         how = f"Welch t-test, {c.n_a} vs {c.n_b} seeds"
     else:
@@ -71,8 +75,16 @@ def verdict_sentence(
     # stated amount: of B - A when B scores higher, of A - B otherwise.
     b_higher = c.difference < 0
     lo, hi = (-c.hi, -c.lo) if b_higher else (c.lo, c.hi)
-    ci = fmt_interval(lo, hi, digits, missing="interval undefined")
-    stats = f"{pct} CI {ci}; {how}, p {fmt_p(c.p, undefined='undefined')}"
+    ci = fmt_interval(lo, hi, digits)
+    n = min(c.n_a, c.n_b)
+    if ci:
+        ci = f"{pct} CI {ci}"
+    elif n < 3:  # :data:`sumo_ayss.analysis.seed_intervals.MIN_SEEDS_FOR_INTERVAL`
+        ci = f"no interval with {n} seed{'s' if n != 1 else ''}"
+    else:
+        ci = "interval undefined"
+    p = fmt_p_family(c.p, c.p_family, c.family_size, undefined="undefined")
+    stats = f"{ci}; {how}, {p}"
     amount = fmt_num(abs(c.difference), digits, minus="-", missing="nan")
     amount += f" {unit}" if unit else ""
     what = score.format(amount=amount, more_less="more" if b_higher else "less")
@@ -88,12 +100,23 @@ def verdict_sentence(
 
 
 def seed_standings(
-    rows: Sequence[SeedRankRow], sentence: Callable[[SeedComparison], str]
+    rows: Sequence[SeedRankRow],
+    sentence: Callable[[SeedComparison], str],
+    *,
+    higher_is_safer: bool = False,
 ) -> list[Standing]:
-    """:class:`Standing` rows of a seed-level ranking; ``sentence`` words a comparison."""
+    """:class:`Standing` rows of a seed-level ranking; ``sentence`` words a comparison.
+
+    ``higher_is_safer`` orients the margin against the next VUT (harm: lower is safer, so
+    the margin is the next VUT's score minus this one's)."""
     out = []
     for i, r in enumerate(rows):
         c = r.vs_next
+        sign = 1.0 if higher_is_safer else -1.0
+        margin = (math.nan, math.nan, math.nan)
+        if c is not None:
+            bounds = sorted((sign * c.lo, sign * c.hi))
+            margin = (sign * c.difference, bounds[0], bounds[1])
         out.append(
             Standing(
                 rank=r.rank,
@@ -106,22 +129,32 @@ def seed_standings(
                 significant=c.significant if c is not None else None,
                 ranked_apart=bool(r.significant_vs_next),
                 p=c.p if c is not None else None,
+                p_adjusted=c.p_decision if c is not None else None,
                 test=c.test if c is not None else "",
                 n_a=c.n_a if c is not None else 0,
                 n_b=c.n_b if c is not None else 0,
                 vs_next=sentence(c) if c is not None else "",
+                margin=margin[0],
+                margin_lo=margin[1],
+                margin_hi=margin[2],
             )
         )
     return out
 
 
 def seed_ends(comparisons: Sequence[SeedComparison], safest: str, least: str) -> tuple[bool, float]:
-    """Whether ``safest`` is found significantly safer than ``least``, and the p-value."""
+    """Whether ``safest`` is found significantly safer than ``least``, and the p-value.
+
+    The known ends are declared before the data are seen: one pre-specified test, so its
+    raw p decides (no family; the ranking's own claims are adjusted,
+    :mod:`sumo_ayss.analysis.multiplicity`).
+    """
     ends = {frozenset((c.name_a, c.name_b)): c for c in comparisons}
     end_cmp = ends.get(frozenset((safest, least)))
     found = (
         end_cmp is not None
-        and end_cmp.significant
+        and math.isfinite(end_cmp.p)
+        and end_cmp.p < end_cmp.alpha
         and end_cmp.name_a == safest  # ranked above, i.e. found safer
     )
     return found, end_cmp.p if end_cmp is not None else math.nan

@@ -12,7 +12,9 @@ They read the run records (:class:`~sumo_ayss.run_folder.RunRecord`: each run's
   within noise), or it is clearly below (the curve peaked earlier).
 - :func:`trust_warnings` — sentences for the top of a report (and the terminal) when the
   budget is below :data:`TRUSTED_TIMESTEPS`, the seeds too few for it (no named budget of
-  :mod:`sumo_ayss.config.budget` covers the protocol), or SPCPs may still be improving.
+  :mod:`sumo_ayss.config.budget` covers the protocol), or SPCPs may still be improving at
+  such a budget; :func:`budget_note` — at a validated budget, what was validated and what
+  was not, once.
 - :func:`mixing_problems` — runs that must not be pooled: the same (case, VUT, seed) twice,
   or runs of one case whose configurations differ other than by VUT and seed.
 - :func:`input_problems` — the missing, unreadable or empty input files of analysed cases,
@@ -31,7 +33,7 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from sumo_ayss.config.budget import BUDGETS
+from sumo_ayss.config.budget import BUDGETS, Budget
 from sumo_ayss.run_folder import Training
 
 if TYPE_CHECKING:
@@ -66,15 +68,35 @@ def fewest_seeds(keys: Iterable[tuple[str, str]]) -> int | None:
     return min(counts.values()) if counts else None
 
 
+def validated_budget(
+    runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None
+) -> tuple[str, Budget] | None:
+    """The largest named budget (:data:`~sumo_ayss.config.budget.BUDGETS`) whose transitions
+    and seeds ``runs`` meet (every run's budget known), or None."""
+    totals = [t.total_timesteps for _, t in runs]
+    if not totals or seeds_per_vut is None or any(t is None for t in totals):
+        return None
+    total = min(t for t in totals if t is not None)
+    met = [
+        (name, b)
+        for name, b in BUDGETS.items()
+        if total >= b.total_timesteps and seeds_per_vut >= b.seeds
+    ]
+    return max(met, key=lambda nb: nb[1].total_timesteps) if met else None
+
+
 def trust_warnings(
     runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None = None
 ) -> list[str]:
     """Sentences that say why verdicts built on ``runs`` (``(label, training)``) are weak.
 
-    Empty when every run trained at least :data:`TRUSTED_TIMESTEPS` transitions, the
+    Empty when every run trained at least :data:`TRUSTED_TIMESTEPS` transitions and the
     protocol (the smallest budget, ``seeds_per_vut`` when given: the fewest seeds of any VUT)
     meets one of the named budgets validated on ladders (:data:`~sumo_ayss.config.budget.
-    BUDGETS`: at least its transitions and its seeds), and every SPCP has peaked.
+    BUDGETS`: at least its transitions and its seeds). SPCPs that were the last candidate of
+    their training are a warning only at a budget no ladder validated: at a validated one the
+    verdict curve found the ranking unchanged by more training, and :func:`budget_note` says
+    so (issue 35: a warning on every default run taught users to ignore it).
     """
     out = []
     budgets_known = {t.total_timesteps for _, t in runs if t.total_timesteps is not None}
@@ -108,13 +130,53 @@ def trust_warnings(
             f"{len(unknown)} of {len(runs)} runs: " + ", ".join(unknown) + "."
         )
     improving = [label for label, t in runs if t.still_improving]
-    if improving:
+    if improving and (out or validated_budget(runs, seeds_per_vut) is None):
         out.append(
             f"{len(improving)} of {len(runs)} SPCPs may still be improving (the SPCP is the "
-            "last candidate: the learning curve was at its best when training stopped); more "
-            "training could change them and the verdicts. Runs: " + ", ".join(improving) + "."
+            "last candidate of its training), at a budget whose ranking no ladder validated: "
+            "more training could change them and the verdicts (the runs are listed under "
+            "Inputs)."
         )
     return out
+
+
+def budget_note(runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None) -> str | None:
+    """What the evidence for this protocol's budget covers and what it does not, one
+    paragraph, at a budget validated on ladders (:func:`validated_budget`) with nothing to
+    warn about (:func:`trust_warnings` empty); None otherwise."""
+    found = validated_budget(runs, seeds_per_vut)
+    if found is None or trust_warnings(runs, seeds_per_vut):
+        return None
+    name, b = found
+    total = min(t.total_timesteps or 0 for _, t in runs)
+    improving = sum(1 for _, t in runs if t.still_improving)
+    last = (
+        f"{improving} of {len(runs)} SPCPs were the last candidate of their training (listed "
+        "under Inputs); on the ladders the ranking did not depend on that"
+        if improving
+        else "every SPCP had peaked or reached a plateau"
+    )
+    paper = (
+        "; the paper mode's AYSS reading was validated at the paper budget only"
+        if name != "paper"
+        else ""
+    )
+    return (
+        f"Budget: {total:,} transitions per run and {seeds_per_vut} or more seeds per VUT, at "
+        f"least the '{name}' budget ({b.total_timesteps:,} transitions, {b.seeds} seeds). "
+        "Validated at this budget: the cross-play ranking of the validation ladders (braking, "
+        "ACC time gap, minGap, time headway; reaction time in cut-in) came out in their known "
+        "order, and the verdict curve found the same order at every budget it tried, from "
+        "10,000 to 100,000 transitions (docs/performance.md). Not validated: that each SPCP "
+        "has converged ("
+        f"{last}); VUT kinds unlike the ladders' (the reaction-time ladder's car-following "
+        f"order is inverted at every budget){paper}."
+    )
+
+
+def improving_runs(runs: Sequence[tuple[str, Training]]) -> list[str]:
+    """The labels of the runs whose SPCP is the last candidate of their training."""
+    return [label for label, t in runs if t.still_improving]
 
 
 def mixing_problems(

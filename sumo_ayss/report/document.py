@@ -40,7 +40,7 @@ from sumo_ayss.report.blocks import (
     Report,
     Table,
 )
-from sumo_ayss.report.checks import fewest_seeds, mixing_problems, trust_warnings
+from sumo_ayss.report.checks import budget_note, fewest_seeds, mixing_problems, trust_warnings
 from sumo_ayss.report.figstyle import vut_colors
 from sumo_ayss.report.leaderboard import leaderboard_table
 from sumo_ayss.report.load import analyse_runs, group_runs
@@ -130,6 +130,13 @@ def build_report(
     )
     if warnings:
         blocks.append(Callout("Read the verdicts with care", tuple(warnings), "warning"))
+    elif (
+        note := budget_note(
+            [(f"{r.case} {r.label}", r.training) for r in runs],
+            fewest_seeds((r.case, r.vut) for r in runs),
+        )
+    ) is not None:
+        blocks.append(Callout("What this budget's evidence covers", (note,), "info"))
     tables = [t for t in (leaderboard_table(a, options.level) for a in analyses) if t]
     if tables:
         blocks.append(Heading("Leaderboard", 2, "leaderboard"))

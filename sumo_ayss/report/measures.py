@@ -52,11 +52,14 @@ class CaseMeasures:
             measure_rankings`).
         r157: The R157 cut-in share per VUT with the constant ``r157_time_s`` (cut-in only,
             else empty).
-        values: ``{measure column: {vut: finite values}}`` for the figure.
+        values: ``{measure column: {vut: defined values}}`` for the figure (∞ kept: the
+            medians count it).
         r157_time_s: The constant term [s] of R157's condition behind ``r157``.
         r157_alt_s: The other constant shown beside it (0.45 s for 0.35 s, and back).
         r157_alt: The share with ``r157_alt_s``; empty where the tables do not hold the
             closing speed at the intrusion (written before ``r157_closing_mps``).
+        primary_apart: Per adjacent pair of ``primary_order``, whether the primary mode's
+            family-adjusted test separates them (a tie where not).
     """
 
     case: str
@@ -70,6 +73,7 @@ class CaseMeasures:
     r157_time_s: float = R157_TIME_S
     r157_alt_s: float = R157_TIME_MARGIN_S
     r157_alt: tuple[R157Row, ...] = ()
+    primary_apart: tuple[bool, ...] = ()
 
 
 def _primary(a: CaseAnalysis) -> tuple[str, tuple[str, ...]]:
@@ -159,14 +163,30 @@ def case_measures(
         else:
             r157_alt = rows
     values = {
-        m.column: {
-            v: cols[m.column][(cols["vut"] == v) & np.isfinite(cols[m.column])] for v in vuts
-        }
+        m.column: {v: cols[m.column][(cols["vut"] == v) & ~np.isnan(cols[m.column])] for v in vuts}
         for m in MEASURES
     }
     return CaseMeasures(
-        a.case, pool, vuts, mode, order, tuple(rankings), r157, values, r157_time_s, alt_s, r157_alt
+        a.case,
+        pool,
+        vuts,
+        mode,
+        order,
+        tuple(rankings),
+        r157,
+        values,
+        r157_time_s,
+        alt_s,
+        r157_alt,
+        _primary_apart(a, mode),
     )
+
+
+def _primary_apart(a: CaseAnalysis, mode: str) -> tuple[bool, ...]:
+    """Per adjacent pair of the primary ranking, whether its (family-adjusted) test
+    separates them."""
+    rows = a.crossplay_rows if mode == CROSSPLAY.name else a.exposure_rows
+    return tuple(bool(r.significant_vs_next) for r in rows[:-1])
 
 
 def _rows(m: CaseMeasures) -> list[dict[str, object]]:

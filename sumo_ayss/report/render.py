@@ -3,6 +3,10 @@
 * :func:`render_html` — one self-contained file: figures embedded as base64 PNG, inline CSS,
   no JavaScript, no network; it opens offline.
 * :func:`render_markdown` — the same blocks, figures linked by relative path.
+
+Both carry :data:`RENDERER_VERSION` (``summary.md`` as a comment under the title, the HTML as
+a ``generator`` meta tag), so a committed report can be checked to be the current renderer's
+(``tests/report/test_committed_reports.py``).
 """
 
 from __future__ import annotations
@@ -21,7 +25,19 @@ from sumo_ayss.report.blocks import (
     Table,
 )
 
-__all__ = ["render_html", "render_markdown"]
+__all__ = ["RENDERER_VERSION", "render_html", "render_markdown", "renderer_stamp"]
+
+RENDERER_VERSION = 2
+"""The report's renderer version. Bump it whenever what a report says or shows changes (a
+statistic, a table, a sentence), then regenerate the committed reports
+(``scripts/regenerate_reports.sh``): a test fails while a committed ``summary.md`` carries
+another version. 1: every report before issue 35 (unstamped); 2: issue 35 (family-wise
+claims, paired margins, one banner)."""
+
+
+def renderer_stamp() -> str:
+    """The stamp line of ``summary.md``: ``<!-- sumo_ayss report renderer 2 -->``."""
+    return f"<!-- sumo_ayss report renderer {RENDERER_VERSION} -->"
 
 
 _CSS = """
@@ -129,6 +145,7 @@ def render_html(report: Report) -> str:
         "<!DOCTYPE html>\n"
         '<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
+        f'<meta name="generator" content="sumo_ayss report renderer {RENDERER_VERSION}">'
         f"<title>{_e(report.title)}</title><style>{_CSS}</style></head>\n"
         f"<body><main><h1>{_e(report.title)}</h1>"
         f'<p class="sub">{_e(report.subtitle)}</p><nav>{nav}</nav>\n{body}\n'
@@ -183,6 +200,6 @@ def render_markdown(report: Report, base: Path) -> str:
     Returns:
         The Markdown text.
     """
-    parts = [f"# {report.title}", f"*{report.subtitle}*"]
+    parts = [f"# {report.title}\n{renderer_stamp()}", f"*{report.subtitle}*"]
     parts += [_md_block(b, base) for b in report.blocks]
     return "\n\n".join(parts) + "\n"

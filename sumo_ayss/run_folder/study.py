@@ -91,18 +91,27 @@ RANKING_COLUMNS = (
     "episodes",
     "mobility_mps",
     "timid",
+    "p_vs_next_adjusted",
+    "margin_vs_next",
+    "margin_lo",
+    "margin_hi",
 )
 """``ranking.csv``'s columns. ``score``: harm per episode in cross-play and exposure mode
 (:mod:`sumo_ayss.analysis.harm`, lower = safer), the AYSS safety index in paper mode (higher
 = safer); ``lo``/``hi`` its interval, ``n_seeds`` the seeds or blocks behind it;
-``p_vs_next``, ``significant_vs_next`` and ``vs_next`` (a sentence) compare the VUT with the
-next one. ``crash_rate`` with its Wilson interval ``crash_lo``/``crash_hi`` (fractions),
-``crashes`` of ``episodes``, ``mobility_mps`` (mean VUT speed, m/s) and ``timid`` (mobility
-below 80 % of the median VUT's) describe the same episodes as the score; empty in paper
-mode."""
+``p_vs_next`` (the test's raw p), ``p_vs_next_adjusted`` (adjusted for the ranking's family
+of claims: Holm over the adjacent pairs, :mod:`sumo_ayss.analysis.multiplicity`; it decides
+``significant_vs_next``) and ``vs_next`` (a sentence) compare the VUT with the next one;
+``margin_vs_next`` is how much safer it is than the next (the paired difference the test is
+about, score unit, positive = safer) with its interval ``margin_lo``/``margin_hi`` (empty
+where the seeds cannot support one). ``crash_rate`` with its Wilson interval
+``crash_lo``/``crash_hi`` (fractions), ``crashes`` of ``episodes``, ``mobility_mps`` (mean
+VUT speed, m/s) and ``timid`` (mobility below 80 % of the median VUT's) describe the same
+episodes as the score; empty in paper mode."""
 
 _RANKING_ADDED = RANKING_COLUMNS[RANKING_COLUMNS.index("crash_rate") :]
-"""The columns a ``ranking.csv`` written before crashes and mobility were recorded lacks."""
+"""The columns a ``ranking.csv`` written before crashes and mobility (and, later, the
+family-adjusted p and the margin against the next VUT) were recorded lacks."""
 
 MEASURES_COLUMNS = (
     "case",

@@ -17,22 +17,18 @@ Decelerations (``decel``, ``emergencyDecel``, ``apparentDecel``) are positive nu
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
-import hashlib
-import importlib
-import importlib.util
-import inspect
-import sys
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 from xml.sax.saxutils import quoteattr
 
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.frozen import FrozenMap
 from sumo_ayss.util.validation import check_keys, suggest
+from sumo_ayss.vuts.controller_spec import ControllerSpec as ControllerSpec
+from sumo_ayss.vuts.controller_spec import controller_imports as controller_imports
+from sumo_ayss.vuts.fmu_spec import FmuSpec
+from sumo_ayss.vuts.process_spec import ProcessSpec
 from sumo_ayss.vuts.vtype_params import (
     COMMON_PARAMS,
     CONTROLLED_BODY_PARAMS,
@@ -40,241 +36,16 @@ from sumo_ayss.vuts.vtype_params import (
     PARAM_SPECS,
     REQUIRED_PARAMS,
     UNSUPPORTED_MODELS,
-    as_number,
     check_param,
     fmt_number,
     random_draws,
 )
 
-# ------------------------------------------------------------------------------ controllers
-
-
-@dataclass(frozen=True)
-class ControllerSpec:
-    """A user's controller as the VUT: what to import, its parameters, its declared limits.
-
-    The object named by ``target`` is called with ``params`` as keyword arguments and must
-    return an object with an ``acceleration(state) -> float`` method (and optionally
-    ``reset()``), see :class:`sumo_ayss.vuts.controllers.Controller`. The testbed bounds every
-    command to ``[-max_decel_mps2, max_accel_mps2]`` and the speed to
-    ``[0, max_speed_mps]``.
-
-    YAML (a VUT entry of ``env.vuts``)::
-
-        acc_tg2:
-          description: constant time-gap ACC, T = 2 s
-          params: {length: 5.0}            # SUMO body only: length, width, height, minGap
-          controller:
-            target: examples.acc_controller:TimeGapACC
-            params: {time_gap_s: 2.0}
-            max_accel_mps2: 3.0
-            max_decel_mps2: 6.0
-
-    Attributes:
-        target: ``"package.module:attr"`` (imported with :mod:`importlib`; the module must be
-            importable, e.g. from the working directory or an installed package) or
-            ``"path/to/file.py:attr"`` (a file; relative to the YAML file that names it).
-            ``attr`` may be dotted (``module:Outer.Inner``); it must name a class with an
-            ``acceleration(state)`` method, checked before the class is instantiated.
-        max_accel_mps2: Largest acceleration the vehicle can realise [m/s²], > 0.
-        max_decel_mps2: Largest deceleration the vehicle can realise [m/s²], a positive
-            number (commands below ``-max_decel_mps2`` are clipped to it).
-        params: Keyword arguments of the target (JSON/YAML values).
-        max_speed_mps: Top speed of the vehicle [m/s], > 0.
-        sensor_range_m: The leader is seen up to this bumper-to-bumper gap [m], > 0.
-    """
-
-    target: str
-    max_accel_mps2: float
-    max_decel_mps2: float
-    params: Mapping[str, Any] = field(default_factory=dict)
-    max_speed_mps: float = 40.0
-    sensor_range_m: float = 250.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "params", FrozenMap(dict(self.params)))
-
-    def validate(self, where: str) -> None:
-        """Raise :class:`ConfigError` naming ``where`` if the limits or the target's form
-        are bad.
-
-        Reading a config runs no user code: the target is imported, and the controller
-        built from ``params``, when an env that drives this VUT is built (:meth:`build`,
-        at the start of a run, so a wrong target or parameter still fails before training).
-        """
-        if not isinstance(self.target, str) or ":" not in self.target:
-            raise ConfigError(
-                f"{where}.target must be 'package.module:attr' or 'file.py:attr', "
-                f"got {self.target!r}"
-            )
-        for name in ("max_accel_mps2", "max_decel_mps2", "max_speed_mps", "sensor_range_m"):
-            value = as_number(f"{where}.{name}", getattr(self, name))
-            if value <= 0:
-                raise ConfigError(f"{where}.{name} must be > 0, got {value!r}")
-        if not isinstance(self.params, Mapping):
-            raise ConfigError(f"{where}.params must be a mapping, got {self.params!r}")
-
-    def resolve(self, where: str = "controller") -> type:
-        """The class ``target`` names, imported; nothing of it is called.
-
-        Raises:
-            ConfigError: The target cannot be imported, imports are not allowed here
-                (``controller_imports(False)``: a run folder opened untrusted), or it is not
-                a class with a callable ``acceleration`` (``subprocess:getoutput`` is not).
-        """
-        if not _CONTROLLER_IMPORTS.get() and not self.target.startswith("sumo_ayss."):
-            raise ConfigError(
-                f"{where}.target {self.target!r}: this VUT is a user controller, and importing "
-                "it runs code named by the run folder; pass --trust-controller if you trust "
-                "the folder (see 'Trust model' in the README; sumo_ayss.* is always allowed)"
-            )
-        module_part, _, attr_part = self.target.rpartition(":")
-        try:
-            module = _import(module_part)
-        except Exception as e:  # any error while importing user code
-            raise ConfigError(
-                f"{where}.target {self.target!r}: cannot import {module_part!r} "
-                f"({type(e).__name__}: {e})"
-            ) from e
-        obj: Any = module
-        for part in attr_part.split("."):
-            if not hasattr(obj, part):
-                raise ConfigError(
-                    f"{where}.target {self.target!r}: {module_part!r} has no attribute "
-                    f"{attr_part!r}"
-                )
-            obj = getattr(obj, part)
-        method = inspect.getattr_static(obj, "acceleration", None)  # runs no descriptor
-        if isinstance(method, staticmethod | classmethod):
-            method = method.__func__
-        if not inspect.isclass(obj) or not callable(method):
-            kind = "function" if inspect.isroutine(obj) else type(obj).__name__
-            what = (
-                f"the class {obj.__name__}, which has no"
-                if inspect.isclass(obj)
-                else f"a {kind}, not a class with an"
-            )
-            raise ConfigError(
-                f"{where}.target {self.target!r} is {what} acceleration(state) method (see "
-                "sumo_ayss.vuts.controllers.Controller)"
-            )
-        return obj
-
-    def build(self, where: str = "controller") -> Any:
-        """A new controller instance: ``target(**params)``; the target is checked to be a
-        class with ``acceleration`` first (:meth:`resolve`), the instance after."""
-        cls = self.resolve(where)
-        try:
-            controller = cls(**dict(self.params))
-        except Exception as e:  # user code: report whatever it raised, with the field
-            raise ConfigError(
-                f"{where}.params {dict(self.params)!r} rejected by {self.target!r} "
-                f"({type(e).__name__}: {e})"
-            ) from e
-        if not callable(getattr(controller, "acceleration", None)):
-            raise ConfigError(
-                f"{where}.target {self.target!r} built {type(controller).__name__}, which has "
-                "no acceleration(state) method (see sumo_ayss.vuts.controllers.Controller)"
-            )
-        reset = getattr(controller, "reset", None)
-        if reset is not None and not callable(reset):
-            raise ConfigError(f"{where}: {type(controller).__name__}.reset is not callable")
-        return controller
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain YAML-safe form (the inverse of :meth:`from_mapping`)."""
-        return {
-            "target": self.target,
-            "params": dict(self.params),
-            "max_accel_mps2": self.max_accel_mps2,
-            "max_decel_mps2": self.max_decel_mps2,
-            "max_speed_mps": self.max_speed_mps,
-            "sensor_range_m": self.sensor_range_m,
-        }
-
-    @classmethod
-    def from_mapping(cls, value: Any, where: str) -> ControllerSpec:
-        """Build from a YAML mapping (keys as in :meth:`to_dict`; ``params`` optional)."""
-        if not isinstance(value, Mapping):
-            raise ConfigError(
-                f"{where} must be a mapping with target, max_accel_mps2, max_decel_mps2 "
-                f"(and optionally params, max_speed_mps, sensor_range_m), got {value!r}"
-            )
-        check_keys(
-            where,
-            value,
-            (
-                "target",
-                "params",
-                "max_accel_mps2",
-                "max_decel_mps2",
-                "max_speed_mps",
-                "sensor_range_m",
-            ),
-        )
-        for key in ("target", "max_accel_mps2", "max_decel_mps2"):
-            if key not in value:
-                raise ConfigError(
-                    f"{where}.{key} is required (a controller VUT declares what it is and "
-                    "its acceleration limits)"
-                )
-        params = value.get("params", {}) or {}
-        if not isinstance(params, Mapping):
-            raise ConfigError(f"{where}.params must be a mapping, got {params!r}")
-        kwargs = {k: value[k] for k in ("max_speed_mps", "sensor_range_m") if k in value}
-        spec = cls(
-            target=value["target"],
-            max_accel_mps2=value["max_accel_mps2"],
-            max_decel_mps2=value["max_decel_mps2"],
-            params={str(k): v for k, v in params.items()},
-            **kwargs,
-        )
-        spec.validate(where)
-        return spec
-
-
-#: Whether user controllers may be imported now (see :func:`controller_imports`).
-_CONTROLLER_IMPORTS: contextvars.ContextVar[bool] = contextvars.ContextVar(
-    "sumo_ayss_controller_imports", default=True
+#: The keys of a VUT entry that name what drives it instead of a SUMO model, and the record
+#: each is read into: a Python class, an FMI co-simulation FMU, an external process.
+DRIVER_KEYS: Mapping[str, type[ControllerSpec]] = FrozenMap(
+    {"controller": ControllerSpec, "fmu": FmuSpec, "process": ProcessSpec}
 )
-
-
-@contextlib.contextmanager
-def controller_imports(allowed: bool) -> Iterator[None]:
-    """Allow or forbid importing user controllers inside the ``with`` block.
-
-    Reading a config never imports a controller; building an env whose VUT it drives does
-    (:meth:`ControllerSpec.build`). Configs a user passes (``train``, ``pipeline``) are
-    trusted; a run folder's ``config.yaml`` is evaluated or replayed with ``allowed=False``
-    unless the user passed ``--trust-controller``, and building such an env then raises a
-    :class:`ConfigError` naming the flag.
-    """
-    token = _CONTROLLER_IMPORTS.set(bool(allowed))
-    try:
-        yield
-    finally:
-        _CONTROLLER_IMPORTS.reset(token)
-
-
-def _import(module_part: str) -> Any:
-    """Import ``pkg.module``, or load ``path/to/file.py`` (made absolute by the config)."""
-    if module_part.endswith(".py"):
-        path = Path(module_part).expanduser().resolve()
-        name = "sumo_ayss_user_" + hashlib.sha1(str(path).encode()).hexdigest()[:16]
-        if name in sys.modules:
-            return sys.modules[name]
-        spec = importlib.util.spec_from_file_location(name, path)
-        if spec is None or spec.loader is None:
-            raise ImportError(f"no Python file at {path}")
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        try:
-            spec.loader.exec_module(module)
-        except BaseException:
-            del sys.modules[name]
-            raise
-        return module
-    return importlib.import_module(module_part)
 
 
 # ------------------------------------------------------------------------------ vehicle types
@@ -292,7 +63,9 @@ class VehicleType:
             controller only the body (:data:`CONTROLLED_BODY_PARAMS`) may be given.
         description: free text shown in reports (e.g. the paper's spacing s0).
         controller: a user's controller that drives this vehicle instead of SUMO's model,
-            or ``None`` (SUMO's ``model`` drives).
+            or ``None`` (SUMO's ``model`` drives). An FMU (:class:`FmuSpec`, YAML key
+            ``fmu``) and an external process (:class:`ProcessSpec`, key ``process``) are
+            controllers too: the same limits, the same execution.
     """
 
     model: str = "IDM"
@@ -353,7 +126,7 @@ class VehicleType:
                 f"its controller; only its body may be set ({sorted(CONTROLLED_BODY_PARAMS)}), "
                 "its limits go into controller.max_accel_mps2 / max_decel_mps2"
             )
-        self.controller.validate(f"{where}.controller")
+        self.controller.validate(f"{where}.{self.controller.yaml_key}")
 
     def random_draws(self) -> tuple[str, ...]:
         """Why SUMO draws random numbers for this vehicle (empty: none; a controller VUT is
@@ -387,7 +160,7 @@ class VehicleType:
             "description": self.description,
         }
         if self.controller is not None:
-            out["controller"] = self.controller.to_dict()
+            out[self.controller.yaml_key] = self.controller.to_dict()
         return out
 
     @classmethod
@@ -395,18 +168,25 @@ class VehicleType:
         """Build and validate a vehicle type from a YAML mapping.
 
         Keys: ``model`` (default ``IDM``), ``params`` (SUMO vType attributes),
-        ``description``, ``controller`` (see :class:`ControllerSpec`). A
+        ``description``, and at most one of ``controller`` (:class:`ControllerSpec`),
+        ``fmu`` (:class:`FmuSpec`), ``process`` (:class:`ProcessSpec`). A
         :class:`VehicleType` is returned as is.
         """
         if isinstance(value, VehicleType):
             return value
         if not isinstance(value, Mapping):
             raise ConfigError(f"{where} must be a mapping with model and params, got {value!r}")
-        check_keys(where, value, ("model", "params", "description", "controller"))
+        check_keys(where, value, ("model", "params", "description", *DRIVER_KEYS))
+        drivers = [key for key in DRIVER_KEYS if value.get(key) is not None]
+        if len(drivers) > 1:
+            raise ConfigError(
+                f"{where} names {drivers}: a VUT is driven by one of {list(DRIVER_KEYS)}"
+            )
         params = value.get("params", {}) or {}
         if not isinstance(params, Mapping):
             raise ConfigError(f"{where}.params must be a mapping, got {params!r}")
-        controller = value.get("controller")
+        key = drivers[0] if drivers else "controller"
+        controller = value.get(key)
         vt = cls(
             model=str(value.get("model", "IDM")),
             params={str(k): v for k, v in params.items()},
@@ -414,7 +194,7 @@ class VehicleType:
             controller=(
                 None
                 if controller is None
-                else ControllerSpec.from_mapping(controller, f"{where}.controller")
+                else DRIVER_KEYS[key].from_mapping(controller, f"{where}.{key}")
             ),
         )
         vt.validate(where)

@@ -74,17 +74,22 @@ initial condition itself (the state after placement, before the first step).
         max_accel_mps2: 3.0                          # declared limits (required)
         max_decel_mps2: 6.0
 
-A worked example is ``examples/acc_controller.py`` (constant time-gap ACC).
+A worked example is ``examples/acc_controller.py`` (constant time-gap ACC). An FMI
+co-simulation FMU (``fmu:``, :mod:`sumo_ayss.vuts.fmu`) or another program (``process:``,
+:mod:`sumo_ayss.vuts.process`) is executed the same way; every kind's calls are timed
+against ``call_deadline_s`` (:mod:`sumo_ayss.vuts.call_budget`).
 """
 
 from __future__ import annotations
 
 import math
 import numbers
+import time
 from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 from sumo_ayss.sim.pair import SensedObject, VehiclePair, VutSensing
 from sumo_ayss.util.errors import ControllerError
+from sumo_ayss.vuts.call_budget import CallBudget
 from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
 
 __all__ = [
@@ -199,6 +204,8 @@ class ControlledVut:
         last_request_mps2: What the controller asked for [m/s²], before bounding.
         last_command_mps2: The acceleration realised in the last step [m/s²] (bounded,
             and zero-speed / top-speed clipped).
+        budget: Per-call wall time against ``spec.call_deadline_s``
+            (:mod:`sumo_ayss.vuts.call_budget`).
     """
 
     def __init__(self, controller: Any, spec: ControllerSpec, dt_s: float) -> None:
@@ -208,6 +215,7 @@ class ControlledVut:
         self.last_state: ControllerInput | None = None
         self.last_request_mps2 = 0.0
         self.last_command_mps2 = 0.0
+        self.budget = CallBudget(spec.label, spec.call_deadline_s)
 
     @classmethod
     def from_vehicle_type(
@@ -248,19 +256,29 @@ class ControlledVut:
         """
         state = self.observe(pair)
         spec = self.spec
+        start_s = time.perf_counter()
         try:
             request = self.controller.acceleration(state)
+        except ControllerError:  # an FMU or process driver's own, already naming the VUT
+            raise
         except Exception as e:  # user code: stop the run with the controller named
             raise ControllerError(
                 f"controller {self.spec.target!r} raised {type(e).__name__}: {e} (state {state})"
             ) from e
+        self.budget.record(start_s, time.perf_counter() - start_s)
         try:
             accel = bound_acceleration(request, spec.max_accel_mps2, spec.max_decel_mps2)
         except ControllerError as e:
-            raise ControllerError(f"{spec.target!r}: {e}") from None
+            raise ControllerError(f"{spec.label}: {e}") from None
         v_next, realised = commanded_speed(state.speed_mps, accel, self.dt_s, spec.max_speed_mps)
         pair.command_vut_speed(v_next)
         self.last_state = state
         self.last_request_mps2 = float(request)
         self.last_command_mps2 = realised
         return realised
+
+    def close(self) -> None:
+        """Release what the controller holds (an FMU instance, a process), if it can."""
+        close = getattr(self.controller, "close", None)
+        if callable(close):
+            close()

@@ -57,3 +57,12 @@ def test_r157_share_per_vut() -> None:
     assert a.lo < 0.5 < a.hi
     assert (b.n_intrusions, b.n_required) == (0, 0) and math.isnan(b.share)
     assert np.isnan([b.lo, b.hi]).all()
+
+
+def test_a_float_tie_is_a_tie() -> None:
+    """Two medians that differ only in the last bits (5.999999999999997 vs
+    6.000000000000003: the same braking reached by two float paths) are a tie, not ranks
+    2 and 1 with tau -1 (issue 35)."""
+    cols = {"vut_max_braking_mps2": [5.999999999999997] * 4 + [6.000000000000003] * 4}
+    (m,) = measure_rankings(VUT, OPP, cols, vuts=["a", "b"], primary_order=["a", "b"], n_boot=50)
+    assert m.ties and [row.rank for row in m.rows] == [1, 1] and math.isnan(m.tau)

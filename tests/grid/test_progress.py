@@ -201,3 +201,13 @@ def test_pipeline_final_messages_name_a_job_that_passed_on_retry(tmp_path: Path)
         "RETRIED car_following/pi1/seed_0: passed on try 2 after a failure: SimulationError: boom"
     )
     assert expected in lines
+
+
+def test_jobs_handed_over_beyond_the_cpus_read_as_submitted(tmp_path: Path) -> None:
+    """Ray takes every job at once: on 2 CPUs, 3 handed-over jobs are 2 running and 1
+    waiting, not '3 running' (issue 35)."""
+    jobs = _grid(tmp_path, 3)
+    for j in jobs:
+        j.start()
+    header = GridProgress(jobs, 2).header()
+    assert "0/3 done, 2 running, 1 submitted (waiting for a CPU), 0 queued" in header

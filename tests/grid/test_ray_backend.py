@@ -42,7 +42,7 @@ def test_grid_on_a_local_ray_instance(tmp_path: Path, caplog: pytest.LogCaptureF
         ray.shutdown()
     # Every job event, as on the local backend: started and done, with the grid's counts.
     for s in statuses:
-        assert f"{s.spec.name}: started on Ray (try 1)" in caplog.text
+        assert f"{s.spec.name}: submitted to Ray (try 1)" in caplog.text
         assert f"{s.spec.name}: done in " in caplog.text
     assert "2/2 done, 0 running, 0 queued, 0 failed" in caplog.text
     assert "grid finished: 2 done, 0 failed" in caplog.text

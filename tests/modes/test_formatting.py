@@ -9,6 +9,7 @@ from sumo_ayss.modes.formatting import (
     fmt_num,
     fmt_p,
     fmt_prob,
+    rank_labels,
     ranking_line,
     seed_interval_text,
 )
@@ -52,7 +53,11 @@ def test_seed_interval_text_says_why_there_is_none() -> None:
 
 
 def test_ties_read_the_same_in_every_mode() -> None:
-    assert ranking_line(["pi2", "pi1"], [False]) == ranking_line(["pi1", "pi2"], [False])
-    assert ranking_line(["c", "b", "a"], [True, False]) == "c > a ≈ b"
-    assert ranking_line(["c", "b", "a"], [False, True]) == "b ≈ c > a"
+    # The ranking's order inside a tie too: the first VUT named is the leaderboard's first.
+    assert ranking_line(["pi2", "pi1"], [False]) == "pi2 ≈ pi1"
+    assert ranking_line(["c", "b", "a"], [True, False]) == "c > b ≈ a"
+    assert ranking_line(["c", "b", "a"], [False, True]) == "c ≈ b > a"
+    assert rank_labels([False, True]) == ["1–2", "1–2", "3"]
+    assert rank_labels([True, False, False]) == ["1", "2–4", "2–4", "2–4"]
+    assert rank_labels([]) == ["1"]
     assert ranking_line(["a"], []) == "a" and ranking_line([], []) == ""

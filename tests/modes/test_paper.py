@@ -97,7 +97,7 @@ def test_verdict_sentence_no_difference_and_caveat() -> None:
     assert verdict_sentence(verdict) == (
         "No significant difference in safety between x and y: over adversarial-yet-safe "
         "states with 1 m ≤ h ≤ 5 m, the mean Δv̄ of y's SPCPs minus x's is 0.05 m/s "
-        "(90 % CI −0.30 to 0.40; P(x safer) = 0.600; 3 vs 2 seeds). "
+        "(no interval with 2 seeds; P(x safer) = 0.600; 3 vs 2 seeds). "
         "Caution: the two indices average over different headway bins."
     )
 
@@ -142,7 +142,10 @@ def test_pair_sentence_under_the_rule() -> None:
 
 def test_significance_rule_names_the_level_and_alpha() -> None:
     rule = significance_rule(ReportOptions(level=0.9, welch_alpha=0.01))
-    assert "BOTH the 90 % hierarchical-bootstrap interval" in rule and "p < 0.01." in rule
+    assert (
+        "BOTH the 90 % hierarchical-bootstrap interval" in rule
+        and "p < 0.01, that p adjusted by Holm" in rule
+    )
 
 
 def test_paper_headline_words_the_verdict_record() -> None:

@@ -128,3 +128,35 @@ def test_too_few_seeds_for_the_budget_are_named() -> None:
     assert trust_warnings([("a", t100)], seeds_per_vut=2)[0].startswith("Few training seeds")
     assert fewest_seeds([("cut_in", "a"), ("cut_in", "a"), ("cut_in", "b")]) == 1
     assert fewest_seeds([]) is None
+
+
+def test_default_budget_first_screen_claims_nothing_the_verdict_curve_contradicts(
+    tmp_path: Path,
+) -> None:
+    """At the verdict budget (20,000 transitions, 4 seeds) with SPCPs that were the last
+    candidate, the first screen says what was validated and what not, once; it does not say
+    that more training could change the verdicts (the verdict curve found the ranking
+    unchanged by it), and the run list sits in the inputs section, folded."""
+    for vut in ("pi1", "pi2"):
+        for seed in range(4):
+            run = make_run(tmp_path / "runs", "car_following", vut, seed)
+            _set_budget(run, 20_000, 5_000)
+            _set_eval(run, [10.0, 12.0, 13.0], 30_000)  # the SPCP is the last candidate
+    write_report([tmp_path / "runs"], tmp_path / "out", options=FAST)
+    md = (tmp_path / "out" / "summary.md").read_text()
+    first = md.split("## Verdicts")[0]
+    assert "more training could change" not in md
+    assert first.count("Validated at this budget") == 1
+    assert "8 of 8 SPCPs were the last candidate" in first
+    assert "car_following pi1 seed 0" not in first  # the list is in Inputs
+    inputs = md.split("## Inputs")[1]
+    assert "SPCPs that were the last candidate of their training (8 of 8)" in inputs
+    assert "car_following pi1 seed 0" in inputs
+
+
+def test_unvalidated_budget_still_warns_about_improving_spcps() -> None:
+    improving = Training(50_000, 5_000, "k", 10, 50_000, 50_000, 0.0, True)
+    warnings = trust_warnings([("a", improving)], seeds_per_vut=2)
+    assert warnings[0].startswith("Few training seeds")
+    assert "more training could change them" in warnings[-1]
+    assert trust_warnings([("a", improving)], seeds_per_vut=4) == []

@@ -16,7 +16,7 @@ from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.report import write_report
 from sumo_ayss.report.crossplay_figure import crossplay_lines
 from sumo_ayss.report.figstyle import set_wrapped_title, style
-from sumo_ayss.report.leaderboard import leaderboard_rows, leaderboard_text
+from sumo_ayss.report.leaderboard import leaderboard_rows, leaderboard_table, leaderboard_text
 from sumo_ayss.run_folder import load_crossplay, read_run
 from tests.report.test_report import FAST, make_crossplay, make_run
 
@@ -67,10 +67,19 @@ def test_leaderboard_comes_first_with_rank_score_crashes_and_verdict(
     html = crossplay_report.read_text(encoding="utf-8")
     assert html.index('id="leaderboard"') < html.index('id="verdicts"')
     board = _section(html, "leaderboard", "verdicts")
-    for head in ("rank", "VUT", "cross-play harm H per episode", "crash rate", "vs next"):
+    for head in (
+        "rank",
+        "VUT",
+        "cross-play harm H per episode",
+        "crash rate",
+        "vs next",
+        "mean speed",
+    ):
         assert head in board
     assert board.index("pi2") < board.index("pi1")  # pi2 is safer in the synthetic data
-    assert "safer than pi1 (paired t, p" in board
+    # The margin against the next VUT with its interval, then the test.
+    assert re.search(r"safer than pi1 by \d\.\d{3} \(\d\.\d{3}–\d\.\d{3}\); paired t, p", board)
+    assert re.search(r"\d+\.\d m/s", board)  # mobility in the first table
     assert re.search(r"\d\.\d % \(\d+\.\d–\d+\.\d %\), \d+/\d+", board)  # crash rate cell
 
 
@@ -82,7 +91,8 @@ def test_leaderboard_text_fits_80_columns_and_matches_the_report(tmp_path: Path)
     rows = leaderboard_rows(a)
     assert [r.vut for r in rows] == ["pi2", "pi1"]
     assert all(len(line) <= 80 for line in text.splitlines()), text
-    assert rows[0].score in text and rows[0].vs_next in text
+    flat = " ".join(text.split())
+    assert rows[0].score in flat and rows[0].vs_next in flat
 
 
 def test_two_seed_report_prints_no_t_interval_over_two_points(tmp_path: Path) -> None:
@@ -90,7 +100,7 @@ def test_two_seed_report_prints_no_t_interval_over_two_points(tmp_path: Path) ->
     html = write_report([tmp_path], options=FAST).read_text(encoding="utf-8")
     premise = html.split("Outcome of the SPCPs per VUT")[1].split("</table>")[0]
     assert premise.count("2 seeds: no interval") == 6  # 3 metrics x 2 VUTs
-    assert "2 seeds: no interval" in _section(html, "leaderboard", "verdicts")
+    assert "(no interval with 2 seeds)" in _section(html, "leaderboard", "verdicts")
 
 
 def test_premise_crash_rate_intervals_lie_in_0_100(tmp_path: Path) -> None:
@@ -142,7 +152,9 @@ def test_paper_mode_leaderboard_reads_the_safety_index(tmp_path: Path) -> None:
     rows = leaderboard_rows(a)
     assert a.ranking_mode == "paper"
     assert [r.vut for r in rows] == [r.name for r in a.ranking]
-    assert rows[0].score.startswith(fmt_num(a.ranking[0].point)) and "m/s²" in rows[0].score
+    assert rows[0].score == fmt_num(a.ranking[0].point)
+    table = leaderboard_table(a, 0.95)
+    assert table is not None and "m/s²" in table.headers[3]  # the unit, in the score's header
     assert "Welch t, p" in rows[0].vs_next and rows[-1].vs_next == "—"
     assert "safety index (higher = safer)" in leaderboard_text([a])
 

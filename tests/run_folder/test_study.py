@@ -84,7 +84,7 @@ def test_ranking_csv_of_older_studies_and_broken_files(tmp_path: Path) -> None:
     with pytest.raises(TableError, match=r"ranking\.csv: missing columns \['vut'"):
         read_ranking_csv(path)
     path.write_text(",".join(RANKING_COLUMNS) + "\ncut_in,crossplay\n")
-    with pytest.raises(TableError, match=r"ranking\.csv, line 2: expected 19 cells"):
+    with pytest.raises(TableError, match=r"ranking\.csv, line 2: expected 23 cells"):
         read_ranking_csv(path)
     with pytest.raises(TableError, match="unreadable"):
         read_ranking_csv(tmp_path / "missing.csv")

@@ -10,7 +10,7 @@ from pathlib import Path
 from sumo_ayss.analysis.harm import VutOutcome
 from sumo_ayss.analysis.ranking import SafetyIndex
 from sumo_ayss.analysis.seeds import SeedComparison
-from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_prob
+from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p, fmt_prob
 from sumo_ayss.report.blocks import Table
 from sumo_ayss.run_folder import Estimate, RunRecord
 
@@ -53,23 +53,53 @@ def display_path(path: Path, base: Path) -> str:
     return Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()
 
 
+def test_cell(c: SeedComparison | None) -> str:
+    """A comparison's test for a table cell: ``"paired t, p = 0.012, Holm p = 0.024"`` (the
+    raw p, then the family-adjusted p that decides, where they differ); "—" without one."""
+    if c is None:
+        return "—"
+    text = f"{c.test}, p {fmt_p(c.p)}"
+    if c.p_family is not None and c.p_family != c.p and math.isfinite(c.p):
+        text += f", Holm p {fmt_p(c.p_family)}"
+    return text
+
+
+def difference_cell(c: SeedComparison, digits: int = 2) -> str:
+    """``B − A`` with its interval, or why there is none (too few seeds)."""
+    ci = fmt_interval(-c.hi, -c.lo, digits)
+    if not ci:
+        n = min(c.n_a, c.n_b)
+        ci = f"no interval with {n} seed{'s' if n != 1 else ''}"
+    return f"{fmt_num(-c.difference, digits)} ({ci})"
+
+
 def pairs_table(pairs: Sequence[SeedComparison], score: str, pct: str, alpha: float) -> Table:
     """The pairwise comparisons of a seed-level ranking (A ranked above B), ``score`` naming
-    the score (``"E"``, ``"X"``), its difference stated as B minus A."""
+    the score (``"H"``, ``"harm"``), its difference stated as B minus A, with the raw p and
+    the family-adjusted p that decides (Holm over the adjacent pairs; a pair further apart
+    takes the largest along the chain between them)."""
     rows = tuple(
         (
             c.name_a,
             c.name_b,
-            f"{fmt_num(-c.difference)} ({fmt_interval(-c.hi, -c.lo)})",
+            difference_cell(c),
             c.test,
             fmt_prob(c.p),
+            fmt_prob(c.p_decision),
             "yes" if c.significant else "no",
         )
         for c in pairs
     )
-    significant = f"significant (p < {alpha:g})"
-    head = ("A", "B", f"{score}_B − {score}_A ({pct} CI)", "test", "p", significant)
-    numeric = (False, False, True, False, True, False)
+    head = (
+        "A",
+        "B",
+        f"{score}_B − {score}_A ({pct} CI)",
+        "test",
+        "raw p",
+        "adjusted p (Holm, adjacent claims)",
+        f"significant (adjusted p < {alpha:g})",
+    )
+    numeric = (False, False, True, False, True, True, False)
     return Table("Pairwise comparisons (A ranked above B)", head, rows, numeric)
 
 

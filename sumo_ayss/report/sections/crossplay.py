@@ -26,6 +26,7 @@ from sumo_ayss.report.sections.common import (
     display_path,
     mobility_cell,
     pairs_table,
+    test_cell,
 )
 from sumo_ayss.run_folder import CaseFolder, read_adaptive
 from sumo_ayss.util.errors import TableError
@@ -102,7 +103,7 @@ def crossplay_blocks(
                 r.name,
                 f"{fmt_num(r.mean, 3)} ({ci})",
                 str(r.n_seeds),
-                f"{nxt.test}, p {fmt_p(nxt.p)}" if nxt else "—",
+                test_cell(nxt),
                 ("yes" if nxt.significant else "no") if nxt else "—",
                 crash_cell(o),
                 mobility_cell(o),
@@ -129,9 +130,14 @@ def crossplay_blocks(
     if any(o.timid for o in outcomes.values()):
         blocks.append(Callout("Timid VUT", (TIMID_NOTE,), "warning"))
     blocks.append(pairs_table(a.crossplay_pairs, "H", pct, options.welch_alpha))
-    blocks.append(pairs_table(a.crossplay_pairs, "X", pct, options.welch_alpha))
     blocks.append(
-        BulletList(tuple(crossplay_sentence(c, a.crossplay_blocks) for c in a.crossplay_pairs))
+        BulletList(
+            tuple(
+                crossplay_sentence(r.vs_next, a.crossplay_blocks)
+                for r in a.crossplay_rows
+                if r.vs_next is not None
+            ),
+        )
     )
     return blocks
 

@@ -7,7 +7,12 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from sumo_ayss.report.blocks import Block, BulletList, Heading, Paragraph, Table
-from sumo_ayss.report.checks import NOISE_SE, TRUSTED_TIMESTEPS, training_status
+from sumo_ayss.report.checks import (
+    NOISE_SE,
+    TRUSTED_TIMESTEPS,
+    improving_runs,
+    training_status,
+)
 from sumo_ayss.report.sections.common import display_path, seeds_text
 from sumo_ayss.run_folder import VERSIONS_JSON, RunRecord
 
@@ -76,6 +81,15 @@ def inputs_blocks(
         )
     )
     blocks.append(training_table(runs))
+    last = improving_runs([(f"{r.case} {r.label}", r.training) for r in runs])
+    if last:
+        blocks.append(
+            BulletList(
+                tuple(last),
+                f"SPCPs that were the last candidate of their training ({len(last)} of "
+                f"{len(runs)})",
+            )
+        )
     blocks.append(
         BulletList(
             tuple(display_path(r.path, out_dir) for r in runs),

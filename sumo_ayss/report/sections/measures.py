@@ -19,12 +19,12 @@ from sumo_ayss.analysis.r157 import (
     R157_TIME_S,
 )
 from sumo_ayss.config.report import ReportOptions
-from sumo_ayss.modes.formatting import fmt_num
+from sumo_ayss.modes.formatting import fmt_num, ranking_line
 from sumo_ayss.report.blocks import Block, FigureBlock, Heading, Paragraph, Table
 from sumo_ayss.report.figstyle import save, style
 from sumo_ayss.report.measures import CaseMeasures, case_measures
 
-__all__ = ["measures_blocks"]
+__all__ = ["measures_blocks", "with_ceiling"]
 
 
 def _cell(x: float, digits: int = 2) -> str:
@@ -88,7 +88,9 @@ def _table(m: CaseMeasures) -> Table:
 
 
 def _agreement(m: CaseMeasures) -> Table:
-    rows = [("primary", m.primary_mode, " > ".join(m.primary_order) or "—", "1")]
+    apart = m.primary_apart if len(m.primary_apart) + 1 == len(m.primary_order) else ()
+    primary = ranking_line(m.primary_order, apart or [True] * (len(m.primary_order) - 1))
+    rows = [("primary", m.primary_mode, primary or "—", "1")]
     for r in m.rankings:
         if not r.order:
             continue
@@ -100,8 +102,10 @@ def _agreement(m: CaseMeasures) -> Table:
         ("measure", "direction", "order", "τ vs primary"),
         tuple(rows),
         (False, False, False, True),
-        "“>”: the two medians' intervals are disjoint; “≈”: they overlap (or tie), so that "
-        "step of the order is not resolved by this measure. τ counts every step.",
+        "Primary row: “>” where the primary mode's test (Holm-adjusted) separates two VUTs, "
+        "“≈” where it does not. Measure rows: “>” where the two medians' intervals are "
+        "disjoint; “≈” where they overlap (or the medians tie), so that step of the order "
+        "is not resolved by this measure. τ counts every step.",
     )
 
 
@@ -112,7 +116,8 @@ def _order_text(r: MeasureRanking) -> str:
     for prev, cur in itertools.pairwise(r.order):
         a, b = by_vut[prev], by_vut[cur]
         disjoint = a.lo > b.hi or b.lo > a.hi
-        parts += [" > " if disjoint and a.median != b.median else " ≈ ", cur]
+        tied = math.isclose(a.median, b.median, rel_tol=1e-9, abs_tol=1e-12)
+        parts += [" > " if disjoint and not tied else " ≈ ", cur]
     return "".join(parts)
 
 
@@ -169,9 +174,28 @@ def _r157_table(m: CaseMeasures, options: ReportOptions) -> Table:
 def _caption(m: CaseMeasures) -> str:
     return (
         f"Each measure's episodes under the {m.pool} pool, one box per VUT (median, quartiles, "
-        "whiskers at the 5th and 95th percentiles; finite values only — the share of ∞ is "
-        "printed above each box). VUTs in the primary order, safest left."
+        "whiskers at the 5th and 95th percentiles; ∞, where nobody closed in, is drawn at "
+        "the dashed line above every finite value, so each box's median is the table's; "
+        "the share of ∞ is printed above each box). VUTs in the primary order, safest left."
     )
+
+
+def with_ceiling(data: list[np.ndarray]) -> tuple[list[np.ndarray], float | None]:
+    """The values a box plot draws: ∞ (nobody closed in) at a ceiling above every finite
+    value of every VUT, so that each box's median is the table's, which counts ∞ too.
+
+    Args:
+        data: Per VUT, the measure's defined values (finite or +∞).
+
+    Returns:
+        ``(finite data, ceiling)``; ceiling None where no VUT has both kinds.
+    """
+    finite = np.concatenate([d[np.isfinite(d)] for d in data] or [np.zeros(0)])
+    if not finite.size or not any(np.isposinf(d).any() for d in data):
+        return [d[np.isfinite(d)] for d in data], None
+    top = float(finite.max())
+    ceiling = top + max(0.1 * abs(top), 0.5)
+    return [np.where(np.isposinf(d), ceiling, d) for d in data], ceiling
 
 
 def _figure(m: CaseMeasures, colors: Mapping[str, str], out_dir: Path) -> Path:
@@ -183,6 +207,10 @@ def _figure(m: CaseMeasures, colors: Mapping[str, str], out_dir: Path) -> Path:
         axes = np.atleast_1d(fig.subplots(nrows, ncols)).ravel()
         for ax, r in zip(axes, shown, strict=False):
             data = [m.values[r.spec.column][v] for v in m.vuts]
+            data, ceiling = with_ceiling(data)
+            if ceiling is not None:
+                ax.axhline(ceiling, color="0.5", lw=0.8, ls="--")
+                ax.annotate("∞", (1.0, ceiling), xycoords=("axes fraction", "data"), fontsize=8)
             keep = [i for i, d in enumerate(data) if d.size]
             if keep:
                 box = ax.boxplot(

@@ -11,7 +11,7 @@ from sumo_ayss.cases import OUTCOME_COLUMNS
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import EXPOSURE
 from sumo_ayss.modes.exposure import exposure_sentence
-from sumo_ayss.modes.formatting import fmt_num, fmt_p, seed_interval_text
+from sumo_ayss.modes.formatting import fmt_num, seed_interval_text
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -27,6 +27,7 @@ from sumo_ayss.report.sections.common import (
     fmt_est,
     mobility_cell,
     pairs_table,
+    test_cell,
 )
 from sumo_ayss.report.seed_figure import seed_scores_figure
 from sumo_ayss.run_folder import Outcome
@@ -219,7 +220,7 @@ def exposure_blocks(
                 f"{fmt_num(r.mean, 3)} ({ci})",
                 per_seed,
                 str(r.n_seeds),
-                f"{nxt.test}, p {fmt_p(nxt.p)}" if nxt else "—",
+                test_cell(nxt),
                 ("yes" if nxt.significant else "no") if nxt else "—",
                 crash_cell(o),
                 mobility_cell(o),
@@ -247,5 +248,9 @@ def exposure_blocks(
     if any(o.timid for o in outcomes.values()):
         blocks.append(Callout("Timid VUT", (TIMID_NOTE,), "warning"))
     blocks.append(pairs_table(a.exposure_pairs, "harm", pct, options.welch_alpha))
-    blocks.append(BulletList(tuple(exposure_sentence(c) for c in a.exposure_pairs)))
+    blocks.append(
+        BulletList(
+            tuple(exposure_sentence(r.vs_next) for r in a.exposure_rows if r.vs_next is not None),
+        )
+    )
     return blocks

@@ -2,14 +2,20 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.verdict import Verdict
 from sumo_ayss.config.report import ReportOptions
-from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_prob
-from sumo_ayss.modes.paper import pair_sentence, significance_rule
+from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_prob, seed_interval_text
+from sumo_ayss.modes.paper import (
+    MIN_SEEDS_FOR_INTERVAL,
+    diff_interval,
+    pair_sentence,
+    significance_rule,
+)
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, BulletList, FigureBlock, Heading, Paragraph, Table
 from sumo_ayss.report.sections.common import seed_points_text
@@ -18,8 +24,16 @@ __all__ = ["paper_blocks"]
 
 
 def _difference(v: Verdict) -> str:
-    """``"0.42 (0.10–0.80)"``: index A − B with its interval."""
-    return f"{fmt_num(v.difference)} ({fmt_interval(v.diff_lo, v.diff_hi)})"
+    """``"0.42 (0.10–0.80)"``: index A − B with its interval (none under three seeds)."""
+    return f"{fmt_num(v.difference)} ({diff_interval(v)})"
+
+
+def _index_interval(lo: float, hi: float, n_seeds: int) -> str:
+    """A safety index's bootstrap interval, or none under three seeds (as the seed-level
+    intervals: :func:`sumo_ayss.modes.formatting.seed_interval_text`)."""
+    if n_seeds < MIN_SEEDS_FOR_INTERVAL:
+        return seed_interval_text(math.nan, math.nan, n_seeds)
+    return fmt_interval(lo, hi)
 
 
 def paper_blocks(
@@ -62,7 +76,7 @@ def paper_blocks(
             (
                 str(r.rank),
                 r.name,
-                f"{fmt_num(r.point)} ({fmt_interval(r.lo, r.hi)})",
+                f"{fmt_num(r.point)} ({_index_interval(r.lo, r.hi, r.n_seeds)})",
                 seed_points_text(a.runs[r.name], idx),
                 str(r.n_seeds),
                 str(idx.n_samples),
@@ -96,6 +110,7 @@ def paper_blocks(
                 fmt_prob(p.verdict.p_a_safer),
                 fmt_num(p.verdict.cohens_d),
                 fmt_prob(p.verdict.p_seed_welch),
+                fmt_prob(p.p_family),
                 "yes" if p.verdict.significant else "no",
                 "yes" if p.significant else "no",
                 p.safer or "no significant difference",
@@ -112,12 +127,13 @@ def paper_blocks(
                     "P(A safer)",
                     "Cohen's d",
                     "Welch p (seeds)",
+                    "Welch p, Holm-adjusted",
                     "bootstrap CI excludes 0",
                     "significant (both)",
                     "safer",
                 ),
                 p_rows,
-                (False, False, True, True, True, True, False, False, False),
+                (False, False, True, True, True, True, True, False, False, False),
                 significance_rule(options),
             )
         )

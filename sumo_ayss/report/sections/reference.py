@@ -10,7 +10,13 @@ from sumo_ayss.modes.formatting import fmt_num, fmt_prob
 from sumo_ayss.report.blocks import Block, Heading, Paragraph, Table
 from sumo_ayss.report.sections.common import crash_text
 
-__all__ = ["EXPLANATION", "reference_blocks", "reference_markdown", "scenario_set_line"]
+__all__ = [
+    "EXPLANATION",
+    "preventable_text",
+    "reference_blocks",
+    "reference_markdown",
+    "scenario_set_line",
+]
 
 #: The paragraph a safety engineer can quote.
 EXPLANATION = (
@@ -48,7 +54,7 @@ def _verdict(r: ReferenceComparison, reference: str) -> str:
     return f"{r.verdict} than {who}"
 
 
-def _preventable_text(r: ReferenceComparison) -> str:
+def preventable_text(r: ReferenceComparison) -> str:
     if r.labelled == 0 and r.crashes:
         return "not labelled"
     text = crash_text(r.preventable, r.episodes, r.preventable_lo, r.preventable_hi)
@@ -72,7 +78,7 @@ def _rows(reading: ReferenceReading) -> list[tuple[str, ...]]:
                 fmt_prob(r.p_adjusted),
                 _verdict(r, reading.reference),
                 crash_text(r.crashes, r.episodes, *_wilson(r)),
-                _preventable_text(r),
+                preventable_text(r),
             )
         )
     return rows
