@@ -9,15 +9,14 @@ outcome scenarios (``evaluate.n_outcome`` of the outcome seed) and writes, per c
 * ``<out>/<case>/crossplay.csv``: one row per (VUT, opponent, scenario)
   (:data:`~sumo_ayss.run_folder.CROSSPLAY_SCHEMA`);
 * ``<out>/<case>/crossplay.json``: the settings, the opponents with the SHA-256 of their
-  ``spcp.zip``, and the wall time (:class:`~sumo_ayss.run_folder.CrossplayRecord`). A rerun
-  with the same settings and SPCPs skips the case (the stage contract,
-  :class:`~sumo_ayss.run_folder.CrossplayStage`).
+  ``spcp.zip``, the definition key of every VUT, and the wall time
+  (:class:`~sumo_ayss.run_folder.CrossplayRecord`). A rerun with the same settings, VUTs and
+  SPCPs skips the case (the stage contract, :class:`~sumo_ayss.run_folder.CrossplayStage`);
+  a study that added, dropped, redefined or renamed a VUT, or added seeds, drives only the
+  cells it does not hold yet (:mod:`sumo_ayss.run_folder.crossplay_cells`).
 
-Until the table is written whole, each finished (VUT, opponent) cell is kept as its own
-file in ``<out>/<case>/crossplay.partial/`` (``crossplay_reference.partial/`` for the
-reference drivers; :class:`~sumo_ayss.run_folder.CellStore`): a stage interrupted mid-case
-(Ctrl-C, SIGKILL) resumes from the cells it finished, and the finished table is
-byte-identical to an undisturbed run's. ``--force`` drops them.
+A stage interrupted mid-case resumes from the cells it finished (each kept in
+``<case>/crossplay.partial/`` until the table is written: :class:`~sumo_ayss.run_folder.CellStore`).
 
 (file names, writers and readers: :mod:`sumo_ayss.run_folder`).
 
@@ -34,6 +33,7 @@ import functools
 import hashlib
 import logging
 import time
+from collections import Counter
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -60,10 +60,13 @@ from sumo_ayss.run_folder import (
     read_run,
     read_table,
     run_dir_for,
+    table_from_rows,
     write_crossplay_json,
     write_inevitable,
     write_table,
 )
+from sumo_ayss.run_folder.crossplay_cells import CellPlan, merged_rows, plan_cells
+from sumo_ayss.run_folder.identity import vut_key
 from sumo_ayss.util.errors import AyssError, CheckpointError, TableError
 from sumo_ayss.vuts.catalog import controller_imports
 from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
@@ -107,7 +110,10 @@ def run_case(
     """Cross-play of one case's runs; writes and returns the case folder's ``crossplay.csv``.
 
     Skipped when the stage is done with these settings and SPCPs
-    (:class:`~sumo_ayss.run_folder.CrossplayStage`), unless ``force``. After the rollouts,
+    (:class:`~sumo_ayss.run_folder.CrossplayStage`), unless ``force``. Otherwise only the
+    cells (VUT × opponent) that the case's recorded table does not hold are driven (a VUT
+    added, redefined or renamed; new opponents: :func:`~sumo_ayss.run_folder.crossplay_cells.
+    plan_cells`), the rest kept; the written table equals a full run's. After the rollouts,
     every SPCP's episodes against its own VUT are compared with its run's ``outcome.csv``
     (:func:`~sumo_ayss.scenarios.crossplay.diagonal_check`); the result goes into
     ``crossplay.json``.
@@ -128,6 +134,7 @@ def run_case(
     from sumo_ayss.scenarios.crossplay import (
         Opponent,
         check_diagonal,
+        check_one_world,
         diagonal_check,
         run_crossplay,
     )
@@ -138,59 +145,73 @@ def run_case(
     )
     folder = CaseFolder(case_dir)
     case = runs[0].experiment.env.case
-    requested = CrossplayRecord(case, n, seed, pool, (), 0.0)
     envs: dict[str, Any] = {}
     for r in runs:
         envs.setdefault(r.experiment.env.vut, r.experiment.env)
+    check_one_world(envs)  # also across kept and new VUTs, driven apart
+    keys = tuple(vut_key(env.vut_type) for env in envs.values())
+    requested = CrossplayRecord(case, n, seed, pool, tuple(envs), 0.0, vut_keys=keys)
     if not force and _done(CrossplayStage(folder, requested)):
         logger.info("%s: cross-play done with these settings and SPCPs; skipped", case_dir)
-        check_diagonal(read_crossplay_json(folder.crossplay_json).diagonal, case)
-        _reference_rows(runs, folder, references, n, seed, trust_controller, progress, reference)
+        done = read_crossplay_json(folder.crossplay_json)
+        check_diagonal(done.diagonal, case)
+        _reference_rows(
+            runs, folder, references, n, seed, trust_controller, progress, reference, done, pool
+        )
         return folder.crossplay_csv
-    earlier = None if force else _extended(folder, requested, tuple(envs))
-    if earlier is not None:
-        old = set(earlier.opponents)
-        to_play = [r for r, o in zip(runs, pool, strict=True) if o not in old]
+    plan = None if force else _reusable(folder, requested)
+    if plan is not None:
+        to_drive = dict(plan.to_drive)
         logger.info(
-            "%s: cross-play of %d new SPCPs (the table of the other %d is kept)",
+            "%s: cross-play drives %d new cells (VUT x SPCP) and keeps %d%s",
             case_dir,
-            len(to_play),
-            len(old),
+            plan.n_to_drive,
+            plan.n_kept,
+            "".join(f"; {new} is {old} renamed: its cells kept" for old, new in plan.renamed),
         )
     else:
-        to_play = list(runs)
-    outcomes = {(r.experiment.env.vut, r.config_seed): _outcome_table(r, n, seed) for r in to_play}
-    sha = {(o.vut, o.seed): o.spcp_sha256 for o in pool}
-    opponents = [
-        Opponent(
-            r.experiment.env.vut,
-            r.config_seed,
-            functools.partial(load_spcp, r),
-            sha[(r.experiment.env.vut, r.config_seed)],
-        )
-        for r in to_play
-    ]
-    cells = _cells(folder.crossplay_partial, force)
+        to_drive = {v: pool for v in envs}
+    by_run = {(o.vut, o.seed): r for o, r in zip(pool, runs, strict=True)}
+    own = [o for o in pool if o in to_drive.get(o.vut, ())]  # diagonal cells driven now
+    outcomes = {o: _outcome_table(by_run[(o.vut, o.seed)], n, seed) for o in own}
+    rows: list[Any] = [] if plan is None else list(plan.kept_rows)
+    cells = CellStore.resume(folder.crossplay_partial, force=force)
     t0 = time.perf_counter()
-    with controller_imports(trust_controller):
-        table = run_crossplay(
-            envs, opponents, n=n, seed=seed, progress=progress, reference=reference, cells=cells
-        )
-    wall_s = time.perf_counter() - t0
-    checks = tuple(diagonal_check(table, v, s, out) for (v, s), out in outcomes.items())
-    if earlier is not None:
-        table = _merged(
-            read_table(folder.crossplay_csv, CROSSPLAY_SCHEMA), table, tuple(envs), pool
-        )
-        checks = _merged_checks(earlier.diagonal, checks, pool)
-        wall_s += earlier.wall_s
+    for opps, vuts in _groups(to_drive).items():
+        opponents = [
+            Opponent(
+                o.vut, o.seed, functools.partial(load_spcp, by_run[(o.vut, o.seed)]), o.spcp_sha256
+            )
+            for o in opps
+        ]
+        with controller_imports(trust_controller):
+            part = run_crossplay(
+                {v: envs[v] for v in vuts},
+                opponents,
+                n=n,
+                seed=seed,
+                progress=progress,
+                reference=reference,
+                cells=cells,
+            )
+        rows += part.rows()
+    wall_s = time.perf_counter() - t0 + (plan.wall_s if plan is not None else 0.0)
+    table = table_from_rows(CROSSPLAY_SCHEMA, merged_rows(rows, tuple(envs), pool))
+    found = {(c.vut, c.seed): c for c in (plan.kept_checks if plan is not None else ())}
+    for o, out in outcomes.items():
+        found[(o.vut, o.seed)] = diagonal_check(table, o.vut, o.seed, out)
+    checks = tuple(found[(o.vut, o.seed)] for o in pool if (o.vut, o.seed) in found)
+    # The reference table first: its cells are matched through the record written after it.
+    earlier = None if force else _record(folder)
+    _reference_rows(
+        runs, folder, references, n, seed, trust_controller, progress, reference, earlier, pool
+    )
     folder.path.mkdir(parents=True, exist_ok=True)
     write_table(folder.crossplay_csv, table)
-    record = dataclasses.replace(requested, vuts=tuple(envs), wall_s=wall_s, diagonal=checks)
+    record = dataclasses.replace(requested, wall_s=wall_s, diagonal=checks)
     write_crossplay_json(folder.crossplay_json, record)
     cells.clear()  # the whole table is written: its cells are no longer needed
     check_diagonal(checks, case)
-    _reference_rows(runs, folder, references, n, seed, trust_controller, progress, reference)
     return folder.crossplay_csv
 
 
@@ -220,10 +241,15 @@ def _reference_rows(
     trust_controller: bool,
     progress: Callable[[str], None] | None,
     label_with: str | None,
+    earlier: CrossplayRecord | None,
+    pool: tuple[CrossplayOpponent, ...],
 ) -> None:
     """Drive the reference drivers against the whole pool (``crossplay_reference.csv``):
-    seconds, since they need no opponents of their own. Kept when the file already holds
-    exactly these references against exactly this pool on these scenarios."""
+    seconds, since they need no opponents of their own. Each (reference, opponent) cell the
+    file already holds is kept where its opponent is still the same SPCP (its SHA-256 in
+    ``earlier``, the case's record, which is written after this file: a kill between the
+    two drives a cell again, never keeps a stale one); only the others are driven, and the
+    file is written in the order a run over the whole pool writes it."""
     from sumo_ayss.evaluate import load_spcp
     from sumo_ayss.scenarios.crossplay import Opponent, run_crossplay
     from sumo_ayss.scenarios.preventability import reference_config
@@ -232,60 +258,81 @@ def _reference_rows(
     path = folder.crossplay_reference_csv
     if not references:
         return
-    pool = sorted({(r.experiment.env.vut, r.config_seed) for r in runs})
-    if path.is_file():
-        try:
-            old = read_table(path, CROSSPLAY_SCHEMA)
-            opp = zip(old["opponent_vut"].tolist(), old["opponent_seed"].tolist(), strict=True)
-            held = sorted(set(opp))
-            same = (
-                held == pool
-                and sorted(set(old["vut"].tolist())) == sorted(references)
-                and len(old) == n * len(pool) * len(references)
-            )
-        except TableError:
-            same = False
-        if same:
-            return
+    kept = _kept_reference_rows(path, references, n, seed, earlier, pool)
+    cells = {(r["vut"], r["opponent_vut"], r["opponent_seed"]) for r in kept}
+    to_drive = {
+        name: tuple(o for o in pool if (name, o.vut, o.seed) not in cells) for name in references
+    }
+    to_drive = {name: opps for name, opps in to_drive.items() if opps}
+    if not to_drive and len(kept) == n * len(pool) * len(references) and path.is_file():
+        same = table_from_rows(CROSSPLAY_SCHEMA, merged_rows(kept, references, pool))
+        if read_table(path, CROSSPLAY_SCHEMA).equals(same):
+            return  # exactly these references against exactly this pool
     base = runs[0].experiment.env
     for name in references:  # one catalog holding every reference: one world for all
         base = reference_config(base, name, own_body=True)
-    envs = {name: dataclasses.replace(base, vut=name) for name in references}
-    opponents = [
-        Opponent(
-            r.experiment.env.vut,
-            r.config_seed,
-            functools.partial(load_spcp, r),
-            _sha256(r.folder.spcp_zip),
-        )
-        for r in runs
-    ]
-    cells = _cells(folder.crossplay_reference_partial, False)
+    by_run = {(o.vut, o.seed): r for o, r in zip(pool, runs, strict=True)}
+    rows = list(kept)
+    store = CellStore.resume(folder.crossplay_reference_partial)
     t0 = time.perf_counter()
-    with controller_imports(trust_controller):
-        table = run_crossplay(
-            envs, opponents, n=n, seed=seed, progress=progress, reference=label_with, cells=cells
-        )
-    write_table(path, table)
-    cells.clear()
+    for opps, names in _groups(to_drive).items():
+        envs = {name: dataclasses.replace(base, vut=name) for name in names}
+        opponents = [
+            Opponent(
+                o.vut, o.seed, functools.partial(load_spcp, by_run[(o.vut, o.seed)]), o.spcp_sha256
+            )
+            for o in opps
+        ]
+        with controller_imports(trust_controller):
+            part = run_crossplay(
+                envs,
+                opponents,
+                n=n,
+                seed=seed,
+                progress=progress,
+                reference=label_with,
+                cells=store,
+            )
+        rows += part.rows()
+    write_table(path, table_from_rows(CROSSPLAY_SCHEMA, merged_rows(rows, references, pool)))
+    store.clear()
     logger.info(
-        "%s: reference drivers %s against %d opponents in %.1f s",
+        "%s: reference drivers %s against %d opponents in %.1f s (%d cells kept)",
         folder.path,
         ", ".join(references),
-        len(opponents),
+        len({o for opps in to_drive.values() for o in opps}),
         time.perf_counter() - t0,
+        len(cells),
     )
 
 
-def _cells(path: Path, force: bool) -> CellStore:
-    """The finished cells of an interrupted run of this table (:class:`~sumo_ayss.run_folder.
-    CellStore`); ``force`` drops them first (every cell is driven again)."""
-    cells = CellStore(path)
-    if force:
-        cells.clear()
-    elif held := cells.count():
-        logger.info("%s: %d finished cells of an interrupted run are kept", path, held)
-    return cells
+def _kept_reference_rows(
+    path: Path,
+    references: Sequence[str],
+    n: int,
+    seed: int,
+    earlier: CrossplayRecord | None,
+    pool: tuple[CrossplayOpponent, ...],
+) -> list[dict[str, Any]]:
+    """The rows of ``crossplay_reference.csv`` whose reference is asked for and whose
+    opponent is, by ``earlier``'s SHA-256, an SPCP of ``pool`` (under its current name);
+    none without a usable file or record of this scenario set."""
+    if earlier is None or (earlier.n, earlier.seed) != (n, seed) or not path.is_file():
+        return []
+    try:
+        old = read_table(path, CROSSPLAY_SCHEMA)
+    except TableError:
+        return []
+    then = {(o.vut, o.seed): o.spcp_sha256 for o in earlier.opponents}
+    now = {(o.seed, o.spcp_sha256): o for o in pool}
+    kept = []
+    for row in old.rows():
+        sha = then.get((row["opponent_vut"], row["opponent_seed"]))
+        o = now.get((row["opponent_seed"], sha)) if sha is not None else None
+        if o is not None and row["vut"] in references:
+            kept.append({**row, "opponent_vut": o.vut})
+    per_cell = Counter((r["vut"], r["opponent_vut"], r["opponent_seed"]) for r in kept)
+    return [r for r in kept if per_cell[(r["vut"], r["opponent_vut"], r["opponent_seed"])] == n]
 
 
 def _done(stage: CrossplayStage) -> bool:
@@ -297,44 +344,40 @@ def _done(stage: CrossplayStage) -> bool:
         return False
 
 
-def _extended(
-    folder: CaseFolder, requested: CrossplayRecord, vuts: tuple[str, ...]
-) -> CrossplayRecord | None:
-    """The case's recorded cross-play when ``requested`` only adds opponents to it (the same
-    scenarios, rollout and VUTs; adaptive seeding's new seeds), else None."""
+def _record(folder: CaseFolder) -> CrossplayRecord | None:
+    """The case's ``crossplay.json``, None when missing or unreadable."""
+    try:
+        return read_crossplay_json(folder.crossplay_json)
+    except TableError:
+        return None
+
+
+def _reusable(folder: CaseFolder, requested: CrossplayRecord) -> CellPlan | None:
+    """The cells of the case's recorded cross-play that ``requested`` keeps
+    (:func:`~sumo_ayss.run_folder.crossplay_cells.plan_cells`), or None when there is no
+    usable record (none, unreadable, other scenarios or rollout, no diagonal check)."""
     if not (folder.crossplay_csv.is_file() and folder.crossplay_json.is_file()):
         return None
     try:
         done = read_crossplay_json(folder.crossplay_json)
-    except TableError:
+        if not (done.same_scenarios(requested) and done.diagonal):
+            return None
+        rows = read_table(folder.crossplay_csv, CROSSPLAY_SCHEMA).rows()
+        return plan_cells(done, rows, requested)
+    except TableError as exc:
+        logger.warning("%s; cross-play of %s is driven whole", exc, folder.path)
         return None
-    if done.extended_by(requested) and done.diagonal and done.vuts == vuts:
-        return done
-    return None
 
 
-def _merged(old: Any, new: Any, vuts: tuple[str, ...], pool: tuple[Any, ...]) -> Any:
-    """The rows of ``old`` and ``new`` in the order one run over the whole pool writes them:
-    VUT, then opponent (pool order), then scenario. Each (VUT, opponent) cell is its own
-    fresh simulation, so the merged table equals that run's."""
-    from sumo_ayss.run_folder import table_from_rows
-
-    order = {(o.vut, o.seed): j for j, o in enumerate(pool)}
-    rows = [*old.rows(), *new.rows()]
-    rows.sort(
-        key=lambda r: (
-            vuts.index(r["vut"]),
-            order[(r["opponent_vut"], r["opponent_seed"])],
-            r["scenario"],
-        )
-    )
-    return table_from_rows(CROSSPLAY_SCHEMA, rows)
-
-
-def _merged_checks(old: Sequence[Any], new: Sequence[Any], pool: tuple[Any, ...]) -> tuple:
-    """The diagonal checks of both tables, in pool order."""
-    by_run = {(c.vut, c.seed): c for c in (*old, *new)}
-    return tuple(by_run[(o.vut, o.seed)] for o in pool if (o.vut, o.seed) in by_run)
+def _groups(
+    to_drive: dict[str, tuple[CrossplayOpponent, ...]],
+) -> dict[tuple[CrossplayOpponent, ...], tuple[str, ...]]:
+    """The VUTs that meet the same opponents, together (one :func:`run_crossplay` each):
+    ``{opponents: VUTs}``, in the order of the VUTs."""
+    groups: dict[tuple[CrossplayOpponent, ...], list[str]] = {}
+    for vut, opps in to_drive.items():
+        groups.setdefault(opps, []).append(vut)
+    return {opps: tuple(vuts) for opps, vuts in groups.items()}
 
 
 def _outcome_table(run: RunRecord, n: int, seed: int) -> Table:

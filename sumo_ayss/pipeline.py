@@ -97,6 +97,11 @@ class PipelineResult(NamedTuple):
             (:func:`sumo_ayss.run_folder.read_run`), in the order of ``statuses``.
         analyses: Every case's analysis (:func:`sumo_ayss.report.load.analyse_runs`, paper
             mode included), computed once; the report's verdicts, and rank's rows.
+        cfg: The configuration it ran.
+        notes: What it said about the output folder before the jobs ran (a renamed VUT
+            reused, a redefined VUT retrained, two names for one vehicle:
+            :func:`sumo_ayss.grid.study.prepare_out`), each line starting ``NOTE:`` or
+            ``WARNING:``.
     """
 
     statuses: list[JobStatus]
@@ -104,6 +109,7 @@ class PipelineResult(NamedTuple):
     runs: list[RunRecord]
     analyses: list[CaseAnalysis]
     cfg: PipelineConfig | None = None
+    notes: tuple[str, ...] = ()
 
 
 def _relative_paths(data: Any, base: Path) -> Any:
@@ -138,7 +144,8 @@ def configure_logging(live: bool) -> Any:
 def final_messages(result: PipelineResult) -> list[str]:
     """What the CLI prints at the end: failures, the report and its trust warnings (from
     the runs the pipeline loaded)."""
-    lines = [
+    lines = list(result.notes)
+    lines += [
         f"FAILED {s.spec.name}: {s.error}  (log: {s.spec.folder.job_log})"
         for s in result.statuses
         if s.state == "failed"
@@ -199,6 +206,9 @@ def _run_locked(
     console: Any,
 ) -> PipelineResult:
     """:func:`run_pipeline` once the output folder's lock is held."""
+    from sumo_ayss.grid.study import prepare_out, set_aside_redefined
+
+    notes = tuple(prepare_out(cfg, jobs))  # another study's folder is refused here
     study = StudyFolder(cfg.out)
     write_pipeline_json(study.pipeline_json, _relative_paths(to_dict(cfg), cfg.out))
     after = ", ".join(stages_after_grid(cfg))
@@ -208,6 +218,8 @@ def _run_locked(
         console = Console()
 
     def run_jobs(todo: list[JobSpec]) -> list[JobStatus]:
+        for line in set_aside_redefined(todo):  # adaptive seeding's jobs too
+            logger.info(line)
         if backend == "ray":
             from sumo_ayss.grid.ray_backend import run_grid_ray
 
@@ -223,7 +235,7 @@ def _run_locked(
     statuses = run_jobs(jobs)
     finished = [s.spec.run_dir for s in statuses if s.state == "done"]
     if not finished:
-        return PipelineResult(statuses, None, [], [], cfg)
+        return PipelineResult(statuses, None, [], [], cfg, notes)
     from sumo_ayss.grid.adaptive import is_adaptive, run_adaptive
     from sumo_ayss.report.document import load_runs, write_report_for
     from sumo_ayss.report.load import analyse_runs
@@ -239,7 +251,7 @@ def _run_locked(
     logger.info("report: analysing %d run folders and drawing the figures", len(runs))
     analyses = analyse_runs(runs, cfg.report)  # once per case: the report's and rank's
     report = write_report_for(runs, study.report_dir, analyses=analyses, options=cfg.report)
-    return PipelineResult(statuses, report, runs, analyses, cfg)
+    return PipelineResult(statuses, report, runs, analyses, cfg, notes)
 
 
 def stages_after_grid(cfg: PipelineConfig) -> list[str]:

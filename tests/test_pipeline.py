@@ -289,7 +289,7 @@ def test_adaptive_seeding_adds_seeds_until_the_cap_and_extends_crossplay(
     assert cfg.added_seeds == (2,)
     with caplog.at_level(logging.INFO):
         statuses, report, runs, *_ = run_pipeline(cfg, live=False)
-    assert "cross-play of 2 new SPCPs (the table of the other 4 is kept)" in caplog.text
+    assert "cross-play drives 4 new cells (VUT x SPCP) and keeps 8" in caplog.text
     assert "adaptive seeding, car_following: not settled at 2 seeds per VUT" in caplog.text
     assert sorted((s.spec.vut, s.spec.seed) for s in statuses) == [
         (v, s) for v in ("pi1", "pi2") for s in (0, 1, 2)

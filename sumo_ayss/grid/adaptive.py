@@ -35,6 +35,7 @@ from sumo_ayss.run_folder import (
     read_adaptive,
     write_adaptive,
 )
+from sumo_ayss.run_folder.identity import vut_key
 from sumo_ayss.util.errors import AyssError
 
 if TYPE_CHECKING:
@@ -42,7 +43,15 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger("sumo_ayss.grid.adaptive")
 
-__all__ = ["case_seeds", "is_adaptive", "read_record", "run_adaptive", "summary_lines"]
+__all__ = [
+    "case_seeds",
+    "grid_vuts",
+    "is_adaptive",
+    "read_record",
+    "run_adaptive",
+    "stale_record",
+    "summary_lines",
+]
 
 RunJobs = Callable[[list[JobSpec]], list[JobStatus]]
 """Runs a list of jobs on the pipeline's backend and returns their statuses."""
@@ -67,9 +76,43 @@ def is_adaptive(cfg: PipelineConfig) -> bool:
     )
 
 
+def grid_vuts(cfg: PipelineConfig, case: str) -> tuple[tuple[str, str], ...]:
+    """``(name, definition key)`` of the grid's VUTs in ``case``, in grid order: what an
+    adaptive record must have looked at to be this grid's."""
+    from sumo_ayss.grid.plan import case_experiment
+
+    vuts = case_experiment(cfg, case).env.vuts
+    return tuple((v, vut_key(vuts[v])) for v in cfg.grid.vuts)
+
+
+def stale_record(cfg: PipelineConfig, case: str) -> str | None:
+    """Why the case's record is ignored although it is this schedule's (it looked at other
+    VUTs), as a sentence; None when there is no such record."""
+    if not is_adaptive(cfg):
+        return None
+    path = CaseFolder(case_dir_for(cfg.out, case)).adaptive_json
+    try:
+        record = read_adaptive(path) if path.is_file() else None
+    except AyssError:
+        return None
+    now = grid_vuts(cfg, case)
+    if record is None or record.same_vuts(now):
+        return None
+    names = {n for n, _ in record.vuts} & {n for n, _ in now}
+    redefined = sorted(n for n in names if dict(record.vuts)[n] != dict(now)[n])
+    return (
+        f"{case}: adaptive seeding's record ({path.name}) looked at VUTs "
+        f"{', '.join(n for n, _ in record.vuts)}"
+        + (f" ({', '.join(redefined)} since redefined)" if redefined else "")
+        + f"; the grid's are {', '.join(n for n, _ in now)}: the record is ignored and "
+        f"seeding starts over from grid.seeds ({len(cfg.seeds)} per VUT)"
+    )
+
+
 def read_record(cfg: PipelineConfig, case: str) -> AdaptiveRecord | None:
-    """The case's record if it belongs to this configuration's schedule, else None (no
-    record, an unreadable one, or one made with other seeds, cap or level)."""
+    """The case's record if it belongs to this configuration's schedule and VUTs, else None
+    (no record, an unreadable one, one made with other seeds, cap or level, or a stale one:
+    of other VUTs, :func:`stale_record`)."""
     path = CaseFolder(case_dir_for(cfg.out, case)).adaptive_json
     if not path.is_file():
         return None
@@ -80,6 +123,8 @@ def read_record(cfg: PipelineConfig, case: str) -> AdaptiveRecord | None:
         return None
     assert cfg.max_seeds is not None
     if not record.same_plan(cfg.seeds, cfg.max_seeds, cfg.report.welch_alpha):
+        return None
+    if not record.same_vuts(grid_vuts(cfg, case)):
         return None
     return record
 
@@ -184,9 +229,11 @@ def _record_look(cfg: PipelineConfig, case: str, look: SettleCheck) -> AdaptiveR
     assert cfg.max_seeds is not None
     record = read_record(cfg, case)
     if record is None:
-        record = AdaptiveRecord(cfg.seeds, cfg.max_seeds, cfg.report.welch_alpha, cfg.seeds, ())
+        record = AdaptiveRecord(
+            cfg.seeds, cfg.max_seeds, cfg.report.welch_alpha, cfg.seeds, (), grid_vuts(cfg, case)
+        )
     looks = (*tuple(x for x in record.looks if x.n_seeds < look.n_seeds), look)
-    record = dataclasses.replace(record, looks=looks)
+    record = dataclasses.replace(record, looks=looks, vuts=grid_vuts(cfg, case))
     write_adaptive(CaseFolder(case_dir_for(cfg.out, case)).adaptive_json, record)
     return record
 

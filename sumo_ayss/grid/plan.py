@@ -15,7 +15,7 @@ from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.validation import suggest
 from sumo_ayss.vuts.reference_types import REFERENCE_VUTS
 
-__all__ = ["plan_jobs", "plan_seed"]
+__all__ = ["case_experiment", "plan_jobs", "plan_seed"]
 
 
 def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
@@ -29,7 +29,7 @@ def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
 
     jobs = []
     for case in cfg.grid.cases:
-        exp = _case_experiment(cfg, case)
+        exp = case_experiment(cfg, case)
         for vut in cfg.grid.vuts:
             for seed in case_seeds(cfg, case):
                 jobs.append(_job(cfg, exp, case, vut, seed))
@@ -38,7 +38,7 @@ def plan_jobs(cfg: PipelineConfig) -> list[JobSpec]:
 
 def plan_seed(cfg: PipelineConfig, case: str, seed: int) -> list[JobSpec]:
     """One seed's jobs of one case, every VUT (adaptive seeding adds them)."""
-    exp = _case_experiment(cfg, case)
+    exp = case_experiment(cfg, case)
     return [_job(cfg, exp, case, vut, seed) for vut in cfg.grid.vuts]
 
 
@@ -55,7 +55,7 @@ def _job(cfg: PipelineConfig, exp: ExperimentConfig, case: str, vut: str, seed: 
     )
 
 
-def _case_experiment(cfg: PipelineConfig, case: str) -> ExperimentConfig:
+def case_experiment(cfg: PipelineConfig, case: str) -> ExperimentConfig:
     """The case's experiment with the pipeline's overrides; its VUTs checked."""
     exp = load_experiment(cfg.experiments[case])
     if exp.env.case != case:

@@ -25,6 +25,8 @@ file                    writer / reader              what
 ``ayss.json``           write_/read_ayss_json        filter counts, settings, throughput
 ``evaluate.done.json``  write_/read_done_marker      the pipeline's evaluation marker
 ``job.log``             (logging)                    the pipeline job's log
+``renamed.json``        (:mod:`sumo_ayss.grid.study`) a VUT renamed without change: the
+                                                     name it was trained under
 ======================  ===========================  =========================================
 
 The case folder ``<out>/<case>/`` (:func:`case_dir_for`, :class:`CaseFolder`), one level
@@ -33,12 +35,15 @@ above the case's run folders, holds the cross-play and discriminability stages' 
 ==========================  ==============================  ==================================
 ``crossplay.csv``           write_/read_table               one row per (VUT, opponent SPCP,
                             (:data:`CROSSPLAY_SCHEMA`)      scenario)
-``crossplay.json``          write_/read_crossplay_json      settings, opponents, wall time
+``crossplay.json``          write_/read_crossplay_json      settings, opponents, VUT keys,
+                                                            wall time
 ``crossplay.partial/``      :class:`CellStore`              finished cells of an unfinished
                                                             table, removed once it is written
 ``discriminability.json``   write_discriminability /        where the VUTs' responses differ
 ``discriminability.csv``    read_discriminability_json      over the AYSS box
-``adaptive.json``           write_/read_adaptive            adaptive seeding: looks and seeds
+``adaptive.json``           write_/read_adaptive            adaptive seeding: looks, seeds,
+                                                            the VUTs looked at
+``.superseded/``            (:mod:`sumo_ayss.grid.study`)   runs of redefined VUTs, set aside
 ==========================  ==============================  ==================================
 
 The study folder ``<out>/`` (:class:`StudyFolder`) holds ``pipeline.json``, ``ranking.csv``,
@@ -47,7 +52,8 @@ The study folder ``<out>/`` (:class:`StudyFolder`) holds ``pipeline.json``, ``ra
 A run folder is read once into a :class:`RunRecord` (:func:`read_run`, :mod:`.record`) and
 that record is handed on; a case's cross-play table is read by :func:`load_crossplay`.
 Whether a stage is done with the inputs asked for now is one contract for every stage
-(:mod:`.stage`: :func:`fingerprint`, :class:`Stage`, :func:`is_done`).
+(:mod:`.stage`: :func:`fingerprint`, :class:`Stage`, :func:`is_done`); a run is identified
+by what made it, not by its study's other VUTs (:mod:`.identity`).
 
 Every file is written atomically (:mod:`sumo_ayss.util.atomic`). No other module spells one of
 these names or parses one of these files. Imports neither SUMO nor torch.

@@ -3,7 +3,10 @@
 Written by the pipeline after every look (:mod:`sumo_ayss.grid.adaptive`); read by the pipeline
 when it resumes (the seeds already added are part of the grid) and by ``rank --no-run``.
 A look is the analysis's own record, :class:`sumo_ayss.analysis.sequential.SettleCheck`,
-stored field by field.
+stored field by field. ``vuts`` names the VUTs looked at, each with its definition's key
+(:func:`~sumo_ayss.run_folder.identity.vut_key`): a grid whose VUTs are others (one added,
+dropped, redefined or renamed) ignores the record and starts over (records written before
+``vuts`` existed are taken as they are).
 """
 
 from __future__ import annotations
@@ -36,6 +39,8 @@ class AdaptiveRecord:
         alpha: The procedure's false-positive rate.
         seeds: Every seed the case's VUTs were trained on so far, in the order added.
         looks: Every look so far, in order.
+        vuts: ``(name, definition key)`` of every VUT looked at (stored as a JSON object;
+            empty in records written before it).
     """
 
     first_seeds: tuple[int, ...]
@@ -43,6 +48,7 @@ class AdaptiveRecord:
     alpha: float
     seeds: tuple[int, ...]
     looks: tuple[SettleCheck, ...]
+    vuts: tuple[tuple[str, str], ...] = ()
 
     @property
     def settled(self) -> bool:
@@ -57,10 +63,16 @@ class AdaptiveRecord:
             alpha,
         )
 
+    def same_vuts(self, vuts: tuple[tuple[str, str], ...]) -> bool:
+        """Whether this record looked at the VUTs ``vuts`` (``(name, key)``, in any order);
+        a record that does not name its VUTs (written before they were) is taken as is."""
+        return not self.vuts or dict(self.vuts) == dict(vuts)
+
 
 def write_adaptive(path: str | Path, record: AdaptiveRecord) -> None:
     """Write ``adaptive.json`` atomically."""
     data = asdict(record)
+    data["vuts"] = dict(record.vuts)
     data["format"] = ADAPTIVE_FORMAT
     write_json(path, data)
 
@@ -100,6 +112,7 @@ def read_adaptive(path: str | Path) -> AdaptiveRecord:
                 )
                 for x in looks
             ),
+            vuts=tuple((str(k), str(v)) for k, v in dict(data.get("vuts") or {}).items()),
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise TableError(f"{path}: not an adaptive-seeding record ({exc!r})") from None

@@ -7,7 +7,8 @@ It lies in the case folder ``<out>/<case>/`` (:class:`~.layout.CaseFolder`), bes
     {"stage": "crossplay", "case": "cut_in", "n": 200, "seed": 4242,
      "opponents": [{"vut": "pi1", "seed": 0, "spcp_sha256": "..."}, ...],
      "vuts": ["pi1", "pi2"], "wall_s": 812.4, "rollout": "outcome",
-     "diagonal": [{"vut": "pi1", "seed": 0, "n": 200, "n_equal": 200}, ...]}
+     "diagonal": [{"vut": "pi1", "seed": 0, "n": 200, "n_equal": 200}, ...],
+     "vut_keys": {"pi1": "3f0c...", "pi2": "a91b..."}}
 
 ``n`` and ``seed`` are the scenario set (:func:`~sumo_ayss.envs.odd.sample_initial_conditions`)
 and, with the opponents and ``rollout``, what a rerun compares before skipping the case.
@@ -15,7 +16,10 @@ and, with the opponents and ``rollout``, what a rerun compares before skipping t
 env, :mod:`sumo_ayss.scenarios.crossplay`) or ``"pairs"`` (many pairs in one simulation,
 how tables were made before issue 21; such a table is re-run). ``diagonal`` is the check
 that each SPCP, driven against its own VUT, reproduced its run's ``outcome.csv``: per run,
-how many of the ``n`` episodes were equal (absent in older records).
+how many of the ``n`` episodes were equal (absent in older records). ``vut_keys`` names the
+vehicle each VUT name stood for (:func:`~sumo_ayss.run_folder.identity.vut_key` of its
+definition; absent in older records): a study that adds, drops, redefines or renames a VUT
+keeps the cells whose VUT and opponent are unchanged (:mod:`.crossplay_cells`).
 
 :func:`load_crossplay` reads a case's table and record back for the analysis, as a
 :class:`~sumo_ayss.analysis.crossplay.CrossplayInput` scored on the runs' harm scale.
@@ -115,6 +119,8 @@ class CrossplayRecord:
         wall_s: Wall time of the rollouts, s.
         rollout: How the episodes were driven (:data:`ROLLOUT` now).
         diagonal: The diagonal check per run (empty in records written before it).
+        vut_keys: The definition key of each VUT, in the order of ``vuts`` (empty in
+            records written before them).
     """
 
     case: str
@@ -125,6 +131,13 @@ class CrossplayRecord:
     wall_s: float
     rollout: str = ROLLOUT
     diagonal: tuple[DiagonalCheck, ...] = ()
+    vut_keys: tuple[str, ...] = ()
+
+    def same_vuts(self, other: CrossplayRecord) -> bool:
+        """Whether both tables drive the same VUTs in the same order and, where both
+        records name their definitions, the same vehicles."""
+        keys = not (self.vut_keys and other.vut_keys) or self.vut_keys == other.vut_keys
+        return self.vuts == other.vuts and keys
 
     def inputs(self) -> dict[str, Any]:
         """What the table was made from: the scenario set, the opponents and how they were
@@ -136,11 +149,10 @@ class CrossplayRecord:
             "rollout": self.rollout,
         }
 
-    def extended_by(self, other: CrossplayRecord) -> bool:
-        """Whether ``other`` is this run with more opponents (same scenarios, same rollout,
-        every opponent of this one among them): only the new ones need driving."""
-        same = (self.n, self.seed, self.rollout) == (other.n, other.seed, other.rollout)
-        return same and set(self.opponents) < set(other.opponents)
+    def same_scenarios(self, other: CrossplayRecord) -> bool:
+        """Whether both tables' cells were driven on the same scenarios in the same way,
+        so that a cell of one may stand for the same cell of the other."""
+        return (self.n, self.seed, self.rollout) == (other.n, other.seed, other.rollout)
 
 
 def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
@@ -157,6 +169,11 @@ def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
             "wall_s": round(record.wall_s, 3),
             "rollout": record.rollout,
             "diagonal": [dataclasses.asdict(d) for d in record.diagonal],
+            **(
+                {"vut_keys": dict(zip(record.vuts, record.vut_keys, strict=True))}
+                if record.vut_keys
+                else {}
+            ),
         },
     )
 
@@ -207,6 +224,13 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
     rollout = data.get("rollout", _LEGACY_ROLLOUT)
     if not isinstance(rollout, str):
         raise TableError(f"{where}: rollout: expected str, got {rollout!r}")
+    keys = data.get("vut_keys", {})  # absent in records written before them
+    if (
+        not isinstance(keys, Mapping)
+        or (keys and sorted(keys) != sorted(vuts))
+        or not all(isinstance(k, str) for k in keys.values())
+    ):
+        raise TableError(f"{where}: vut_keys: expected a key per VUT of {vuts}, got {keys!r}")
     return CrossplayRecord(
         case=_field(data, "case", str, where),
         n=_field(data, "n", int, where),
@@ -216,6 +240,7 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
         wall_s=float(_field(data, "wall_s", (int, float), where)),
         rollout=rollout,
         diagonal=diagonal,
+        vut_keys=tuple(keys[v] for v in vuts) if keys else (),
     )
 
 
@@ -294,7 +319,9 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
         The :class:`~sumo_ayss.analysis.crossplay.CrossplayInput`: the matrix, its path and
         its diagonal check, or why there is none (no table, runs in several case folders or
         on different harm scales, an unreadable table or one whose design is not complete
-        and balanced, or a table whose diagonal did not reproduce the outcome tables).
+        and balanced, a table whose diagonal did not reproduce the outcome tables, or one
+        of other VUTs than the runs': a study whose VUTs changed and whose cross-play
+        could not run).
     """
     from sumo_ayss.analysis.crossplay import CrossplayInput
 
@@ -326,6 +353,13 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
                 missing=f"the cross-play record is unreadable ({exc})",
                 problem=str(exc),  # names the file
             )
+        if sorted(record.vuts) != sorted(runs):
+            why = (
+                f"the cross-play table is stale: it drove VUTs {', '.join(record.vuts)}, the "
+                f"runs are of {', '.join(runs)} (the pipeline drives the missing cells when "
+                "every job of the case is done)"
+            )
+            return CrossplayInput(path=path, missing=why, problem=f"{path}: {why}")
         diagonal = tuple((d.vut, d.seed, d.n, d.n_equal) for d in record.diagonal)
         bad = [d for d in record.diagonal if not d.ok]
         if bad:

@@ -50,6 +50,17 @@ class CellStore:
 
     folder: Path
 
+    @classmethod
+    def resume(cls, folder: Path, *, force: bool = False) -> CellStore:
+        """The store of ``folder`` with the cells an interrupted run left there (logged);
+        ``force`` drops them first (every cell is driven again)."""
+        store = cls(folder)
+        if force:
+            store.clear()
+        elif held := store.count():
+            logger.info("%s: %d finished cells of an interrupted run are kept", folder, held)
+        return store
+
     def path(self, key: Sequence[Any]) -> Path:
         """The file of the cell ``key`` (everything its rows depend on, JSON-able or
         ``str``-able, in a fixed order)."""

@@ -10,8 +10,8 @@ counts by its bytes). Each stage names its inputs, outputs and marker in one cla
 =====================  ===============================  ======================================
 stage                  done marker (what it records)    inputs
 =====================  ===============================  ======================================
-train                  ``config.yaml`` (the inputs      the experiment (display options
-                       themselves) + ``spcp.json``      aside) and the seed
+train                  ``config.yaml`` (the inputs      the run's identity: experiment,
+                       themselves) + ``spcp.json``      seed, its own VUT's definition
 evaluate (pipeline)    ``evaluate.done.json``           ``spcp.zip``'s bytes, the outcome
                        (the fingerprint)                episodes, the AYSS settings
 outcome / ayss (CLI)   ``outcome.json`` / ``ayss.json``  their settings
@@ -41,6 +41,7 @@ from typing import Any, Protocol
 from sumo_ayss.config import AyssConfig, EnvConfig, ExperimentConfig, experiment_from_dict, to_dict
 from sumo_ayss.run_folder.crossplay import CrossplayRecord, read_crossplay_json
 from sumo_ayss.run_folder.discriminability import read_discriminability_json
+from sumo_ayss.run_folder.identity import DISPLAY_FIELDS, flat_config, run_identity
 from sumo_ayss.run_folder.layout import CaseFolder, RunFolder
 from sumo_ayss.run_folder.metadata import read_json_object, read_run_config
 from sumo_ayss.run_folder.summaries import read_ayss_json, read_outcome_json
@@ -63,9 +64,6 @@ __all__ = [
     "stored_experiment",
     "write_done_marker",
 ]
-
-#: Fields that change what a run shows, never what it computes: a resume may differ in them.
-DISPLAY_FIELDS = ("train.progress_bar",)
 
 
 def fingerprint(*parts: Any) -> str:
@@ -139,16 +137,6 @@ def read_done_marker(path: Path) -> str | None:
 # --------------------------------------------------------------------------- train
 
 
-def flat_config(data: Any, prefix: str = "") -> dict[str, Any]:
-    """``{"train.total_timesteps": 100000, ...}``: nested mappings as dotted keys."""
-    if isinstance(data, dict):
-        out: dict[str, Any] = {}
-        for key, value in data.items():
-            out.update(flat_config(value, f"{prefix}{key}."))
-        return out
-    return {prefix[:-1]: data}
-
-
 def stored_experiment(folder: RunFolder) -> tuple[ExperimentConfig, int]:
     """The experiment and seed a run folder's ``config.yaml`` records.
 
@@ -162,18 +150,15 @@ def stored_experiment(folder: RunFolder) -> tuple[ExperimentConfig, int]:
         raise CheckpointError(f"{folder.config}: unreadable run configuration ({e})") from e
 
 
-def _train_inputs(cfg: ExperimentConfig, seed: int) -> dict[str, Any]:
-    flat = flat_config(to_dict(cfg))
-    return {"seed": seed, **{k: v for k, v in flat.items() if k not in DISPLAY_FIELDS}}
-
-
 @dataclass(frozen=True)
 class TrainStage:
     """Training and SPCP selection of one (case, VUT, seed).
 
     Its marker is ``config.yaml`` (written when the run starts: the inputs themselves) with
-    ``spcp.json`` (written last): a run whose stored configuration differs is not done,
-    and may not be resumed either (:func:`sumo_ayss.training.config_check.
+    ``spcp.json`` (written last). Both sides are read as the run's identity
+    (:func:`~sumo_ayss.run_folder.identity.run_identity`: its own VUT's definition, not the
+    study's catalog nor the VUT's name): a run whose identity differs is not done, and may
+    not be resumed either (:func:`sumo_ayss.training.config_check.
     check_same_config` names the fields).
     """
 
@@ -187,13 +172,13 @@ class TrainStage:
         return (self.folder.spcp_zip, self.folder.spcp_json)
 
     def key(self) -> str:
-        return fingerprint(_train_inputs(self.experiment, self.seed))
+        return fingerprint(run_identity(self.experiment, self.seed))
 
     def recorded(self) -> str | None:
         """Raises :class:`CheckpointError` if ``config.yaml`` exists but is unreadable."""
         if not self.folder.config.is_file():
             return None
-        return fingerprint(_train_inputs(*stored_experiment(self.folder)))
+        return fingerprint(run_identity(*stored_experiment(self.folder)))
 
 
 # --------------------------------------------------------------------------- evaluate
@@ -319,7 +304,8 @@ class AyssStage(_SettingsStage):
 class CrossplayStage:
     """Every SPCP of a case against every VUT. ``crossplay.json`` records the inputs (the
     scenario set, the opponents with their SPCP's SHA-256, how they were driven); a record
-    without the diagonal check (written before it) is not done."""
+    without the diagonal check (written before it), or of other VUTs (other names, or, where
+    it names them, other definitions), is not done."""
 
     folder: CaseFolder
     requested: CrossplayRecord
@@ -337,7 +323,8 @@ class CrossplayStage:
         if not self.folder.crossplay_json.is_file():
             return None
         done = read_crossplay_json(self.folder.crossplay_json)
-        return fingerprint(done.inputs()) if done.diagonal else None
+        fresh = done.diagonal and done.same_vuts(self.requested)
+        return fingerprint(done.inputs()) if fresh else None
 
 
 @dataclass(frozen=True)

@@ -53,6 +53,7 @@ __all__ = [
     "CellCache",
     "Opponent",
     "check_diagonal",
+    "check_one_world",
     "diagonal_check",
     "run_crossplay",
 ]
@@ -91,12 +92,14 @@ class CellCache(Protocol):
         ...
 
 
-def _same_but_vut(envs: Mapping[str, EnvConfig]) -> None:
-    """Refuses a pool whose VUT env configs differ in anything but the VUT."""
+def check_one_world(envs: Mapping[str, EnvConfig]) -> None:
+    """Refuses a pool whose VUT env configs differ in anything but the VUT (the VUT's name
+    and definition, and the catalog of the study its run was made in: a VUT added to a
+    finished study comes with a larger catalog than the runs before it)."""
     items = list(envs.items())
     ref_name, ref = items[0]
     for name, cfg in items[1:]:
-        if dataclasses.replace(cfg, vut=ref.vut) != ref:
+        if dataclasses.replace(cfg, vut=ref.vut, vuts=ref.vuts) != ref:
             raise ConfigError(
                 f"cross-play: the env configs of {ref_name!r} and {name!r} differ in more "
                 "than the VUT (case, ODD, reward, actuator or timing); cross-play needs one "
@@ -138,7 +141,7 @@ def run_crossplay(
         raise ConfigError("cross-play needs at least one VUT and one opponent SPCP")
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise ConfigError(f"n: expected an integer >= 1, got {n!r}")
-    _same_but_vut(envs)
+    check_one_world(envs)
     rows: list[dict[str, object]] = []
     # Each opponent is loaded once (0.48 s a load here under load, against 15 ms for a fresh
     # SUMO): its greedy policy depends on the spaces only, the same for every VUT of the pool.

@@ -1,42 +1,46 @@
 """Whether a run folder may be resumed with a requested configuration.
 
-A resume must compute what the run started to compute: every field of the experiment and
-the seed must match, except display options (:data:`~sumo_ayss.run_folder.stage.
-DISPLAY_FIELDS`, e.g. the progress bar): the training stage's inputs
-(:class:`~sumo_ayss.run_folder.TrainStage`). A refusal names each differing field with its
-stored and requested value.
+A resume must compute what the run started to compute: the run's identity
+(:func:`~sumo_ayss.run_folder.identity.run_identity`: every field of the experiment, the
+seed and the run's own VUT's definition; not the other VUTs of the study's catalog, not the
+VUT's name, not display options such as the progress bar) must match: the training stage's
+inputs (:class:`~sumo_ayss.run_folder.TrainStage`). A refusal names each differing field
+with its stored and requested value.
 """
 
 from __future__ import annotations
 
-from sumo_ayss.config import ExperimentConfig, to_dict
+from sumo_ayss.config import ExperimentConfig
 from sumo_ayss.run_folder import RunFolder, stored_experiment
-from sumo_ayss.run_folder.stage import DISPLAY_FIELDS, flat_config
+from sumo_ayss.run_folder.identity import identity_differences
 from sumo_ayss.util.errors import CheckpointError
 
-__all__ = ["check_same_config", "config_differences"]
+__all__ = ["check_same_config", "config_differences", "stored_differences"]
 
 
 def config_differences(stored: ExperimentConfig, requested: ExperimentConfig) -> list[str]:
-    """The dotted fields in which two experiments differ, display options left out
-    (:data:`~sumo_ayss.run_folder.stage.DISPLAY_FIELDS`), each as
-    ``"field: stored -> requested"``."""
-    a, b = flat_config(to_dict(stored)), flat_config(to_dict(requested))
-    return [
-        f"{key}: {a.get(key, '(absent)')!r} -> {b.get(key, '(absent)')!r}"
-        for key in sorted(set(a) | set(b))
-        if key not in DISPLAY_FIELDS and a.get(key) != b.get(key)
-    ]
+    """The dotted fields in which two experiments' run identities differ (seed aside), each
+    as ``"field: stored -> requested"``; the run's own VUT's definition is named
+    ``env.vuts[env.vut]``."""
+    return identity_differences(stored, 0, requested, 0)
+
+
+def stored_differences(folder: RunFolder, cfg: ExperimentConfig, seed: int) -> list[str]:
+    """The fields in which the run folder's stored identity (``config.yaml``) differs from
+    the requested one, the seed first.
+
+    Raises:
+        CheckpointError: ``config.yaml`` is missing or unreadable.
+    """
+    stored_cfg, stored_seed = stored_experiment(folder)
+    return identity_differences(stored_cfg, stored_seed, cfg, seed)
 
 
 def check_same_config(folder: RunFolder, cfg: ExperimentConfig, seed: int) -> None:
     """Raises :class:`CheckpointError` naming every field in which the run folder's stored
-    configuration (and seed) differs from the requested one, display options aside, or
-    when ``config.yaml`` is unreadable."""
-    stored_cfg, stored_seed = stored_experiment(folder)
-    diffs = config_differences(stored_cfg, cfg)
-    if stored_seed != seed:
-        diffs.insert(0, f"seed: {stored_seed!r} -> {seed!r}")
+    identity differs from the requested one (:func:`stored_differences`), or when
+    ``config.yaml`` is unreadable."""
+    diffs = stored_differences(folder, cfg, seed)
     if diffs:
         shown = "; ".join(diffs[:5]) + (f"; and {len(diffs) - 5} more" if len(diffs) > 5 else "")
         raise CheckpointError(

@@ -28,6 +28,7 @@ from sumo_ayss.run_folder import (
     TrainStage,
     fingerprint,
     is_done,
+    read_crossplay_json,
     read_done_marker,
     write_ayss_json,
     write_crossplay_json,
@@ -147,11 +148,9 @@ def test_outcome_and_ayss_stages_compare_the_settings_their_json_records(tmp_pat
 def test_crossplay_stage_needs_the_same_opponents_and_a_diagonal_check(tmp_path: Path) -> None:
     folder = CaseFolder(tmp_path)
     pool = (CrossplayOpponent("pi1", 0, "a" * 64), CrossplayOpponent("pi2", 0, "b" * 64))
-    requested = CrossplayRecord("cut_in", 6, 4242, pool, (), 0.0)
+    requested = CrossplayRecord("cut_in", 6, 4242, pool, ("pi1", "pi2"), 0.0)
     stage = CrossplayStage(folder, requested)
-    done = dataclasses.replace(
-        requested, vuts=("pi1", "pi2"), wall_s=3.5, diagonal=(DiagonalCheck("pi1", 0, 6, 6),)
-    )
+    done = dataclasses.replace(requested, wall_s=3.5, diagonal=(DiagonalCheck("pi1", 0, 6, 6),))
     write_crossplay_json(folder.crossplay_json, dataclasses.replace(done, diagonal=()))
     folder.crossplay_csv.write_text("x")
     assert not is_done(stage)  # a record from before the diagonal check: run again
@@ -160,6 +159,17 @@ def test_crossplay_stage_needs_the_same_opponents_and_a_diagonal_check(tmp_path:
     assert not is_done(CrossplayStage(folder, dataclasses.replace(requested, n=7)))
     other = (pool[0], CrossplayOpponent("pi2", 0, "c" * 64))  # pi2's SPCP retrained
     assert not is_done(CrossplayStage(folder, dataclasses.replace(requested, opponents=other)))
+    # A record without VUT keys (before issue 36) is done for the same VUT names; with
+    # keys, another definition under a name is another table.
+    keyed = dataclasses.replace(requested, vut_keys=("k1", "k2"))
+    assert is_done(CrossplayStage(folder, keyed))
+    assert not is_done(CrossplayStage(folder, dataclasses.replace(requested, vuts=("pi1",))))
+    write_crossplay_json(folder.crossplay_json, dataclasses.replace(done, vut_keys=("k1", "k2")))
+    assert read_crossplay_json(folder.crossplay_json).vut_keys == ("k1", "k2")
+    assert is_done(CrossplayStage(folder, keyed))
+    redefined = dataclasses.replace(requested, vut_keys=("k1", "k3"))
+    assert not is_done(CrossplayStage(folder, redefined))
+    write_crossplay_json(folder.crossplay_json, done)
     data = json.loads(folder.crossplay_json.read_text())
     del data["rollout"]  # written before issue 21: driven as pairs, run again
     folder.crossplay_json.write_text(json.dumps(data))

@@ -76,17 +76,20 @@ def test_an_interrupted_crossplay_resumes_from_its_finished_cells(tmp_path: Path
     assert not folder.crossplay_csv.exists()
     assert len(list(folder.crossplay_partial.glob("cell_*.csv"))) == 2
 
-    second = _StopAfter(stop=1, prefix=DEFAULT_REFERENCE)  # then in the reference drivers' cells
+    second = _StopAfter(stop=1, prefix=DEFAULT_REFERENCE)  # then in the reference cells
     with pytest.raises(KeyboardInterrupt):
         cross(second)
     assert (second.kept("pi"), second.driven("pi")) == (2, 2)  # only the unfinished cells
-    assert folder.crossplay_csv.read_bytes() == undisturbed["crossplay.csv"]
-    assert not folder.crossplay_partial.exists()  # removed with the table written
+    assert not folder.crossplay_csv.exists()  # written after the reference drivers' table
+    assert len(list(folder.crossplay_partial.glob("cell_*.csv"))) == 4
     assert len(list(folder.crossplay_reference_partial.glob("cell_*.csv"))) == 1
 
     third = _StopAfter()
     cross(third)
-    assert (third.kept(), third.driven()) == (1, 1)  # the main table is done: skipped
+    assert (third.kept("pi"), third.driven("pi")) == (4, 0)
+    assert (third.kept(DEFAULT_REFERENCE), third.driven(DEFAULT_REFERENCE)) == (1, 1)
+    assert folder.crossplay_csv.read_bytes() == undisturbed["crossplay.csv"]
     assert folder.crossplay_reference_csv.read_bytes() == undisturbed["crossplay_reference.csv"]
+    assert not folder.crossplay_partial.exists()  # removed once the tables are written
     assert not folder.crossplay_reference_partial.exists()
     assert folder.inevitable_json.is_file()

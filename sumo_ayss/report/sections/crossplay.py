@@ -179,6 +179,14 @@ def _adaptive_blocks(a: CaseAnalysis) -> list[Block]:
         return [Callout("Adaptive seeding record unreadable", (str(exc),), "warning")]
     if not record.looks:
         return []
+    looked = [name for name, _ in record.vuts]
+    if looked and sorted(looked) != sorted(a.runs):
+        why = (
+            f"{path} looked at VUTs {', '.join(looked)}; this case ranks "
+            f"{', '.join(a.runs)}: the record is stale (a VUT was added, dropped or renamed "
+            "since) and is not shown"
+        )
+        return [Callout("Adaptive seeding record ignored", (why,), "warning")]
     rows = tuple(
         (
             str(x.n_seeds),

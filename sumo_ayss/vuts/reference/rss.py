@@ -31,7 +31,9 @@ def rss_safe_distance_m(
 ) -> float:
     """RSS's minimum safe longitudinal distance, same direction [m] (ad-rss-lib's
     ``calculateSafeLongitudinalDistanceSameDirection`` without its speed cap and extra
-    margin): ``max(0, v_r·ρ + a_max·ρ²/2 + (v_r + ρ·a_max)²/(2·b_min) - v_f²/(2·b_max))``."""
+    margin): ``max(0, v_r·ρ + a_max·ρ²/2 + (v_r + ρ·a_max)²/(2·b_min) - v_f²/(2·b_max))``;
+    equal to the ``ad_rss`` binding's (PyPI 5.0) on the same inputs
+    (``tests/vuts/test_rss_crosscheck.py``)."""
     v_resp = v_rear_mps + rho_s * a_max_mps2
     d = (
         v_rear_mps * rho_s

@@ -1,0 +1,91 @@
+"""A run's identity: its own VUT's definition, not the study's catalog nor the VUT's name;
+the committed run folders (whose config.yaml holds their study's whole catalog) still match."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+from sumo_ayss.config import ExperimentConfig, to_dict
+from sumo_ayss.run_folder import RunConfig, RunFolder, TrainStage, stored_experiment
+from sumo_ayss.run_folder.identity import (
+    identity_differences,
+    is_redefinition,
+    run_identity,
+    vut_key,
+)
+from sumo_ayss.run_folder.metadata import write_run_config
+from sumo_ayss.training.config_check import check_same_config
+from sumo_ayss.vuts.catalog import VehicleType
+
+ROOT = Path(__file__).resolve().parents[2]
+OB40 = VehicleType("IDM", {"minGap": 40.0}, "a far follower")
+
+
+def _with_catalog(cfg: ExperimentConfig, vuts: dict[str, VehicleType]) -> ExperimentConfig:
+    return dataclasses.replace(cfg, env=dataclasses.replace(cfg.env, vuts=vuts))
+
+
+def test_another_vuts_definition_is_not_part_of_a_run() -> None:
+    base = ExperimentConfig()  # pi1 in the built-in catalog
+    grown = _with_catalog(base, {**base.env.vuts, "ob40": OB40})
+    redefined = _with_catalog(
+        base, {**base.env.vuts, "ob40": dataclasses.replace(OB40, model="EIDM")}
+    )
+    alone = _with_catalog(base, {"pi1": base.env.vuts["pi1"]})
+    for other in (grown, redefined, alone):
+        assert run_identity(other, 0) == run_identity(base, 0)
+        assert identity_differences(base, 0, other, 0) == []
+
+
+def test_the_runs_own_definition_is_named_and_its_description_is_not() -> None:
+    base = ExperimentConfig()
+    pi1 = base.env.vuts["pi1"]
+    slower = dataclasses.replace(pi1, params={**pi1.params, "accel": 2.0})
+    changed = _with_catalog(base, {**base.env.vuts, "pi1": slower})
+    diffs = identity_differences(base, 0, changed, 0)
+    assert diffs == ["env.vuts[env.vut].params.accel: 3.0 -> 2.0"]
+    assert is_redefinition(diffs)
+    retitled = _with_catalog(
+        base, {**base.env.vuts, "pi1": dataclasses.replace(pi1, description="x")}
+    )
+    assert identity_differences(base, 0, retitled, 0) == []
+    longer = dataclasses.replace(
+        base, train=dataclasses.replace(base.train, total_timesteps=300_000)
+    )
+    mixed = identity_differences(base, 0, dataclasses.replace(longer, env=changed.env), 0)
+    assert len(mixed) == 2 and not is_redefinition(mixed)
+    assert identity_differences(base, 0, base, 1) == ["seed: 0 -> 1"]
+
+
+def test_a_renamed_vut_is_the_same_run_and_the_same_vehicle() -> None:
+    base = ExperimentConfig()
+    env = dataclasses.replace(base.env, vut="first", vuts={"first": base.env.vuts["pi1"]})
+    renamed = dataclasses.replace(base, env=env)
+    assert run_identity(renamed, 3) == run_identity(base, 3)
+    assert vut_key(renamed.env.vut_type) == vut_key(base.env.vuts["pi1"])
+    assert vut_key(base.env.vuts["pi1"]) != vut_key(base.env.vuts["pi2"])
+
+
+def test_resume_check_ignores_the_catalog_and_names_a_redefinition(tmp_path: Path) -> None:
+    cfg = _with_catalog(ExperimentConfig(), {**ExperimentConfig().env.vuts, "ob40": OB40})
+    folder = RunFolder(tmp_path)
+    write_run_config(folder.config, RunConfig("pi1", 0, to_dict(cfg)))
+    alone = _with_catalog(cfg, {"pi1": cfg.env.vuts["pi1"]})
+    check_same_config(folder, alone, 0)  # the issue's failure: another VUT's entry changed
+    folder.spcp_json.write_text("{}")
+    folder.spcp_zip.write_bytes(b"weights")
+    assert TrainStage(folder, alone, 0).recorded() == TrainStage(folder, alone, 0).key()
+
+
+def test_committed_run_folders_are_still_done_under_a_catalog_of_their_vut_alone() -> None:
+    """Every committed run folder's stored catalog is its study's; asked with only its own
+    VUT in the catalog (or another study's), the run is the same run."""
+    folders = sorted(p.parent for p in (ROOT / "results").rglob("seed_*/config.yaml"))
+    assert len(folders) > 100
+    for path in folders[::7]:
+        folder = RunFolder(path)
+        cfg, seed = stored_experiment(folder)
+        alone = _with_catalog(cfg, {cfg.env.vut: cfg.env.vut_type})
+        stage = TrainStage(folder, alone, seed)
+        assert stage.key() == stage.recorded(), path
