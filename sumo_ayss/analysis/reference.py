@@ -33,6 +33,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from sumo_ayss.analysis.crossplay import CrossplayMatrix
+from sumo_ayss.analysis.harm import HARM_RANGE
 from sumo_ayss.analysis.multiplicity import holm
 from sumo_ayss.analysis.seeds import SeedComparison, compare_seeds
 from sumo_ayss.analysis.stats import wilson_interval
@@ -193,7 +194,7 @@ def read_against_reference(
     )
     ref_scores = {s.name: s for s in aligned.scores(blocks)}[reference]
     tests = [
-        compare_seeds(s, ref_scores, level=level, alpha=alpha)
+        compare_seeds(s, ref_scores, level=level, alpha=alpha, bounds=HARM_RANGE)
         for s in m.scores(blocks)
         if s.name != reference
     ]

@@ -138,3 +138,19 @@ def test_reference_rows_of_another_pool_are_refused() -> None:
         read_against_reference(m, ref, "cc_driver")
     with pytest.raises(ConfigError, match="no 'fsm'"):
         read_against_reference(m, ref, "fsm")
+
+
+def test_the_difference_interval_stays_possible_and_needs_three_blocks() -> None:
+    """A harm difference lies in [-1, 1]; with 2 blocks no interval is given at all."""
+    rng = np.random.default_rng(3)
+    for seeds in ((0, 1), (0, 1, 2)):
+        n = len(seeds)
+        harm_v = np.clip(0.5 + 0.45 * rng.standard_normal(n), 0, 1)
+        harm_r = np.clip(0.5 + 0.45 * rng.standard_normal(n), 0, 1)
+        m = crossplay_matrix(["a"] * n, ["pi"] * n, list(seeds), harm_v, [False] * n)
+        ref = crossplay_matrix(["cc_driver"] * n, ["pi"] * n, list(seeds), harm_r, [False] * n)
+        t = read_against_reference(m, ref, "cc_driver").rows[0].test
+        if n < 3:
+            assert math.isnan(t.lo) and math.isnan(t.hi)
+        else:
+            assert -1.0 <= t.lo <= t.difference <= t.hi <= 1.0

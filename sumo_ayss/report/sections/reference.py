@@ -68,8 +68,9 @@ def _rows(reading: ReferenceReading) -> list[tuple[str, ...]]:
     for r in reading.rows:
         t = r.test
         diff = f"{fmt_num(t.difference, 3)} ({fmt_num(t.lo, 3)} to {fmt_num(t.hi, 3)})"
-        if t.lo != t.lo:  # NaN: no interval
-            diff = f"{fmt_num(t.difference, 3)} (no interval)"
+        if t.lo != t.lo:  # NaN: too few blocks for an interval, or no spread at all
+            why = f"with {t.n_a} blocks" if t.n_a < 3 else "identical in every block"
+            diff = f"{fmt_num(t.difference, 3)} (no interval: {why})"
         rows.append(
             (
                 r.vut,
