@@ -130,7 +130,7 @@ def run_case(
         TableError: If a run's outcome table is missing or was run on other scenarios.
         CheckpointError: If a run's configuration or SPCP cannot be read.
     """
-    from sumo_ayss.evaluate import load_spcp
+    from sumo_ayss.agents.weights import load_spcp
     from sumo_ayss.scenarios.crossplay import (
         Opponent,
         check_diagonal,
@@ -250,7 +250,7 @@ def _reference_rows(
     ``earlier``, the case's record, which is written after this file: a kill between the
     two drives a cell again, never keeps a stale one); only the others are driven, and the
     file is written in the order a run over the whole pool writes it."""
-    from sumo_ayss.evaluate import load_spcp
+    from sumo_ayss.agents.weights import load_spcp
     from sumo_ayss.scenarios.crossplay import Opponent, run_crossplay
     from sumo_ayss.scenarios.preventability import reference_config
 

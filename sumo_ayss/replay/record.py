@@ -99,7 +99,7 @@ def _initial_condition(kind: Kind, row: dict[str, Any]) -> InitialCondition:
 
 def _load_policy(run: RunRecord) -> Policy:
     """The run's SPCP, weights only (never unpickled: see "Trust model" in the README)."""
-    from sumo_ayss.evaluate import load_spcp  # torch: only when a policy is needed
+    from sumo_ayss.agents.weights import load_spcp  # torch: only when a policy is needed
 
     return load_spcp(run, make_env(run.experiment.env))
 
