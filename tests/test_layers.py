@@ -28,8 +28,8 @@ ROOT = Path(__file__).resolve().parents[1] / PACKAGE
 #: The largest module allowed [lines].
 MAX_MODULE_LINES = 500
 #: What :mod:`sumo_ayss.analysis` may import from the package besides itself: the error
-#: tree, range checks, the case records and the ranking modes. It reads no file (no
-#: run_folder, report or config) and runs nothing (no sim, envs or agents): the run records
+#: tree, range checks, the registry type, the case records and the ranking modes. It reads no
+#: file (no run_folder, report or config) and runs nothing (no sim, envs or agents): the run records
 #: (:func:`sumo_ayss.run_folder.read_run`) and the cross-play table
 #: (:func:`sumo_ayss.run_folder.load_crossplay`) are read outside and handed to it. The
 #: ranking modes (:mod:`sumo_ayss.modes`) are held to the same rule, so that analysis stays
@@ -38,6 +38,7 @@ ANALYSIS_MAY_IMPORT = (
     "sumo_ayss.analysis",
     "sumo_ayss.util.errors",
     "sumo_ayss.util.validation",
+    "sumo_ayss.util.registry",
     "sumo_ayss.cases",
     "sumo_ayss.modes",
 )
