@@ -241,6 +241,29 @@ def test_the_analysis_rule_catches_a_loader_import() -> None:
     assert _within("sumo_ayss.cases.cut_in", ANALYSIS_MAY_IMPORT)
 
 
+def private_imports(modules: dict[str, Path]) -> list[str]:
+    """``module: from other import _name`` for every private name imported from another
+    module of the package (a helper two modules share belongs in a module of its own)."""
+    found = []
+    for name, path in modules.items():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(PACKAGE):
+                for alias in node.names:
+                    if alias.name.startswith("_") and not alias.name.startswith("__"):
+                        found.append(f"{name}: from {node.module} import {alias.name}")
+    return found
+
+
+def test_no_module_imports_a_private_name_of_another() -> None:
+    assert private_imports(module_files()) == []
+
+
+def test_the_private_import_rule_sees_one(tmp_path: Path) -> None:
+    path = tmp_path / "x.py"
+    path.write_text(f"from {PACKAGE}.replay.record import _row, Kind\n")
+    assert private_imports({"x": path}) == [f"x: from {PACKAGE}.replay.record import _row"]
+
+
 def modules_over_limit() -> dict[str, int]:
     """Modules over :data:`MAX_MODULE_LINES` lines -> their lines, largest first."""
     lines = sorted(module_lines().items(), key=lambda kv: (-kv[1], kv[0]))
