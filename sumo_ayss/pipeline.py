@@ -65,7 +65,7 @@ from sumo_ayss.grid.jobs import JobSpec
 from sumo_ayss.grid.local import run_grid_local
 from sumo_ayss.grid.plan import plan_jobs, plan_seed
 from sumo_ayss.grid.progress import JobStatus
-from sumo_ayss.modes import get_mode
+from sumo_ayss.modes import check_mode, get_mode
 from sumo_ayss.run_folder import RunRecord, StudyFolder, write_pipeline_json
 from sumo_ayss.util.errors import AyssError
 
@@ -191,6 +191,7 @@ def run_pipeline(
     :class:`rich.console.Console` to draw it on, default a new one); job events are logged
     either way.
     """
+    check_mode(cfg.report.mode)
     jobs = plan_jobs(cfg)
     check_out_dir(cfg.out, "out")
     with output_lock(cfg.out):  # one writer per output folder
@@ -390,8 +391,9 @@ def add_config_flags(parser: argparse.ArgumentParser) -> None:
 
 
 def config_from_args(args: argparse.Namespace) -> PipelineConfig:
-    """``args.config`` with the flags of :func:`add_config_flags` applied."""
-    return load_pipeline(
+    """``args.config`` with the flags of :func:`add_config_flags` applied, its
+    ``report.mode`` checked against the registered modes."""
+    cfg = load_pipeline(
         args.config,
         out=args.out,
         workers=args.workers,
@@ -403,6 +405,8 @@ def config_from_args(args: argparse.Namespace) -> PipelineConfig:
         n_ayss=args.n_ayss,
         max_seeds=args.max_seeds,
     )
+    check_mode(cfg.report.mode)
+    return cfg
 
 
 def main(argv: Sequence[str] | None = None) -> None:

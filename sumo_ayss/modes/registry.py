@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from sumo_ayss.util.registry import Registry
-from sumo_ayss.util.validation import require
+from sumo_ayss.util.validation import check_choice, require
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 __all__ = [
     "Mode",
     "Standing",
+    "check_mode",
     "get_mode",
     "headline_text",
     "missing_rows_line",
@@ -179,6 +180,17 @@ def get_mode(name: str) -> Mode:
         ConfigError: Naming the registered modes, if ``name`` is none of them.
     """
     return _REGISTRY.get(name)
+
+
+def check_mode(name: str, where: str = "report.mode") -> Mode:
+    """The registered mode ``name``, as the configuration field ``where`` names it (the
+    stages check ``report.mode`` here when they start: the configuration imports no mode).
+
+    Raises:
+        ConfigError: ``"report.mode must be one of [...]"``, if ``name`` is none of them.
+    """
+    check_choice(where, name, mode_names())
+    return get_mode(name)
 
 
 def headline_text(a: CaseAnalysis) -> str:

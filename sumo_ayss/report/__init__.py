@@ -23,7 +23,7 @@ _LAZY = {
     "MARKDOWN_NAME": "sumo_ayss.report.document",
     "PairVerdict": "sumo_ayss.analysis.significance",
     "Report": "sumo_ayss.report.document",
-    "analyse_case": "sumo_ayss.analysis.case",
+    "analyse_case": "sumo_ayss.modes",
     "build_report": "sumo_ayss.report.document",
     "load_runs": "sumo_ayss.report.document",
     "pair_verdict": "sumo_ayss.analysis.significance",

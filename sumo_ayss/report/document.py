@@ -25,10 +25,10 @@ import logging
 from collections.abc import Sequence
 from pathlib import Path
 
-from sumo_ayss.analysis.case import CaseAnalysis, analyse_case, vut_safety_index
+from sumo_ayss.analysis.case import CaseAnalysis, vut_safety_index
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
 from sumo_ayss.config.report import ReportOptions
-from sumo_ayss.modes import get_mode
+from sumo_ayss.modes import analyse_case, get_mode
 from sumo_ayss.modes.paper import significance_rule
 from sumo_ayss.report.blocks import (
     Block,

@@ -13,8 +13,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from sumo_ayss.analysis.case import CaseAnalysis, CaseOptions, analyse_case
+from sumo_ayss.analysis.case import CaseAnalysis, CaseOptions
 from sumo_ayss.cases import case_names
+from sumo_ayss.modes import analyse_case
 from sumo_ayss.run_folder import RunRecord, load_crossplay
 
 __all__ = ["analyse_runs", "group_runs"]
@@ -45,7 +46,7 @@ def analyse_runs(
     runs: Sequence[RunRecord], options: CaseOptions, *, paper: bool = True
 ) -> list[CaseAnalysis]:
     """The analysis of every case among ``runs``, each computed once, in :func:`group_runs`
-    order (:func:`~sumo_ayss.analysis.case.analyse_case` on the case's runs and its
+    order (:func:`~sumo_ayss.modes.analyse_case` on the case's runs and its
     cross-play table, :func:`~sumo_ayss.run_folder.load_crossplay`).
 
     Args:
