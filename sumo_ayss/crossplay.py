@@ -411,7 +411,7 @@ def read_matrix(runs: Sequence[RunRecord]) -> Any:
     Raises:
         TableError: If there is no usable table (the message says why).
     """
-    from sumo_ayss.report.load import group_runs
+    from sumo_ayss.run_folder import group_runs
 
     groups = group_runs(runs)
     found = load_crossplay(next(iter(groups.values())))

@@ -28,7 +28,7 @@ below (rows of the modes follow in registry order).
 from __future__ import annotations
 
 # The built-in modes, registered in import order (ranking rows follow it).
-from sumo_ayss.modes.analyse import analyse_case
+from sumo_ayss.modes.analyse import analyse_case, analyse_cases
 from sumo_ayss.modes.crossplay import CROSSPLAY
 from sumo_ayss.modes.exposure import EXPOSURE
 from sumo_ayss.modes.paper import PAPER
@@ -57,6 +57,7 @@ __all__ = [
     "Mode",
     "Standing",
     "analyse_case",
+    "analyse_cases",
     "check_mode",
     "get_mode",
     "headline_text",
