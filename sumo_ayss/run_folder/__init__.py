@@ -211,6 +211,7 @@ from sumo_ayss.run_folder.study_runs import (
     group_runs,
     load_runs,
     mixing_problems,
+    read_case_matrix,
 )
 from sumo_ayss.run_folder.summaries import (
     AyssRecord,
@@ -328,6 +329,7 @@ __all__ = [
     "mixing_problems",
     "read_adaptive",
     "read_ayss_json",
+    "read_case_matrix",
     "read_checkpoint_state",
     "read_command",
     "read_crossplay_json",

@@ -14,13 +14,20 @@ from sumo_ayss.cases import case_names
 from sumo_ayss.run_folder.crossplay import load_crossplay
 from sumo_ayss.run_folder.layout import CONFIG_YAML, find_run_dirs
 from sumo_ayss.run_folder.record import RunRecord, Training, read_run
-from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.util.errors import ConfigError, TableError
 from sumo_ayss.util.paths import display_path
 
 if TYPE_CHECKING:
-    from sumo_ayss.analysis.crossplay import CrossplayInput
+    from sumo_ayss.analysis.crossplay import CrossplayInput, CrossplayMatrix
 
-__all__ = ["CaseRuns", "case_runs", "group_runs", "load_runs", "mixing_problems"]
+__all__ = [
+    "CaseRuns",
+    "case_runs",
+    "group_runs",
+    "load_runs",
+    "mixing_problems",
+    "read_case_matrix",
+]
 
 
 @dataclass(frozen=True)
@@ -96,6 +103,19 @@ def case_runs(runs: Sequence[RunRecord]) -> list[CaseRuns]:
     return [
         CaseRuns(case, by_vut, load_crossplay(by_vut)) for case, by_vut in group_runs(runs).items()
     ]
+
+
+def read_case_matrix(runs: Sequence[RunRecord]) -> CrossplayMatrix:
+    """The cross-play matrix of one case's runs, scored on their harm scale, with its
+    diagonal check (:func:`~.crossplay.load_crossplay`).
+
+    Raises:
+        TableError: If there is no usable table (the message says why).
+    """
+    found = load_crossplay(next(iter(group_runs(runs).values())))
+    if found.matrix is None:
+        raise TableError(found.missing or f"no cross-play table for {runs[0].path}")
+    return found.matrix
 
 
 def mixing_problems(
