@@ -107,7 +107,7 @@ class PipelineResult(NamedTuple):
     statuses: list[JobStatus]
     report: Path | None
     runs: list[RunRecord]
-    analyses: list[CaseAnalysis]
+    analyses: list[CaseAnalysis[RunRecord]]
     cfg: PipelineConfig | None = None
     notes: tuple[str, ...] = ()
 

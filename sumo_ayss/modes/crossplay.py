@@ -8,7 +8,7 @@ without it the headline falls back to the exposure mode's and says so.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.modes.formatting import fmt_p_family, ranking_line
 from sumo_ayss.modes.registry import Mode, Standing, get_mode, register_mode
@@ -102,14 +102,14 @@ def crossplay_gap_text(gap: CrossplayGap) -> str:
     return gap.loader or NO_CROSSPLAY_TABLE
 
 
-def _gap(a: CaseAnalysis) -> str:
+def _gap(a: CaseAnalysis[Any]) -> str:
     """Why the case has no cross-play ranking, one sentence."""
     if a.crossplay_gap is not None:
         return crossplay_gap_text(a.crossplay_gap)
     return "the cross-play table ranks fewer than two VUTs"
 
 
-def crossplay_verdict(a: CaseAnalysis) -> CaseVerdict:
+def crossplay_verdict(a: CaseAnalysis[Any]) -> CaseVerdict:
     """The cross-play mode's verdict; without a ranking of two VUTs, the exposure mode's
     in its place, as a warning."""
     import dataclasses
@@ -123,7 +123,7 @@ def crossplay_verdict(a: CaseAnalysis) -> CaseVerdict:
     return dataclasses.replace(exposure_verdict(a, EXPOSURE.name), kind="warning")
 
 
-def crossplay_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
+def crossplay_headline(a: CaseAnalysis[Any], v: CaseVerdict) -> str:
     """The cross-play mode's verdict in words; one that fell back to the exposure mode's
     says why first."""
     from sumo_ayss.analysis.seeds import SeedComparison
@@ -136,11 +136,11 @@ def crossplay_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
     return crossplay_sentence(v.top, a.crossplay_blocks)
 
 
-def _standings(a: CaseAnalysis) -> list[Standing]:
+def _standings(a: CaseAnalysis[Any]) -> list[Standing]:
     return seed_standings(a.crossplay_rows, lambda c: crossplay_sentence(c, a.crossplay_blocks))
 
 
-def _companion_lines(a: CaseAnalysis) -> list[str]:
+def _companion_lines(a: CaseAnalysis[Any]) -> list[str]:
     """The exposure ranking beside the cross-play one."""
     rows = a.exposure_rows
     if not rows:

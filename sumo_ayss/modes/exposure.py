@@ -5,7 +5,7 @@ Always available (it reads the runs' outcome tables); a paired t-test over share
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.modes.registry import Mode, Standing, register_mode
 from sumo_ayss.modes.seed_level import (
@@ -45,7 +45,7 @@ def exposure_sentence(c: SeedComparison) -> str:
     )
 
 
-def exposure_verdict(a: CaseAnalysis, name: str = NAME) -> CaseVerdict:
+def exposure_verdict(a: CaseAnalysis[Any], name: str = NAME) -> CaseVerdict:
     """The exposure mode's verdict, ranked under ``name`` (a plug-in built from this
     record ranks under its own name)."""
     from sumo_ayss.analysis.case_verdict import seed_verdict
@@ -54,7 +54,7 @@ def exposure_verdict(a: CaseAnalysis, name: str = NAME) -> CaseVerdict:
     return seed_verdict(name, a.exposure_rows, a.exposure_pairs, caution=caution)
 
 
-def exposure_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
+def exposure_headline(a: CaseAnalysis[Any], v: CaseVerdict) -> str:
     """The exposure mode's verdict in words."""
     from sumo_ayss.analysis.seeds import SeedComparison
 
@@ -66,7 +66,7 @@ def exposure_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
     return text
 
 
-def _standings(a: CaseAnalysis) -> list[Standing]:
+def _standings(a: CaseAnalysis[Any]) -> list[Standing]:
     return seed_standings(a.exposure_rows, exposure_sentence)
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p
 from sumo_ayss.modes.registry import Mode, Standing, register_mode
@@ -155,7 +155,7 @@ def significance_rule(options: SignificanceOptions) -> str:
     )
 
 
-def paper_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
+def paper_headline(a: CaseAnalysis[Any], v: CaseVerdict) -> str:
     """The paper mode's verdict in words."""
     from sumo_ayss.analysis.significance import PairVerdict
 
@@ -170,7 +170,7 @@ def paper_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
     return text + _CONFOUNDED if v.caveat == "premise_not_met" else text
 
 
-def _standings(a: CaseAnalysis) -> list[Standing]:
+def _standings(a: CaseAnalysis[Any]) -> list[Standing]:
     pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
     order = [r.name for r in a.ranking]
     out = []
@@ -201,7 +201,7 @@ def _standings(a: CaseAnalysis) -> list[Standing]:
     return out
 
 
-def _ends(a: CaseAnalysis, safest: str, least: str) -> tuple[bool, float]:
+def _ends(a: CaseAnalysis[Any], safest: str, least: str) -> tuple[bool, float]:
     pair = next(
         (p for p in a.pairs if {p.verdict.name_a, p.verdict.name_b} == {safest, least}),
         None,
@@ -209,7 +209,7 @@ def _ends(a: CaseAnalysis, safest: str, least: str) -> tuple[bool, float]:
     return pair is not None and pair.safer == safest, math.nan
 
 
-def _score_text(a: CaseAnalysis, s: Standing) -> str:
+def _score_text(a: CaseAnalysis[Any], s: Standing) -> str:
     ci = fmt_interval(s.lo, s.hi)
     return f"{fmt_num(s.score)} {a.info.indicator.unit}" + (f" ({ci})" if ci else "")
 

@@ -11,7 +11,7 @@ import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.util.registry import Registry
 from sumo_ayss.util.validation import check_choice, require
@@ -131,19 +131,19 @@ class Mode:
     score_name: str
     interval_name: str
     digits: int
-    available: Callable[[CaseAnalysis], bool]
-    standings: Callable[[CaseAnalysis], list[Standing]]
-    verdict: Callable[[CaseAnalysis], CaseVerdict]
-    headline: Callable[[CaseAnalysis, CaseVerdict], str]
-    unit: Callable[[CaseAnalysis], str]
-    ends: Callable[[CaseAnalysis, str, str], tuple[bool, float]]
-    score_text: Callable[[CaseAnalysis, Standing], str]
+    available: Callable[[CaseAnalysis[Any]], bool]
+    standings: Callable[[CaseAnalysis[Any]], list[Standing]]
+    verdict: Callable[[CaseAnalysis[Any]], CaseVerdict]
+    headline: Callable[[CaseAnalysis[Any], CaseVerdict], str]
+    unit: Callable[[CaseAnalysis[Any]], str]
+    ends: Callable[[CaseAnalysis[Any], str, str], tuple[bool, float]]
+    score_text: Callable[[CaseAnalysis[Any], Standing], str]
     interval_text: Callable[[float, float, int, int], str]
-    companion_lines: Callable[[CaseAnalysis], list[str]]
-    closing_lines: Callable[[CaseAnalysis], list[str]]
+    companion_lines: Callable[[CaseAnalysis[Any]], list[str]]
+    closing_lines: Callable[[CaseAnalysis[Any]], list[str]]
     runs_crossplay: bool = False
     needs_safety_index: bool = False
-    gap_text: Callable[[CaseAnalysis], str] | None = None
+    gap_text: Callable[[CaseAnalysis[Any]], str] | None = None
 
     def __post_init__(self) -> None:
         require(
@@ -193,12 +193,12 @@ def check_mode(name: str, where: str = "report.mode") -> Mode:
     return get_mode(name)
 
 
-def headline_text(a: CaseAnalysis) -> str:
+def headline_text(a: CaseAnalysis[Any]) -> str:
     """The case's headline: its verdict (``a.verdict``) worded by the mode asked for."""
     return get_mode(a.mode).headline(a, a.verdict)
 
 
-def missing_rows_line(a: CaseAnalysis) -> str | None:
+def missing_rows_line(a: CaseAnalysis[Any]) -> str | None:
     """One line saying why the mode asked for (``a.mode``) has no rows for the case and
     which mode's rows stand in their place, for ``ranking.md``, the report's leaderboard
     and the terminal; None when it has them."""

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.modes.formatting import (
     fmt_interval,
@@ -165,12 +165,12 @@ def seed_interval(lo: float, hi: float, n_seeds: int, digits: int) -> str:
     return seed_interval_text(lo, hi, n_seeds, digits)
 
 
-def seed_score_text(a: CaseAnalysis, s: Standing) -> str:
+def seed_score_text(a: CaseAnalysis[Any], s: Standing) -> str:
     """A seed-level score with its interval, three decimals, as the leaderboard writes it."""
     return f"{fmt_num(s.score, 3)} ({seed_interval(s.lo, s.hi, s.n_seeds, 3)})"
 
 
-def paper_verdict_lines(a: CaseAnalysis) -> list[str]:
+def paper_verdict_lines(a: CaseAnalysis[Any]) -> list[str]:
     """The paper mode's verdict, closing the callout of a mode that is not the paper's."""
     v = a.paper_verdict
     line = get_mode(v.mode).headline(a, v)
@@ -179,6 +179,6 @@ def paper_verdict_lines(a: CaseAnalysis) -> list[str]:
     return [line]
 
 
-def no_lines(a: CaseAnalysis) -> list[str]:
+def no_lines(a: CaseAnalysis[Any]) -> list[str]:
     """No further verdict lines."""
     return []
