@@ -31,12 +31,13 @@ from sumo_ayss.report.sections.outcome import (
 )
 from sumo_ayss.report.sections.paper import paper_blocks
 from sumo_ayss.report.sections.reference import reference_blocks
+from sumo_ayss.run_folder import RunRecord
 
 __all__ = ["case_blocks", "verdict_lines"]
 
 
 def case_blocks(
-    a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
+    a: CaseAnalysis[RunRecord], colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
     info, case = a.info, a.case
     anchor = f"case-{case}"
@@ -61,7 +62,7 @@ def case_blocks(
     return blocks
 
 
-def verdict_lines(a: CaseAnalysis, options: ReportOptions) -> tuple[str, ...]:
+def verdict_lines(a: CaseAnalysis[RunRecord], options: ReportOptions) -> tuple[str, ...]:
     """The verdict callout: the mode's headline and ranking, the premise, the other modes."""
     v = a.verdict
     lines = [headline_text(a)]
@@ -73,7 +74,7 @@ def verdict_lines(a: CaseAnalysis, options: ReportOptions) -> tuple[str, ...]:
     return tuple(lines)
 
 
-def reward_blocks(a: CaseAnalysis, out_dir: Path) -> list[Block]:
+def reward_blocks(a: CaseAnalysis[RunRecord], out_dir: Path) -> list[Block]:
     blocks: list[Block] = [Heading("(a) Reward shapes", 3)]
     rewards = [r.reward for rs in a.runs.values() for r in rs if r.reward is not None]
     if not rewards:
@@ -90,7 +91,9 @@ def reward_blocks(a: CaseAnalysis, out_dir: Path) -> list[Block]:
     return [*blocks, FigureBlock(path, caption)]
 
 
-def learning_blocks(a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path) -> list[Block]:
+def learning_blocks(
+    a: CaseAnalysis[RunRecord], colors: Mapping[str, str], out_dir: Path
+) -> list[Block]:
     path = figures.learning_curves_figure(
         a.runs,
         colors,
@@ -130,7 +133,7 @@ def learning_blocks(a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path) -
 
 
 def indicator_blocks(
-    a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
+    a: CaseAnalysis[RunRecord], colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
     info = a.info
     edges = options.figure_edges
