@@ -7,14 +7,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from sumo_ayss.modes.registry import Mode, Standing, register_mode
+from sumo_ayss.modes.registry import Standing, register_mode
 from sumo_ayss.modes.seed_level import (
     INTERVAL_NAME,
-    no_lines,
-    paper_verdict_lines,
+    SeedLevelMode,
     seed_ends,
-    seed_interval,
-    seed_score_text,
     seed_standings,
     verdict_sentence,
 )
@@ -27,6 +24,7 @@ if TYPE_CHECKING:
 __all__ = [
     "EXPOSURE",
     "EXPOSURE_SCORE",
+    "ExposureMode",
     "exposure_headline",
     "exposure_sentence",
     "exposure_verdict",
@@ -66,12 +64,30 @@ def exposure_headline(a: CaseAnalysis[Any], v: CaseVerdict) -> str:
     return text
 
 
-def _standings(a: CaseAnalysis[Any]) -> list[Standing]:
-    return seed_standings(a.exposure_rows, exposure_sentence)
+class ExposureMode(SeedLevelMode):
+    """Exposure mode: its ranking, verdict and words (see the module docstring)."""
+
+    def available(self, a: CaseAnalysis[Any]) -> bool:
+        return bool(a.exposure_rows)
+
+    def standings(self, a: CaseAnalysis[Any]) -> list[Standing]:
+        return seed_standings(a.exposure_rows, exposure_sentence)
+
+    def verdict(self, a: CaseAnalysis[Any]) -> CaseVerdict:
+        return exposure_verdict(a, a.mode)
+
+    def headline(self, a: CaseAnalysis[Any], v: CaseVerdict) -> str:
+        return exposure_headline(a, v)
+
+    def unit(self, a: CaseAnalysis[Any]) -> str:
+        return "harm/episode, own SPCPs (lower = safer)"
+
+    def ends(self, a: CaseAnalysis[Any], safest: str, least: str) -> tuple[bool, float]:
+        return seed_ends(a.exposure_pairs, safest, least)
 
 
 EXPOSURE = register_mode(
-    Mode(
+    ExposureMode(
         name=NAME,
         description=(
             "Exposure mode: a VUT's score is the mean harm per episode its own SPCPs bring "
@@ -86,15 +102,5 @@ EXPOSURE = register_mode(
         score_name="exposure harm per episode (lower = safer)",
         interval_name=INTERVAL_NAME,
         digits=3,
-        available=lambda a: bool(a.exposure_rows),
-        standings=_standings,
-        verdict=lambda a: exposure_verdict(a, a.mode),
-        headline=exposure_headline,
-        unit=lambda a: "harm/episode, own SPCPs (lower = safer)",
-        ends=lambda a, safest, least: seed_ends(a.exposure_pairs, safest, least),
-        score_text=seed_score_text,
-        interval_text=seed_interval,
-        companion_lines=no_lines,
-        closing_lines=paper_verdict_lines,
     )
 )

@@ -7,9 +7,9 @@ configuration validates ``report.mode`` against this registry without loading nu
 
 from __future__ import annotations
 
+import abc
 import math
 import re
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -89,11 +89,13 @@ class Standing:
 
 
 @dataclass(frozen=True)
-class Mode:
+class Mode(abc.ABC):
     """A ranking mode: how a case's VUTs are scored, ranked and compared, and how that reads.
 
-    The hooks read a :class:`~sumo_ayss.analysis.case.CaseAnalysis`; a mode module imports
-    what they need inside them, so that this record stays light.
+    A mode is an object: its data are the fields below, its behaviour the methods, which
+    read a :class:`~sumo_ayss.analysis.case.CaseAnalysis`. A new mode subclasses this class
+    in one module of :mod:`sumo_ayss.modes` (its methods import what they need when called,
+    so that this module stays light) and registers an instance.
 
     Attributes:
         name: The mode's name in ``report.mode``, ``--mode`` and ``ranking.csv``.
@@ -104,26 +106,6 @@ class Mode:
         runs_crossplay: The pipeline runs the cross-play stage before the report.
         needs_safety_index: Ranking in this mode needs the AYSS safety indices (the slow
             bootstrap); a ranking in another mode skips them.
-        available: Whether the mode has a ranking of this case.
-        standings: The case's ranking in this mode, safest first.
-        verdict: The case's verdict when this mode was asked for, as a record (called by
-            the analysis after every mode's data is computed); its ``mode`` is another
-            mode's when this one has no ranking and falls back to it.
-        headline: The verdict record in words: ``(analysis, verdict) -> sentence``, for a
-            verdict this mode gave (or fell back from).
-        unit: The score's unit text in ``ranking.csv`` and ``ranking.md``.
-        ends: ``(found, p)`` for a known safest and least safe VUT: whether this mode
-            finds the first significantly safer than the second, and the p-value (NaN when
-            the mode has none).
-        score_text: The score with its interval as the leaderboard writes it.
-        interval_text: ``(lo, hi, n_seeds, digits)`` -> the interval as ``ranking.md``
-            writes it ("" without one).
-        companion_lines: Verdict-callout lines after the ranking line, when this mode gave
-            the headline (e.g. the other modes' rankings).
-        closing_lines: Verdict-callout lines after the premise check, when this mode was
-            asked for.
-        gap_text: Why the mode has no ranking of a case, one sentence
-            (:func:`missing_rows_line`); None: a generic sentence.
     """
 
     name: str
@@ -131,25 +113,65 @@ class Mode:
     score_name: str
     interval_name: str
     digits: int
-    available: Callable[[CaseAnalysis[Any]], bool]
-    standings: Callable[[CaseAnalysis[Any]], list[Standing]]
-    verdict: Callable[[CaseAnalysis[Any]], CaseVerdict]
-    headline: Callable[[CaseAnalysis[Any], CaseVerdict], str]
-    unit: Callable[[CaseAnalysis[Any]], str]
-    ends: Callable[[CaseAnalysis[Any], str, str], tuple[bool, float]]
-    score_text: Callable[[CaseAnalysis[Any], Standing], str]
-    interval_text: Callable[[float, float, int, int], str]
-    companion_lines: Callable[[CaseAnalysis[Any]], list[str]]
-    closing_lines: Callable[[CaseAnalysis[Any]], list[str]]
     runs_crossplay: bool = False
     needs_safety_index: bool = False
-    gap_text: Callable[[CaseAnalysis[Any]], str] | None = None
 
     def __post_init__(self) -> None:
         require(
             isinstance(self.name, str) and _NAME.fullmatch(self.name) is not None,
             f"mode name must be lower-case letters, digits and '_', got {self.name!r}",
         )
+
+    @abc.abstractmethod
+    def available(self, a: CaseAnalysis[Any]) -> bool:
+        """Whether the mode has a ranking of this case."""
+
+    @abc.abstractmethod
+    def standings(self, a: CaseAnalysis[Any]) -> list[Standing]:
+        """The case's ranking in this mode, safest first."""
+
+    @abc.abstractmethod
+    def verdict(self, a: CaseAnalysis[Any]) -> CaseVerdict:
+        """The case's verdict when this mode was asked for, as a record (called after every
+        mode's data is computed); its ``mode`` is another mode's when this one has no
+        ranking and falls back to it."""
+
+    @abc.abstractmethod
+    def headline(self, a: CaseAnalysis[Any], v: CaseVerdict) -> str:
+        """The verdict record ``v`` in words, for a verdict this mode gave (or fell back
+        from)."""
+
+    @abc.abstractmethod
+    def unit(self, a: CaseAnalysis[Any]) -> str:
+        """The score's unit text in ``ranking.csv`` and ``ranking.md``."""
+
+    @abc.abstractmethod
+    def ends(self, a: CaseAnalysis[Any], safest: str, least: str) -> tuple[bool, float]:
+        """``(found, p)`` for a known safest and least safe VUT: whether this mode finds the
+        first significantly safer than the second, and the p-value (NaN when it has none)."""
+
+    @abc.abstractmethod
+    def score_text(self, a: CaseAnalysis[Any], s: Standing) -> str:
+        """The score with its interval as the leaderboard writes it."""
+
+    @abc.abstractmethod
+    def interval_text(self, lo: float, hi: float, n_seeds: int, digits: int) -> str:
+        """The interval as ``ranking.md`` writes it ("" without one)."""
+
+    def companion_lines(self, a: CaseAnalysis[Any]) -> list[str]:
+        """Verdict-callout lines after the ranking line, when this mode gave the headline
+        (e.g. the other modes' rankings); none by default."""
+        return []
+
+    def closing_lines(self, a: CaseAnalysis[Any]) -> list[str]:
+        """Verdict-callout lines after the premise check, when this mode was asked for;
+        none by default."""
+        return []
+
+    def gap_text(self, a: CaseAnalysis[Any]) -> str | None:
+        """Why the mode has no ranking of a case, one sentence (:func:`missing_rows_line`);
+        None (the default): a generic sentence."""
+        return None
 
 
 # --------------------------------------------------------------------------- the registry
@@ -205,7 +227,7 @@ def missing_rows_line(a: CaseAnalysis[Any]) -> str | None:
     mode = get_mode(a.mode)
     if mode.available(a):
         return None
-    why = mode.gap_text(a) if mode.gap_text is not None else "this mode has no ranking of it"
+    why = mode.gap_text(a) or "this mode has no ranking of it"
     why = why.rstrip(". ")
     instead = (
         f"; the {a.ranking_mode}-mode rows stand in their place" if a.ranking_mode != a.mode else ""

@@ -18,7 +18,7 @@ from sumo_ayss.modes.formatting import (
     ranking_line,
     seed_interval_text,
 )
-from sumo_ayss.modes.registry import Standing, get_mode
+from sumo_ayss.modes.registry import Mode, Standing, get_mode
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
@@ -26,6 +26,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "INTERVAL_NAME",
+    "SeedLevelMode",
     "no_lines",
     "paper_verdict_lines",
     "seed_ends",
@@ -182,3 +183,18 @@ def paper_verdict_lines(a: CaseAnalysis[Any]) -> list[str]:
 def no_lines(a: CaseAnalysis[Any]) -> list[str]:
     """No further verdict lines."""
     return []
+
+
+class SeedLevelMode(Mode):
+    """A mode whose score is a per-seed mean compared by a paired test over seeds (exposure,
+    cross-play): its interval and score read alike, and its callout closes with the paper
+    mode's verdict."""
+
+    def score_text(self, a: CaseAnalysis[Any], s: Standing) -> str:
+        return seed_score_text(a, s)
+
+    def interval_text(self, lo: float, hi: float, n_seeds: int, digits: int) -> str:
+        return seed_interval(lo, hi, n_seeds, digits)
+
+    def closing_lines(self, a: CaseAnalysis[Any]) -> list[str]:
+        return paper_verdict_lines(a)
