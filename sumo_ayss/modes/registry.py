@@ -168,6 +168,17 @@ class Mode(abc.ABC):
         none by default."""
         return []
 
+    def compute(self, a: CaseAnalysis[Any]) -> object | None:
+        """The mode's own result from the case's data, kept in ``a.results[name]`` (by
+        :func:`~sumo_ayss.modes.analyse_case`, before any verdict); None (the default): the
+        mode reads what the analysis computed for every mode."""
+        return None
+
+    def section(self, a: CaseAnalysis[Any]) -> tuple[str, list[str]] | None:
+        """The report's section of this mode for a case, ``(title, paragraphs)``, after the
+        built-in sections; None (the default): none of its own."""
+        return None
+
     def gap_text(self, a: CaseAnalysis[Any]) -> str | None:
         """Why the mode has no ranking of a case, one sentence (:func:`missing_rows_line`);
         None (the default): a generic sentence."""

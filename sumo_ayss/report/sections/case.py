@@ -14,7 +14,7 @@ import numpy as np
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.config.report import ReportOptions
-from sumo_ayss.modes import get_mode, headline_text
+from sumo_ayss.modes import get_mode, headline_text, registered_modes
 from sumo_ayss.modes.formatting import fmt_num, ranking_line
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragraph, Table
@@ -59,6 +59,10 @@ def case_blocks(
     blocks += crossplay_blocks(a, colors, out_dir, options)
     blocks += measures_blocks(a, colors, out_dir, options)
     blocks += reference_blocks(a)
+    for mode in registered_modes():  # a mode's own section (none for the built-in ones)
+        section = mode.section(a)
+        if section is not None:
+            blocks += [Heading(section[0], 3), *(Paragraph(p) for p in section[1])]
     return blocks
 
 
