@@ -307,7 +307,7 @@ def _mobility_cell(row: dict[str, Any]) -> str:
 def main(argv: Sequence[str] | None = None) -> None:
     import dataclasses
 
-    from sumo_ayss.cli import prog
+    from sumo_ayss.cli import STRICT_HELP, prog
     from sumo_ayss.pipeline import (
         add_config_flags,
         config_from_args,
@@ -316,7 +316,6 @@ def main(argv: Sequence[str] | None = None) -> None:
         plan_jobs,
         run_pipeline,
     )
-    from sumo_ayss.report.__main__ import STRICT_HELP
     from sumo_ayss.report.checks import input_problems
 
     parser = argparse.ArgumentParser(
