@@ -695,7 +695,13 @@ RESUME_CORRUPTIONS: list[tuple[str, str, Corruption, str]] = [
         "state.json not a state",
         "checkpoints/LATEST/state.json",
         lambda p: p.write_text("[]"),
-        "not a checkpoint state",
+        "state.json: expected a JSON object, got list",
+    ),
+    (
+        "state.json without counters",
+        "checkpoints/LATEST/state.json",
+        lambda p: p.write_text('{"next_eval": 4}'),
+        "state.json: not a checkpoint state: missing field 'num_timesteps'",
     ),
     (
         "truncated model.zip",

@@ -17,7 +17,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from sumo_ayss.run_folder.jsonio import read_json, write_json
+from sumo_ayss.run_folder.jsonio import json_field, read_json, write_json
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.sequential import SettleCheck
@@ -77,8 +77,18 @@ def write_adaptive(path: str | Path, record: AdaptiveRecord) -> None:
     write_json(path, data)
 
 
+_NUMBER = (int, float)
+_NUMBER_OR_NULL = (int, float, type(None))
+
+
 def _float(value: Any) -> float:
     return math.nan if value is None else float(value)
+
+
+def _ints(values: list[Any], key: str, where: str) -> list[int]:
+    if not all(isinstance(v, int) and not isinstance(v, bool) for v in values):
+        raise TableError(f"{where}: {key}: expected a list of integers, got {values!r}")
+    return values
 
 
 def read_adaptive(path: str | Path) -> AdaptiveRecord:
@@ -90,29 +100,34 @@ def read_adaptive(path: str | Path) -> AdaptiveRecord:
     from sumo_ayss.analysis.sequential import SettleCheck
 
     data = read_json(path)
-    try:
-        if data.get("format") != ADAPTIVE_FORMAT:
-            raise TableError(f"{path}: format {data.get('format')!r}, expected {ADAPTIVE_FORMAT}")
-        looks: list[Mapping[str, Any]] = data["looks"]
-        return AdaptiveRecord(
-            first_seeds=tuple(int(s) for s in data["first_seeds"]),
-            max_seeds=int(data["max_seeds"]),
-            alpha=float(data["alpha"]),
-            seeds=tuple(int(s) for s in data["seeds"]),
-            looks=tuple(
-                SettleCheck(
-                    n_seeds=int(x["n_seeds"]),
-                    omnibus_p=_float(x["omnibus_p"]),
-                    gate_level=float(x["gate_level"]),
-                    safest=str(x["safest"]),
-                    least_safe=str(x["least_safe"]),
-                    ends_p=_float(x["ends_p"]),
-                    alpha=float(x["alpha"]),
-                    settled=bool(x["settled"]),
-                )
-                for x in looks
-            ),
-            vuts=tuple((str(k), str(v)) for k, v in dict(data.get("vuts") or {}).items()),
+    where = str(path)
+    if data.get("format") != ADAPTIVE_FORMAT:
+        raise TableError(f"{path}: format {data.get('format')!r}, expected {ADAPTIVE_FORMAT}")
+    looks = []
+    for i, x in enumerate(json_field(data, "looks", list, where)):
+        at = f"{where}: looks[{i}]"
+        if not isinstance(x, Mapping):
+            raise TableError(f"{at}: expected an object, got {x!r}")
+        looks.append(
+            SettleCheck(
+                n_seeds=json_field(x, "n_seeds", int, at),
+                omnibus_p=_float(json_field(x, "omnibus_p", _NUMBER_OR_NULL, at)),
+                gate_level=float(json_field(x, "gate_level", _NUMBER, at)),
+                safest=json_field(x, "safest", str, at),
+                least_safe=json_field(x, "least_safe", str, at),
+                ends_p=_float(json_field(x, "ends_p", _NUMBER_OR_NULL, at)),
+                alpha=float(json_field(x, "alpha", _NUMBER, at)),
+                settled=json_field(x, "settled", bool, at),
+            )
         )
-    except (KeyError, TypeError, ValueError) as exc:
-        raise TableError(f"{path}: not an adaptive-seeding record ({exc!r})") from None
+    vuts = (json_field(data, "vuts", (dict, type(None)), where) if "vuts" in data else None) or {}
+    return AdaptiveRecord(
+        first_seeds=tuple(
+            _ints(json_field(data, "first_seeds", list, where), "first_seeds", where)
+        ),
+        max_seeds=json_field(data, "max_seeds", int, where),
+        alpha=float(json_field(data, "alpha", _NUMBER, where)),
+        seeds=tuple(_ints(json_field(data, "seeds", list, where), "seeds", where)),
+        looks=tuple(looks),
+        vuts=tuple((str(k), str(v)) for k, v in vuts.items()),
+    )

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from sumo_ayss.run_folder.jsonio import read_json, write_json
+from sumo_ayss.run_folder.jsonio import json_field, read_json, write_json
 from sumo_ayss.run_folder.layout import CaseFolder
 from sumo_ayss.run_folder.schemas import CROSSPLAY_SCHEMA
 from sumo_ayss.run_folder.table import read_table
@@ -178,28 +178,18 @@ def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
     )
 
 
-def _field(data: Mapping[str, Any], key: str, kind: type | tuple[type, ...], where: str) -> Any:
-    if key not in data:
-        raise TableError(f"{where}: missing field {key!r}")
-    value = data[key]
-    if isinstance(value, bool) or not isinstance(value, kind):  # no field is a boolean
-        names = " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
-        raise TableError(f"{where}: {key}: expected {names}, got {value!r}")
-    return value
-
-
 def _records(
     data: Mapping[str, Any], key: str, where: str, cls: type[_R], kinds: tuple[type, ...]
 ) -> tuple[_R, ...]:
     """The list ``data[key]`` of JSON objects as ``cls`` records, field by field in the
     order of ``cls``'s dataclass fields, each checked to be of its kind."""
     out = []
-    for i, item in enumerate(_field(data, key, list, where)):
+    for i, item in enumerate(json_field(data, key, list, where)):
         at = f"{where}: {key}[{i}]"
         if not isinstance(item, Mapping):
             raise TableError(f"{at}: expected an object, got {item!r}")
         names = [f.name for f in dataclasses.fields(cls)]  # type: ignore[arg-type]
-        out.append(cls(*(_field(item, n, k, at) for n, k in zip(names, kinds, strict=True))))
+        out.append(cls(*(json_field(item, n, k, at) for n, k in zip(names, kinds, strict=True))))
     return tuple(out)
 
 
@@ -213,7 +203,7 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
     data = read_json(path)
     where = str(path)
     opponents = _records(data, "opponents", where, CrossplayOpponent, (str, int, str))
-    vuts = _field(data, "vuts", list, where)
+    vuts = json_field(data, "vuts", list, where)
     if not all(isinstance(v, str) for v in vuts):
         raise TableError(f"{where}: vuts: expected a list of names, got {vuts!r}")
     diagonal = (
@@ -232,12 +222,12 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
     ):
         raise TableError(f"{where}: vut_keys: expected a key per VUT of {vuts}, got {keys!r}")
     return CrossplayRecord(
-        case=_field(data, "case", str, where),
-        n=_field(data, "n", int, where),
-        seed=_field(data, "seed", int, where),
+        case=json_field(data, "case", str, where),
+        n=json_field(data, "n", int, where),
+        seed=json_field(data, "seed", int, where),
         opponents=opponents,
         vuts=tuple(vuts),
-        wall_s=float(_field(data, "wall_s", (int, float), where)),
+        wall_s=float(json_field(data, "wall_s", (int, float), where)),
         rollout=rollout,
         diagonal=diagonal,
         vut_keys=tuple(keys[v] for v in vuts) if keys else (),
@@ -299,9 +289,9 @@ def read_inevitable(path: Path) -> tuple[int, int, tuple[int, ...]]:
         TableError: If the file is missing, unreadable or malformed.
     """
     data = read_json(path)
-    n = _field(data, "n", int, str(path))
-    seed = _field(data, "seed", int, str(path))
-    ics = _field(data, "ics", list, str(path))
+    n = json_field(data, "n", int, str(path))
+    seed = json_field(data, "seed", int, str(path))
+    ics = json_field(data, "ics", list, str(path))
     if not all(isinstance(i, int) and 0 <= i < n for i in ics):
         raise TableError(f"{path}: ics must list scenario indices in [0, {n})")
     return n, seed, tuple(ics)

@@ -1,6 +1,11 @@
 """JSON summaries of the run folder (``outcome.json``, ``ayss.json``): strict JSON, one
 writer, one reader.
 
+:func:`read_json` is the one JSON reader of :mod:`sumo_ayss.run_folder` and
+:func:`json_field` its one field check: every stored JSON file is read through them, and every
+error they raise names the file and the field (:class:`~sumo_ayss.util.errors.StoredFileError`,
+the common base of the ``TableError`` and ``CheckpointError`` callers catch).
+
 Non-finite floats are written as ``null`` (strict JSON has no NaN); numpy scalars and arrays
 become Python numbers and lists; paths become strings. Files are indented, key-sorted and
 written atomically.
@@ -17,9 +22,9 @@ from typing import Any
 import numpy as np
 
 from sumo_ayss.util.atomic import atomic_write_text
-from sumo_ayss.util.errors import TableError
+from sumo_ayss.util.errors import StoredFileError, TableError
 
-__all__ = ["read_json", "write_json"]
+__all__ = ["json_field", "read_json", "write_json"]
 
 
 def _jsonable(obj: Any) -> Any:
@@ -49,24 +54,64 @@ def write_json(path: str | Path, data: Mapping[str, Any]) -> None:
     atomic_write_text(path, text + "\n")
 
 
-def read_json(path: str | Path) -> dict[str, Any]:
-    """Read a summary written by :func:`write_json`.
+def read_json(path: str | Path, *, error: type[StoredFileError] = TableError) -> dict[str, Any]:
+    """Read a JSON object from a stored file: the one JSON reader of the run folder.
+
+    Args:
+        path: The file.
+        error: The :class:`~sumo_ayss.util.errors.StoredFileError` to raise: a summary or
+            study file raises :class:`TableError` (the default), a run's own records
+            (``seeds.json``, ``spcp.json``, checkpoints) :class:`CheckpointError`.
 
     Raises:
-        TableError: If the file is missing or unreadable, not UTF-8 JSON, or not a JSON
-            object.
+        StoredFileError: (``error``) If the file is missing or unreadable, not UTF-8 JSON,
+            or not a JSON object; the message starts with the file.
     """
     path = Path(path)
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise TableError(f"{path}: summary file not found") from None
+        raise error(f"{path}: file not found") from None
     except UnicodeDecodeError as exc:
-        raise TableError(f"{path}: not UTF-8 text, not JSON ({exc})") from None
+        raise error(f"{path}: unreadable JSON: not UTF-8 text ({exc})") from None
     except json.JSONDecodeError as exc:
-        raise TableError(f"{path}: not valid JSON ({exc})") from None
+        raise error(f"{path}: unreadable JSON: not valid JSON ({exc})") from None
     except OSError as exc:
-        raise TableError(f"{path}: cannot read ({exc})") from None
+        raise error(f"{path}: unreadable JSON: cannot read ({exc})") from None
     if not isinstance(data, dict):
-        raise TableError(f"{path}: expected a JSON object, got {type(data).__name__}")
+        raise error(f"{path}: expected a JSON object, got {type(data).__name__}")
     return data
+
+
+def json_field(
+    data: Mapping[str, Any],
+    key: str,
+    kind: type | tuple[type, ...],
+    where: str,
+    *,
+    error: type[StoredFileError] = TableError,
+) -> Any:
+    """``data[key]``, checked to be present and of ``kind`` (a boolean is never an ``int``
+    or ``float`` here unless ``kind`` names ``bool``).
+
+    Args:
+        data: A JSON object as read.
+        key: The field.
+        kind: The allowed type(s); ``object`` allows any value.
+        where: The file and the object's place in it (``"<path>: cases[2]"``).
+        error: The error type to raise (as :func:`read_json`).
+
+    Raises:
+        StoredFileError: ``<where>: missing field 'key'`` or ``<where>: key: expected int,
+            got ...``.
+    """
+    if key not in data:
+        raise error(f"{where}: missing field {key!r}")
+    value = data[key]
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    if (isinstance(value, bool) and bool not in kinds and object not in kinds) or not isinstance(
+        value, kinds
+    ):
+        names = " or ".join(k.__name__ for k in kinds)
+        raise error(f"{where}: {key}: expected {names}, got {value!r}")
+    return value

@@ -19,7 +19,6 @@ Imports neither SUMO nor torch.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import time
 from collections.abc import Mapping
@@ -30,6 +29,7 @@ from typing import Any
 import yaml
 
 from sumo_ayss.config import EnvConfig, check_seed, safe_load_yaml, write_yaml
+from sumo_ayss.run_folder.jsonio import json_field, read_json
 from sumo_ayss.run_folder.layout import PROGRESS_JSON
 from sumo_ayss.util.atomic import atomic_write_json, atomic_write_text
 from sumo_ayss.util.errors import CheckpointError, ConfigError
@@ -40,7 +40,6 @@ __all__ = [
     "SpcpChoice",
     "read_checkpoint_state",
     "read_command",
-    "read_json_object",
     "read_latest",
     "read_progress",
     "read_run_config",
@@ -56,21 +55,6 @@ __all__ = [
     "write_spcp",
     "write_versions",
 ]
-
-
-def read_json_object(path: Path) -> dict[str, Any]:
-    """A JSON object from a run-folder file.
-
-    Raises:
-        CheckpointError: The file is missing, unreadable, not JSON or not an object.
-    """
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as e:
-        raise CheckpointError(f"{path}: unreadable JSON ({e})") from e
-    if not isinstance(data, dict):
-        raise CheckpointError(f"{path}: expected a JSON object, got {type(data).__name__}")
-    return data
 
 
 # --------------------------------------------------------------------------- config.yaml
@@ -175,7 +159,7 @@ def read_versions(path: Path) -> dict[str, str]:
     Raises:
         CheckpointError: The file is missing, unreadable or not a JSON object.
     """
-    return {str(k): str(v) for k, v in read_json_object(path).items()}
+    return {str(k): str(v) for k, v in read_json(path, error=CheckpointError).items()}
 
 
 # --------------------------------------------------------------------------- seeds.json
@@ -207,14 +191,13 @@ def read_seeds(path: Path) -> Seeds:
     Raises:
         CheckpointError: The file is unreadable or a seed is missing or not an integer.
     """
-    data = read_json_object(path)
-    values = {}
-    for f in dataclasses.fields(Seeds):
-        value = data.get(f.name)
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise CheckpointError(f"{path}: {f.name} must be an integer, got {value!r}")
-        values[f.name] = value
-    return Seeds(**values)
+    data = read_json(path, error=CheckpointError)
+    return Seeds(
+        **{
+            f.name: json_field(data, f.name, int, str(path), error=CheckpointError)
+            for f in dataclasses.fields(Seeds)
+        }
+    )
 
 
 # --------------------------------------------------------------------------- spcp.json
@@ -261,10 +244,8 @@ def read_spcp(path: Path) -> SpcpChoice:
     Raises:
         CheckpointError: The file is unreadable or ``step`` is missing or not an integer.
     """
-    data = read_json_object(path)
-    step = data.get("step")
-    if isinstance(step, bool) or not isinstance(step, int):
-        raise CheckpointError(f"{path}: step must be an integer, got {step!r}")
+    data = read_json(path, error=CheckpointError)
+    step = json_field(data, "step", int, str(path), error=CheckpointError)
     score = data.get("score")
     return SpcpChoice(
         step=step,
@@ -291,13 +272,11 @@ def read_latest(path: Path) -> tuple[int, str]:
         CheckpointError: The file is unreadable, ``dir`` does not name a ``step_*`` folder
             (no path), or ``step`` is not an integer.
     """
-    data = read_json_object(path)
+    data = read_json(path, error=CheckpointError)
     name = data.get("dir")
     if not isinstance(name, str) or Path(name).name != name or not name.startswith("step_"):
         raise CheckpointError(f"{path}: 'dir' must name a step_* folder, got {name!r}")
-    step = data.get("step")
-    if isinstance(step, bool) or not isinstance(step, int):
-        raise CheckpointError(f"{path}: 'step' must be an integer, got {step!r}")
+    step = json_field(data, "step", int, str(path), error=CheckpointError)
     return step, name
 
 
@@ -312,12 +291,9 @@ def read_checkpoint_state(path: Path) -> dict[str, Any]:
     Raises:
         CheckpointError: The file is unreadable or not a checkpoint state.
     """
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as e:
-        raise CheckpointError(f"{path}: unreadable JSON ({e})") from e
-    if not isinstance(data, dict) or not {"num_timesteps", "next_eval"} <= set(data):
-        raise CheckpointError(f"{path}: not a checkpoint state")
+    data = read_json(path, error=CheckpointError)
+    for key in ("num_timesteps", "next_eval"):
+        json_field(data, key, object, f"{path}: not a checkpoint state", error=CheckpointError)
     return data
 
 
@@ -334,6 +310,6 @@ def write_progress(run_dir: Path, stage: str, **fields: Any) -> None:
 def read_progress(run_dir: Path) -> dict[str, Any] | None:
     """``<run_dir>/progress.json``, or None when it is missing or unreadable."""
     try:
-        return read_json_object(run_dir / PROGRESS_JSON)
+        return read_json(run_dir / PROGRESS_JSON, error=CheckpointError)
     except CheckpointError:
         return None

@@ -42,8 +42,9 @@ from sumo_ayss.config import AyssConfig, EnvConfig, ExperimentConfig, experiment
 from sumo_ayss.run_folder.crossplay import CrossplayRecord, read_crossplay_json
 from sumo_ayss.run_folder.discriminability import read_discriminability_json
 from sumo_ayss.run_folder.identity import DISPLAY_FIELDS, flat_config, run_identity
+from sumo_ayss.run_folder.jsonio import read_json
 from sumo_ayss.run_folder.layout import CaseFolder, RunFolder
-from sumo_ayss.run_folder.metadata import read_json_object, read_run_config
+from sumo_ayss.run_folder.metadata import read_run_config
 from sumo_ayss.run_folder.summaries import read_ayss_json, read_outcome_json
 from sumo_ayss.util.atomic import atomic_write_json
 from sumo_ayss.util.errors import CheckpointError, ConfigError, TableError
@@ -130,7 +131,7 @@ def read_done_marker(path: Path) -> str | None:
     """
     if not path.is_file():
         return None
-    inputs = read_json_object(path).get("inputs")
+    inputs = read_json(path, error=CheckpointError).get("inputs")
     return inputs if isinstance(inputs, str) else None
 
 

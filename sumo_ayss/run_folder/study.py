@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.run_folder.csvio import read_csv_rows, write_csv_rows
-from sumo_ayss.run_folder.jsonio import read_json
+from sumo_ayss.run_folder.jsonio import json_field, read_json
 from sumo_ayss.run_folder.layout import CaseFolder, case_dir_for
 from sumo_ayss.util.atomic import atomic_write_json
 from sumo_ayss.util.errors import TableError
@@ -317,20 +317,12 @@ def read_order_check(path: Path) -> OrderChecks:
     """
     data = read_json(path)
     expected = _names(data.get("expected"), f"{path}: expected")
-    items = data.get("cases")
-    if not isinstance(items, list):
-        raise TableError(f"{path}: cases: expected a list, got {items!r}")
     cases = []
-    for i, item in enumerate(items):
+    for i, item in enumerate(json_field(data, "cases", list, str(path))):
         at = f"{path}: cases[{i}]"
         if not isinstance(item, Mapping):
             raise TableError(f"{at}: expected an object, got {item!r}")
-        for key, kind in _CHECK_KINDS.items():
-            value = item.get(key)
-            wrong_bool = isinstance(value, bool) and kind is not bool
-            if key not in item or wrong_bool or not isinstance(value, kind):
-                raise TableError(f"{at}: {key}: missing or of the wrong type, got {value!r}")
-        fields = {k: item[k] for k in _CHECK_KINDS}
+        fields = {k: json_field(item, k, kind, at) for k, kind in _CHECK_KINDS.items()}
         fields["order"] = _names(item["order"], f"{at}: order")
         fields["expected"] = _names(item["expected"], f"{at}: expected")
         cases.append(OrderCheck(**fields))

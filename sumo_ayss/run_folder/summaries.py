@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.jsonio import read_json, write_json
+from sumo_ayss.run_folder.jsonio import json_field, read_json, write_json
 from sumo_ayss.util.errors import TableError
 
 __all__ = [
@@ -207,12 +207,6 @@ def write_ayss_json(
 # --------------------------------------------------------------------------- readers
 
 
-def _field(data: Mapping[str, Any], key: str, where: str) -> Any:
-    if key not in data:
-        raise TableError(f"{where}: missing field {key!r}")
-    return data[key]
-
-
 def _number(value: Any, where: str) -> float:
     """A JSON number, or NaN for ``null`` (how NaN is written)."""
     if value is None:
@@ -237,11 +231,11 @@ def _object(value: Any, where: str) -> Mapping[str, Any]:
 def _estimate(data: Mapping[str, Any], key: str, point: str, where: str) -> Estimate:
     """A proportion (``point="value"``) or a mean (``point="mean"``) of the summary."""
     where = f"{where}.{key}"
-    item = _object(_field(data, key, where.rsplit(".", 1)[0]), where)
+    item = _object(json_field(data, key, object, where.rsplit(".", 1)[0]), where)
     return Estimate(
-        _number(_field(item, point, where), f"{where}.{point}"),
-        _number(_field(item, "lo", where), f"{where}.lo"),
-        _number(_field(item, "hi", where), f"{where}.hi"),
+        _number(json_field(item, point, object, where), f"{where}.{point}"),
+        _number(json_field(item, "lo", object, where), f"{where}.lo"),
+        _number(json_field(item, "hi", object, where), f"{where}.hi"),
     )
 
 
@@ -254,14 +248,15 @@ def read_outcome_json(path: Path) -> OutcomeRecord:
     """
     data = read_json(path)
     where = f"{path}: summary"
-    summary = _object(_field(data, "summary", str(path)), where)
+    summary = _object(json_field(data, "summary", object, str(path)), where)
     lc = summary.get("lane_change_rate")
     lc_return = summary.get("lc_no_collision_return")
     subset = None
     if lc_return is not None:
         subset = OutcomeSubset(
             n=_count(
-                _field(_object(lc_return, where), "n", where), f"{where}.lc_no_collision_return.n"
+                json_field(_object(lc_return, where), "n", object, where),
+                f"{where}.lc_no_collision_return.n",
             ),
             mean_return=_estimate(summary, "lc_no_collision_return", "mean", where),
             mean_final_headway_m=_estimate(
@@ -269,7 +264,7 @@ def read_outcome_json(path: Path) -> OutcomeRecord:
             ),
         )
     outcome = Outcome(
-        n=_count(_field(summary, "n_episodes", where), f"{where}.n_episodes"),
+        n=_count(json_field(summary, "n_episodes", object, where), f"{where}.n_episodes"),
         crash_rate=_estimate(summary, "crash_rate", "value", where),
         lane_change_rate=None
         if lc is None
@@ -280,7 +275,9 @@ def read_outcome_json(path: Path) -> OutcomeRecord:
     )
     step = data.get("spcp_step")
     return OutcomeRecord(
-        settings=dict(_object(_field(data, "settings", str(path)), f"{path}: settings")),
+        settings=dict(
+            _object(json_field(data, "settings", object, str(path)), f"{path}: settings")
+        ),
         outcome=outcome,
         spcp_step=step if isinstance(step, int) and not isinstance(step, bool) else None,
     )
@@ -294,11 +291,11 @@ def read_ayss_json(path: Path) -> AyssRecord:
             ``indicator_name`` or ``counts`` is missing or of the wrong type.
     """
     data = read_json(path)
-    name = _field(data, "indicator_name", str(path))
-    if not isinstance(name, str):
-        raise TableError(f"{path}: indicator_name: expected text, got {name!r}")
+    name = json_field(data, "indicator_name", str, str(path))
     return AyssRecord(
-        settings=dict(_object(_field(data, "settings", str(path)), f"{path}: settings")),
+        settings=dict(
+            _object(json_field(data, "settings", object, str(path)), f"{path}: settings")
+        ),
         indicator_name=name,
-        counts=dict(_object(_field(data, "counts", str(path)), f"{path}: counts")),
+        counts=dict(_object(json_field(data, "counts", object, str(path)), f"{path}: counts")),
     )

@@ -20,7 +20,14 @@ class SimulationError(AyssError, RuntimeError):
     """SUMO failed, or was used in a way it does not support (e.g. a second live simulation)."""
 
 
-class CheckpointError(AyssError, RuntimeError):
+class StoredFileError(AyssError):
+    """A file of a run, case or study folder cannot be read back: the message names the file
+    and the field. The base of :class:`CheckpointError` (a run's own records: config, seeds,
+    SPCP, checkpoints) and :class:`TableError` (tables and stage summaries), so a reader of
+    any stored file can catch one type."""
+
+
+class CheckpointError(StoredFileError, RuntimeError):
     """A checkpoint or run folder cannot be read back or resumed."""
 
 
@@ -28,7 +35,7 @@ class ActionError(AyssError, ValueError):
     """An action outside the env's action space, or a step before reset."""
 
 
-class TableError(AyssError, ValueError):
+class TableError(StoredFileError, ValueError):
     """A table or summary file is missing, malformed, or does not match its schema."""
 
 

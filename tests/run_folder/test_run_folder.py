@@ -247,14 +247,48 @@ def test_readers_name_the_file_and_field(run_folder: RunFolder) -> None:
     with pytest.raises(TableError, match=r"outcome\.json: summary: missing field 'crash_rate'"):
         read_outcome_json(f.outcome_json)
     f.seeds.write_text('{"train_seed": 1, "sumo_seed": "x", "eval_seed": 2}')
-    with pytest.raises(CheckpointError, match=r"seeds\.json: sumo_seed must be an integer"):
+    with pytest.raises(CheckpointError, match=r"seeds\.json: sumo_seed: expected int, got 'x'"):
         read_seeds(f.seeds)
     f.config.write_text("vut: pi2\nenv: {}\n")
     with pytest.raises(CheckpointError, match=r"config\.yaml: unreadable run configuration"):
         read_run_config(f.config)
     f.spcp_json.write_text('{"score": 1}')
-    with pytest.raises(CheckpointError, match=r"spcp\.json: step must be an integer"):
+    with pytest.raises(CheckpointError, match=r"spcp\.json: missing field 'step'"):
         read_spcp(f.spcp_json)
+
+
+def test_one_json_reader_one_error_family(tmp_path: Path) -> None:
+    """Every stored JSON file is read by ``jsonio.read_json``: a broken file raises the same
+    message whichever reader meets it, as a ``StoredFileError`` (the base of the
+    ``TableError`` of summaries and the ``CheckpointError`` of a run's own records)."""
+    from sumo_ayss.run_folder.adaptive import read_adaptive
+    from sumo_ayss.run_folder.metadata import read_checkpoint_state, read_latest
+    from sumo_ayss.util.errors import StoredFileError
+
+    readers = [read_outcome_json, read_seeds, read_spcp, read_latest, read_checkpoint_state]
+    readers.append(read_adaptive)
+    for reader in readers:
+        for text, message in [
+            (None, "file not found"),
+            ("{", "unreadable JSON: not valid JSON"),
+            ("[1]", "expected a JSON object, got list"),
+        ]:
+            path = tmp_path / f"{reader.__name__}.json"
+            path.unlink(missing_ok=True)
+            if text is not None:
+                path.write_text(text)
+            with pytest.raises(StoredFileError) as info:
+                reader(path)
+            assert str(info.value).startswith(f"{path}: {message}"), reader.__name__
+    assert issubclass(TableError, StoredFileError) and issubclass(CheckpointError, StoredFileError)
+    with pytest.raises(CheckpointError):
+        read_seeds(tmp_path / "missing.json")
+    with pytest.raises(TableError):
+        read_outcome_json(tmp_path / "missing.json")
+    bad = tmp_path / "adaptive.json"
+    bad.write_text('{"format": 1, "looks": [{"n_seeds": true}]}')
+    with pytest.raises(TableError, match=r"adaptive\.json: looks\[0\]: n_seeds: expected int"):
+        read_adaptive(bad)
 
 
 def test_config_yaml_holds_the_vut_once_and_legacy_folders_still_read(tmp_path: Path) -> None:
@@ -327,5 +361,5 @@ def test_adaptive_record_round_trips_and_refuses_another_layout(tmp_path: Path) 
     assert not back.settled and back.same_plan((0, 1, 2, 3), 6, 0.05)
     assert not back.same_plan((0, 1, 2), 6, 0.05)
     path.write_text('{"format": 1, "looks": "x"}')
-    with pytest.raises(TableError, match="not an adaptive-seeding record"):
+    with pytest.raises(TableError, match=r"adaptive\.json: looks: expected list, got .x."):
         read_adaptive(path)

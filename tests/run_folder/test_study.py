@@ -115,7 +115,7 @@ def test_order_check_round_trips_and_keeps_the_former_text(tmp_path: Path) -> No
     committed = read_order_check(ROOT / "results" / "ladders" / "min_gap_a" / "order_check.json")
     assert committed.expected == ("gap15", "gap10", "gap5", "gap2") and committed.cases
     path.write_text('{"expected": ["a"], "cases": [{"case": "x", "mode": "crossplay"}]}')
-    with pytest.raises(TableError, match=r"order_check\.json: cases\[0\]: order: missing"):
+    with pytest.raises(TableError, match=r"order_check\.json: cases\[0\]: missing field 'order'"):
         read_order_check(path)
     path.write_text('{"expected": "a", "cases": []}')
     with pytest.raises(TableError, match=r"order_check\.json: expected: expected a list"):

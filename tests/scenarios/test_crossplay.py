@@ -165,7 +165,7 @@ def test_cli_cross_plays_a_tiny_grid_and_skips_when_done(tmp_path: Path, capsys)
         main([str(pipe)])
     for vut in ("pi1", "pi2"):
         train(load_experiment(exp).with_vut(vut), seed=0, out=out)
-    with pytest.raises(SystemExit, match=r"outcome\.json: summary file not found"):
+    with pytest.raises(SystemExit, match=r"outcome\.json: file not found"):
         main([str(pipe)])  # the diagonal check needs each run's outcome table
     for vut in ("pi1", "pi2"):
         evaluate_run(
