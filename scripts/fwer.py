@@ -126,6 +126,7 @@ def _study_name(path: Path) -> str:
 
 def committed_ladders() -> list[dict]:
     from sumo_ayss.analysis.crossplay import rank_crossplay
+    from sumo_ayss.analysis.harm import harm_scale_of
     from sumo_ayss.run_folder import read_ranking_csv
     from sumo_ayss.run_folder.crossplay import read_crossplay_matrix
     from sumo_ayss.run_folder.record import read_run
@@ -135,7 +136,7 @@ def committed_ladders() -> list[dict]:
         run = next(iter(sorted(path.parent.glob("*/seed_*"))), None)
         if run is None:
             continue
-        m = read_crossplay_matrix(path, read_run(run).harm_scale)
+        m = read_crossplay_matrix(path, harm_scale_of(read_run(run)))
         ranked, _ = rank_crossplay(m)
         raw = [r.vs_next.p for r in ranked[:-1] if r.vs_next is not None]
         rows.append(

@@ -29,6 +29,7 @@ import matplotlib as mpl
 mpl.use("Agg")
 from matplotlib.figure import Figure
 
+from sumo_ayss.analysis.harm import run_episodes
 from sumo_ayss.run_folder import (
     StudyFolder,
     group_runs,
@@ -103,7 +104,7 @@ def per_seed_figure(
         for k, (run, study, expected) in enumerate(entries):
             runs = _runs(study, case)
             scores = {
-                v: {r.seed: r.episodes.mean_harm for r in runs.get(v, []) if r.episodes}
+                v: {r.seed: e.mean_harm for r in runs.get(v, []) if (e := run_episodes(r))}
                 for v in expected
             }
             seeds = sorted({s for v in expected for s in scores[v]})

@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from sumo_ayss.analysis.crossplay import crossplay_matrix, rank_crossplay
-from sumo_ayss.analysis.harm import episode_harm
+from sumo_ayss.analysis.harm import episode_harm, harm_scale_of
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.run_folder import (
     MODEL_ZIP,
@@ -252,7 +252,7 @@ def _load_cells(folder: Path) -> tuple[dict, dict, float]:
     """(vut, opp_vut, opp_seed, step) -> (harm, collided) arrays; meta; CPU-s per episode."""
     meta = json.loads((folder / "cells.json").read_text())
     first = read_run(PROJECT_ROOT / next(iter(meta["runs"].values()))["run_dir"])
-    scale = first.harm_scale
+    scale = harm_scale_of(first)
     if scale is None:
         sys.exit(f"{first.path}: no harm scale ({'; '.join(first.problems)})")
     data: dict = defaultdict(list)

@@ -32,7 +32,14 @@ from sumo_ayss.analysis.crossplay import (
     CrossplayMatrix,
     rank_crossplay,
 )
-from sumo_ayss.analysis.harm import HARM_RANGE, EpisodeStats, VutOutcome, vut_outcomes
+from sumo_ayss.analysis.harm import (
+    HARM_RANGE,
+    ColumnsLike,
+    RewardLike,
+    VutOutcome,
+    run_episodes,
+    vut_outcomes,
+)
 from sumo_ayss.analysis.premise import Premise, premise_check
 from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex, rank, safety_index
 from sumo_ayss.analysis.reference import (
@@ -156,7 +163,13 @@ class RunLike(Protocol):
     def outcome(self) -> OutcomeLike | None: ...
 
     @property
-    def episodes(self) -> EpisodeStats | None: ...
+    def reward(self) -> RewardLike | None: ...
+
+    @property
+    def decisions_per_episode(self) -> int | None: ...
+
+    @property
+    def outcome_table(self) -> ColumnsLike | None: ...
 
 
 R = TypeVar("R", bound=RunLike)
@@ -282,9 +295,15 @@ def _exposure(out: CaseAnalysis[R], options: CaseOptions) -> None:
     scores = []
     counts: dict[str, tuple[int, int, float]] = {}
     for vut, members in out.runs.items():
-        done = [
-            (r.seed, r.episodes) for r in members if r.seed is not None and r.episodes is not None
-        ]
+        done = []
+        for r in members:
+            try:
+                episodes = run_episodes(r)
+            except ConfigError as exc:  # the table does not fit the run's scale
+                out.problems.append(f"{run_label(r)}: outcome.csv unreadable ({exc})")
+                continue
+            if r.seed is not None and episodes is not None:
+                done.append((r.seed, episodes))
         if done:
             scores.append(SeedScores(vut, {seed: e.mean_harm for seed, e in done}))
             counts[vut] = (

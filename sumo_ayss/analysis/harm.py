@@ -35,7 +35,9 @@ Imports neither SUMO nor torch; reads no file.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -43,7 +45,18 @@ import numpy.typing as npt
 from sumo_ayss.analysis.stats import wilson_interval
 from sumo_ayss.util.errors import ConfigError
 
-__all__ = ["HARM_RANGE", "MOBILITY_FLOOR", "HarmScale", "episode_harm", "mobility_flags"]
+__all__ = [
+    "HARM_RANGE",
+    "MOBILITY_FLOOR",
+    "EpisodeStats",
+    "HarmScale",
+    "ScorableRun",
+    "episode_harm",
+    "episode_stats",
+    "harm_scale_of",
+    "mobility_flags",
+    "run_episodes",
+]
 
 HARM_RANGE = (0.0, 1.0)
 """The possible range of a harm per episode (and of any mean of harms): intervals of a
@@ -209,3 +222,77 @@ def vut_outcomes(
         lo, hi = wilson_interval(crashes, n, level) if n else (math.nan, math.nan)
         out[vut] = VutOutcome(crashes, n, lo, hi, mob, flags[vut])
     return out
+
+
+# --------------------------------------------------------------------------- a run, scored
+
+
+class RewardLike(Protocol):
+    """The reward weights the harm scale needs (:class:`sumo_ayss.config.RewardConfig`)."""
+
+    @property
+    def alpha_adversarial(self) -> float: ...
+
+    @property
+    def alpha_collision(self) -> float: ...
+
+
+class ColumnsLike(Protocol):
+    """A table as read: ``name -> array`` (:class:`sumo_ayss.run_folder.Table`)."""
+
+    @property
+    def columns(self) -> Mapping[str, Any]: ...
+
+
+class ScorableRun(Protocol):
+    """What scoring a run's outcome episodes reads of it, as stored
+    (:class:`sumo_ayss.run_folder.RunRecord` is one)."""
+
+    @property
+    def reward(self) -> RewardLike | None: ...
+
+    @property
+    def decisions_per_episode(self) -> int | None: ...
+
+    @property
+    def outcome_table(self) -> ColumnsLike | None: ...
+
+
+def harm_scale_of(run: ScorableRun) -> HarmScale | None:
+    """The harm scale of a run: ``alpha_A ·`` decisions per episode, and ``alpha_C``; None
+    when its ``config.yaml`` gives no reward or episode timing.
+
+    Raises:
+        ConfigError: If the weights do not make a scale (:class:`HarmScale`).
+    """
+    if run.reward is None or run.decisions_per_episode is None:
+        return None
+    return HarmScale(
+        run.reward.alpha_adversarial * run.decisions_per_episode, run.reward.alpha_collision
+    )
+
+
+def episode_stats(columns: Mapping[str, Any], scale: HarmScale) -> EpisodeStats:
+    """An outcome table's columns reduced to harm, crashes and mobility (a table written
+    before ``near_miss_pay`` existed derives it from the return).
+
+    Raises:
+        ConfigError: If the table holds no episode or a pay does not fit the scale.
+    """
+    c = columns
+    pay = scale.near_miss_pay(c["near_miss_pay"], c["episode_return"], c["collided"])
+    harm = episode_harm(pay, c["collided"], scale.max_episode_pay)
+    return EpisodeStats.of(harm, c["collided"], c["vut_mean_speed_mps"])
+
+
+def run_episodes(run: ScorableRun) -> EpisodeStats | None:
+    """A run's outcome episodes (``outcome.csv``) scored on its harm scale, or None without
+    a table or a scale.
+
+    Raises:
+        ConfigError: If the scale is invalid or the table does not fit it.
+    """
+    scale = harm_scale_of(run)
+    if run.outcome_table is None or scale is None:
+        return None
+    return episode_stats(run.outcome_table.columns, scale)

@@ -159,7 +159,6 @@ from sumo_ayss.run_folder.record import (
     RunRecord,
     Training,
     config_key,
-    harm_scale_of,
     read_run,
 )
 from sumo_ayss.run_folder.schemas import (
@@ -320,7 +319,6 @@ __all__ = [
     "find_run_dirs",
     "fingerprint",
     "group_runs",
-    "harm_scale_of",
     "is_done",
     "is_run_dir",
     "load_crossplay",

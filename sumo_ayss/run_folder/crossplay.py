@@ -314,6 +314,7 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
         could not run).
     """
     from sumo_ayss.analysis.crossplay import CrossplayInput
+    from sumo_ayss.analysis.harm import harm_scale_of
 
     case_dirs = sorted({r.path.parent.parent for rs in runs.values() for r in rs})
     if len(case_dirs) != 1:
@@ -325,7 +326,10 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
     path = folder.crossplay_csv
     if not path.is_file():
         return CrossplayInput()
-    scales = {r.harm_scale for rs in runs.values() for r in rs}
+    try:
+        scales = {harm_scale_of(r) for rs in runs.values() for r in rs}
+    except ConfigError:
+        scales = set()
     scale = next(iter(scales)) if len(scales) == 1 else None
     if scale is None:
         return CrossplayInput(

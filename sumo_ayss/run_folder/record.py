@@ -12,8 +12,9 @@ not been evaluated yet says what is missing. A stage that cannot do without a fi
 record for it and gets a :class:`~sumo_ayss.util.errors.CheckpointError` naming the file
 (:attr:`RunRecord.experiment`).
 
-Imports neither SUMO nor torch; the harm reduction (:mod:`sumo_ayss.analysis.harm`, numpy
-and scipy) is imported when a record is read.
+The record holds what is stored: scoring the outcome episodes (harm, crashes, mobility) is
+the analysis's (:func:`sumo_ayss.analysis.harm.run_episodes`). Imports neither SUMO nor
+torch, nor the analysis.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -42,17 +43,13 @@ from sumo_ayss.run_folder.summaries import Outcome, OutcomeRecord, read_outcome_
 from sumo_ayss.run_folder.table import Table, read_table
 from sumo_ayss.util.errors import AyssError, CheckpointError, ConfigError
 
-if TYPE_CHECKING:
-    from sumo_ayss.analysis.harm import EpisodeStats, HarmScale
-
 __all__ = [
     "AyssSamples",
     "EvalCurve",
     "RunRecord",
     "Training",
     "config_key",
-    "episode_stats",
-    "harm_scale_of",
+    "decisions_of",
     "read_run",
 ]
 
@@ -149,13 +146,13 @@ class RunRecord:
         config: ``config.yaml`` as stored, or None.
         vut_description: The VUT's description from the catalog in ``config.yaml``.
         reward: The run's reward configuration, or None.
-        harm_scale: The constants that turn this run's episodes into harm (from the reward
-            and the episode length in ``config.yaml``), or None.
+        decisions_per_episode: Decisions per episode (``config.yaml``'s episode length over
+            its decision period), or None; with the reward, what scores the outcome episodes
+            (:func:`sumo_ayss.analysis.harm.run_episodes`: the analysis scores, not the reader).
         eval_curve: The candidate evaluations (``eval.csv``), or None.
         spcp: The selected SPCP (``spcp.json``), or None.
         outcome_record: The outcome summary with its settings (``outcome.json``), or None.
         outcome_table: The outcome episodes (``outcome.csv``), or None.
-        episodes: The outcome episodes reduced to harm, crashes and mobility, or None.
         ayss: The AYSS samples (``ayss.csv``), or None.
         versions: Package versions the run used (``versions.json``), or empty.
         training: Training budget and SPCP state (from ``config.yaml``, ``eval.csv`` and
@@ -171,12 +168,11 @@ class RunRecord:
     config: RunConfig | None = None
     vut_description: str = ""
     reward: RewardConfig | None = None
-    harm_scale: HarmScale | None = None
+    decisions_per_episode: int | None = None
     eval_curve: EvalCurve | None = None
     spcp: SpcpChoice | None = None
     outcome_record: OutcomeRecord | None = None
     outcome_table: Table | None = None
-    episodes: EpisodeStats | None = None
     ayss: AyssSamples | None = None
     versions: Mapping[str, str] = field(default_factory=dict)
     training: Training = field(default_factory=Training)
@@ -248,26 +244,19 @@ def config_key(config: Mapping[str, Any]) -> str:
     return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:12]
 
 
-def harm_scale_of(reward: RewardConfig, env: Mapping[str, Any]) -> HarmScale:
-    """The harm scale of a run: ``alpha_A ·`` decisions per episode, and ``alpha_C``
-    (decisions = ``env.episode_s / env.decision_period_s``, the env's defaults if unset)."""
-    from sumo_ayss.analysis.harm import HarmScale
+def decisions_of(env: Mapping[str, Any]) -> int:
+    """Decisions per episode of a run's env section: ``episode_s / decision_period_s``
+    rounded (the env's defaults where unset).
 
+    Raises:
+        ConfigError: If the timing gives no decision.
+    """
     episode_s = float(env.get("episode_s", EnvConfig.episode_s))
     period_s = float(env.get("decision_period_s", EnvConfig.decision_period_s))
     decisions = round(episode_s / period_s)
-    return HarmScale(reward.alpha_adversarial * decisions, reward.alpha_collision)
-
-
-def episode_stats(table: Table, scale: HarmScale) -> EpisodeStats:
-    """An outcome table reduced to harm, crashes and mobility (:mod:`~sumo_ayss.analysis.
-    harm`; a table written before ``near_miss_pay`` existed derives it from the return)."""
-    from sumo_ayss.analysis.harm import EpisodeStats, episode_harm
-
-    c = table.columns
-    pay = scale.near_miss_pay(c["near_miss_pay"], c["episode_return"], c["collided"])
-    harm = episode_harm(pay, c["collided"], scale.max_episode_pay)
-    return EpisodeStats.of(harm, c["collided"], c["vut_mean_speed_mps"])
+    if decisions < 1:
+        raise ConfigError(f"env: {episode_s} s episodes of {period_s} s decisions: no decision")
+    return decisions
 
 
 def _int_or_none(value: Any) -> int | None:
@@ -398,7 +387,7 @@ def read_run(path: str | Path) -> RunRecord:
         run_dir.parent.name or "unknown",
         seed_of_dir(run_dir),
     )
-    config = description = reward = scale = None
+    config = description = reward = decisions = None
     if not folder.config.is_file():
         r.problems.append(f"{CONFIG_YAML} missing (case, VUT and seed taken from the folder path)")
     else:
@@ -417,8 +406,8 @@ def read_run(path: str | Path) -> RunRecord:
             r.problems.append(f"{CONFIG_YAML}: reward section invalid ({exc})")
         else:
             try:
-                scale = harm_scale_of(reward, env)
-            except (ConfigError, TypeError, ValueError) as exc:
+                decisions = decisions_of(env)
+            except (ConfigError, TypeError, ValueError, ArithmeticError) as exc:
                 r.problems.append(f"{CONFIG_YAML}: episode timing invalid ({exc})")
 
     rows_read = r.attempt(folder.eval_table, lambda p: read_eval_rows(p, skip_bad_rows=True))
@@ -432,16 +421,10 @@ def read_run(path: str | Path) -> RunRecord:
     spcp = r.attempt(folder.spcp_json, read_spcp)
     outcome_record = r.attempt(folder.outcome_json, read_outcome_json)
     # outcome.csv is the exposure mode's input: its absence is a problem only where the
-    # run could be scored (a harm scale).
+    # run could be scored (a reward and an episode timing).
     table = r.attempt(
-        folder.outcome_csv, lambda p: read_table(p, OUTCOME_SCHEMA), needed=scale is not None
+        folder.outcome_csv, lambda p: read_table(p, OUTCOME_SCHEMA), needed=decisions is not None
     )
-    episodes = None
-    if table is not None and scale is not None:
-        try:
-            episodes = episode_stats(table, scale)
-        except (AyssError, ValueError) as exc:
-            r.problems.append(f"{folder.outcome_csv.name} unreadable ({exc})")
     ayss = r.attempt(folder.ayss_csv, _ayss_samples)
     versions = r.attempt(folder.versions, _read_versions, needed=False)  # optional
     if curve is not None and len(curve) == 0 and not n_dropped:
@@ -465,12 +448,11 @@ def read_run(path: str | Path) -> RunRecord:
         config=config,
         vut_description=description or "",
         reward=reward,
-        harm_scale=scale,
+        decisions_per_episode=decisions,
         eval_curve=curve,
         spcp=spcp,
         outcome_record=outcome_record,
         outcome_table=table,
-        episodes=episodes,
         ayss=ayss,
         versions=versions or {},
         training=_training(config, rows, spcp.step if spcp is not None else None),

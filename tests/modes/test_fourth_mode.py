@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from sumo_ayss.analysis.case_verdict import CaseVerdict
+from sumo_ayss.analysis.harm import run_episodes
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import Mode, Standing, mode_names, register_mode, unregister_mode
 from sumo_ayss.rank import analyse, ranking_rows
@@ -25,7 +26,7 @@ class CrashCount(Mode):
 
     def compute(self, a: Any) -> dict[str, int]:
         return {
-            vut: sum(r.episodes.crashes for r in runs if r.episodes is not None)
+            vut: sum(e.crashes for r in runs if (e := run_episodes(r)) is not None)
             for vut, runs in a.runs.items()
         }
 

@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from sumo_ayss.analysis.harm import harm_scale_of, run_episodes
 from sumo_ayss.run_folder import OUTCOME_CSV, RunRecord, read_run
 from sumo_ayss.util.errors import CheckpointError
 from tests.report.test_report import make_run
@@ -20,10 +21,11 @@ def test_a_complete_run_is_read_into_one_frozen_record(tmp_path: Path) -> None:
     assert isinstance(run, RunRecord) and run.problems == ()
     assert (run.case, run.vut, run.seed, run.label) == ("car_following", "pi2", 4, "pi2 seed 4")
     assert run.path == (tmp_path / "car_following" / "pi2" / "seed_4").resolve()
-    assert run.outcome_table is not None and run.episodes is not None
-    assert run.episodes.n == len(run.outcome_table)
+    assert run.outcome_table is not None and run.decisions_per_episode == 25
+    episodes = run_episodes(run)  # the analysis scores the stored table, not the reader
+    assert episodes is not None and episodes.n == len(run.outcome_table)
     assert run.outcome is not None and run.outcome_record is not None
-    assert run.harm_scale is not None and run.training.n_candidates == len(run.eval_curve or ())
+    assert harm_scale_of(run) is not None and run.training.n_candidates == len(run.eval_curve or ())
     assert run.experiment.env.vut == "pi2" and run.experiment.agent.gamma == 0.8
     assert run.config_seed == 4
     with pytest.raises(dataclasses.FrozenInstanceError):
