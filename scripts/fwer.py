@@ -126,9 +126,10 @@ def _study_name(path: Path) -> str:
 
 def committed_ladders() -> list[dict]:
     from sumo_ayss.analysis.crossplay import rank_crossplay
+    from sumo_ayss.analysis.crossplay_scoring import score_crossplay
     from sumo_ayss.analysis.harm import harm_scale_of
     from sumo_ayss.run_folder import read_ranking_csv
-    from sumo_ayss.run_folder.crossplay import read_crossplay_matrix
+    from sumo_ayss.run_folder.crossplay import read_crossplay_table
     from sumo_ayss.run_folder.record import read_run
 
     rows = []
@@ -136,7 +137,10 @@ def committed_ladders() -> list[dict]:
         run = next(iter(sorted(path.parent.glob("*/seed_*"))), None)
         if run is None:
             continue
-        m = read_crossplay_matrix(path, harm_scale_of(read_run(run)))
+        scale = harm_scale_of(read_run(run))
+        if scale is None:
+            continue
+        m = score_crossplay(read_crossplay_table(path).columns, scale)
         ranked, _ = rank_crossplay(m)
         raw = [r.vs_next.p for r in ranked[:-1] if r.vs_next is not None]
         rows.append(

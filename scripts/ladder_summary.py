@@ -29,6 +29,7 @@ import matplotlib as mpl
 mpl.use("Agg")
 from matplotlib.figure import Figure
 
+from sumo_ayss.analysis.crossplay_scoring import crossplay_input
 from sumo_ayss.analysis.harm import run_episodes
 from sumo_ayss.run_folder import (
     StudyFolder,
@@ -132,7 +133,8 @@ def crossplay_figure(
     cells = []
     for (ladder, case), entries in sorted(panels.items()):
         for run, study, expected in entries:
-            found = load_crossplay(_runs(study, case))
+            by_vut = _runs(study, case)
+            found = crossplay_input(load_crossplay(by_vut), by_vut)
             if found.matrix is not None:
                 cells.append((ladder, case, run, expected, found.matrix))
     if not cells:

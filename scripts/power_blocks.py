@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sumo_ayss.analysis.crossplay_scoring import crossplay_input
 from sumo_ayss.analysis.stats import student_t_sf
 from sumo_ayss.run_folder import StudyFolder, group_runs, load_crossplay, read_order_check, read_run
 
@@ -42,7 +43,7 @@ def block_diffs(study: Path) -> dict[tuple[str, str, str], list[float]]:
     out: dict[tuple[str, str, str], list[float]] = {}
     runs = group_runs([read_run(d) for d in sorted(study.glob("*/*/seed_*"))])
     for case, by_vut in runs.items():
-        m = load_crossplay(by_vut).matrix
+        m = crossplay_input(load_crossplay(by_vut), by_vut).matrix
         if m is None:
             continue
         scores = {sc.name: sc.values for sc in m.scores("seed")}

@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.analysis.crossplay import BLOCKS
+from sumo_ayss.analysis.crossplay_scoring import case_matrix
 from sumo_ayss.cli import prog
 from sumo_ayss.run_folder import (
     CROSSPLAY_SCHEMA,
@@ -52,8 +53,8 @@ from sumo_ayss.run_folder import (
     RunRecord,
     Table,
     case_dir_for,
+    case_of,
     is_done,
-    read_case_matrix,
     read_crossplay_json,
     read_inevitable,
     read_outcome_json,
@@ -456,7 +457,8 @@ def main(argv: Sequence[str] | None = None) -> None:
                 reference=cfg.evaluate.reference,
                 references=cfg.evaluate.reference_rows,
             )
-            matrix = read_case_matrix(runs)
+            found = case_of(runs)
+            matrix = case_matrix(found.crossplay, found.runs)
             rows, _pairs = rank_crossplay(matrix, blocks=args.blocks)
             print(f"\n{case}: cross-play ranking, safest first (lower harm = safer)")
             for r in rows:

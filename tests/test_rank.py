@@ -124,8 +124,8 @@ def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, mon
     )
     monkeypatch.setattr(
         crossplay_mod,
-        "read_crossplay_matrix",
-        counted("crossplay", crossplay_mod.read_crossplay_matrix, lambda p, *a: str(p)),
+        "read_crossplay_table",
+        counted("crossplay", crossplay_mod.read_crossplay_table, lambda p, *a: str(p)),
     )
     monkeypatch.setattr(
         case_mod,

@@ -140,11 +140,13 @@ def case_seeds(cfg: PipelineConfig, case: str) -> tuple[int, ...]:
 
 def _look(cfg: PipelineConfig, case: str, runs: Sequence[RunRecord]) -> SettleCheck:
     """One look at a case from its cross-play table."""
+    from sumo_ayss.analysis.crossplay_scoring import case_matrix
     from sumo_ayss.analysis.sequential import looks_of, settle_check
-    from sumo_ayss.run_folder import read_case_matrix
+    from sumo_ayss.run_folder import case_of
 
     assert cfg.max_seeds is not None
-    matrix = read_case_matrix(runs)
+    found = case_of(runs)
+    matrix = case_matrix(found.crossplay, found.runs)
     return settle_check(
         matrix.scores("seed"),  # seed blocks: the independent replications
         looks_of(len(cfg.seeds), cfg.max_seeds),

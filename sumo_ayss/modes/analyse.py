@@ -11,6 +11,7 @@ from sumo_ayss.modes.registry import get_mode, registered_modes
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis, CaseOptions, RunLike
     from sumo_ayss.analysis.crossplay import CrossplayInput
+    from sumo_ayss.analysis.crossplay_scoring import CrossplayTablesLike
 
 __all__ = ["CaseInput", "analyse_case", "analyse_cases"]
 
@@ -28,7 +29,7 @@ class CaseInput(Protocol[R]):
     def runs(self) -> dict[str, list[R]]: ...
 
     @property
-    def crossplay(self) -> CrossplayInput: ...
+    def crossplay(self) -> CrossplayTablesLike: ...
 
 
 def analyse_case(
@@ -69,6 +70,11 @@ def analyse_cases(
         options: Statistical settings.
         paper: Compute the paper mode (the AYSS bootstrap, the slow part).
     """
+    from sumo_ayss.analysis.crossplay_scoring import crossplay_input
+
     return [
-        analyse_case(c.case, c.runs, options, crossplay=c.crossplay, paper=paper) for c in cases
+        analyse_case(
+            c.case, c.runs, options, crossplay=crossplay_input(c.crossplay, c.runs), paper=paper
+        )
+        for c in cases
     ]

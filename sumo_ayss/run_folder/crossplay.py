@@ -21,10 +21,11 @@ vehicle each VUT name stood for (:func:`~sumo_ayss.run_folder.identity.vut_key` 
 definition; absent in older records): a study that adds, drops, redefines or renames a VUT
 keeps the cells whose VUT and opponent are unchanged (:mod:`.crossplay_cells`).
 
-:func:`load_crossplay` reads a case's table and record back for the analysis, as a
-:class:`~sumo_ayss.analysis.crossplay.CrossplayInput` scored on the runs' harm scale.
+:func:`load_crossplay` reads a case's table and record back for the analysis, as stored
+(:class:`CrossplayTables`); the analysis scores them on the runs' harm scale
+(:func:`sumo_ayss.analysis.crossplay.crossplay_input`).
 
-Imports neither SUMO nor torch (nor, until a table is read, the analysis).
+Imports neither SUMO nor torch, nor the analysis.
 """
 
 from __future__ import annotations
@@ -38,22 +39,21 @@ from typing import TYPE_CHECKING, Any, TypeVar
 from sumo_ayss.run_folder.jsonio import json_field, read_json, write_json
 from sumo_ayss.run_folder.layout import CaseFolder
 from sumo_ayss.run_folder.schemas import CROSSPLAY_SCHEMA
-from sumo_ayss.run_folder.table import read_table
-from sumo_ayss.util.errors import ConfigError, TableError
+from sumo_ayss.run_folder.table import Table, read_table
+from sumo_ayss.util.errors import TableError
 
 if TYPE_CHECKING:
-    from sumo_ayss.analysis.crossplay import CrossplayInput, CrossplayMatrix
-    from sumo_ayss.analysis.harm import HarmScale
     from sumo_ayss.run_folder.record import RunRecord
 
 __all__ = [
     "ROLLOUT",
     "CrossplayOpponent",
     "CrossplayRecord",
+    "CrossplayTables",
     "DiagonalCheck",
     "load_crossplay",
     "read_crossplay_json",
-    "read_crossplay_matrix",
+    "read_crossplay_table",
     "write_crossplay_json",
 ]
 
@@ -237,33 +237,45 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
 # --------------------------------------------------------------------------- the analysis's input
 
 
-def read_crossplay_matrix(path: Path, scale: HarmScale) -> CrossplayMatrix:
-    """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of a case folder's
-    ``crossplay.csv`` (read against :data:`~.schemas.CROSSPLAY_SCHEMA`), each episode's
-    harm on ``scale`` (a table written before ``near_miss_pay`` existed derives it from the
-    return).
+def read_crossplay_table(path: Path) -> Table:
+    """A case folder's ``crossplay.csv`` (or ``crossplay_reference.csv``), read against
+    :data:`~.schemas.CROSSPLAY_SCHEMA`; the analysis scores it
+    (:func:`sumo_ayss.analysis.crossplay.score_crossplay`).
 
     Raises:
         TableError: If the file is missing or does not follow the schema.
-        ConfigError: If the design is not complete and balanced
-            (:func:`~sumo_ayss.analysis.crossplay.crossplay_matrix`), or a pay does not fit
-            the scale.
     """
-    from sumo_ayss.analysis.crossplay import crossplay_matrix
-    from sumo_ayss.analysis.harm import episode_harm
+    return read_table(path, CROSSPLAY_SCHEMA)
 
-    c = read_table(path, CROSSPLAY_SCHEMA).columns
-    pay = scale.near_miss_pay(c["near_miss_pay"], c["episode_return"], c["collided"])
-    return crossplay_matrix(
-        c["vut"],
-        c["opponent_vut"],
-        c["opponent_seed"],
-        episode_harm(pay, c["collided"], scale.max_episode_pay),
-        c["collided"],
-        episode_return=c["episode_return"],
-        mobility=c["vut_mean_speed_mps"],
-        preventable=c["crash_preventable"],
-    )
+
+@dataclass(frozen=True)
+class CrossplayTables:
+    """A case's cross-play files as found, stored data only: the analysis scores them
+    (:func:`sumo_ayss.analysis.crossplay.crossplay_input`).
+
+    Attributes:
+        case_dir: The case folder the runs lie in, or None (several).
+        path: ``crossplay.csv``, or None (not found, or the runs lie in several folders).
+        table: ``crossplay.csv`` read, or None.
+        missing: Why there is no usable table (one sentence), "" with no problem.
+        problem: A line for the case's problem list, or "".
+        diagonal: The record's diagonal check, ``(vut, seed, n, n_equal)`` per run.
+        reference: ``crossplay_reference.csv`` read, or None.
+        reference_problem: Why that file is unreadable, or "".
+        inevitable: ``inevitable.json``'s ``(n, seed, indices)``, or None.
+        inevitable_problem: Why that file is unreadable, or "".
+    """
+
+    case_dir: Path | None = None
+    path: Path | None = None
+    table: Table | None = None
+    missing: str = ""
+    problem: str = ""
+    diagonal: tuple[tuple[str, int, int, int], ...] = ()
+    reference: Table | None = None
+    reference_problem: str = ""
+    inevitable: tuple[int, int, tuple[int, ...]] | None = None
+    inevitable_problem: str = ""
 
 
 def write_inevitable(
@@ -297,53 +309,38 @@ def read_inevitable(path: Path) -> tuple[int, int, tuple[int, ...]]:
     return n, seed, tuple(ics)
 
 
-def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
-    """The cross-play table of one case's runs: ``crossplay.csv`` of the case folder they lie
-    in (the parent of the VUT folders), read against :data:`~.schemas.CROSSPLAY_SCHEMA`,
-    with its record's diagonal check (``crossplay.json``); never raises.
+def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayTables:
+    """The cross-play files of one case's runs: ``crossplay.csv`` of the case folder they lie
+    in (the parent of the VUT folders), its record's diagonal check (``crossplay.json``), the
+    reference rows and the inevitable-collision states; never raises.
 
     Args:
         runs: ``{vut: runs}`` of one case (:func:`~.record.read_run`).
 
     Returns:
-        The :class:`~sumo_ayss.analysis.crossplay.CrossplayInput`: the matrix, its path and
-        its diagonal check, or why there is none (no table, runs in several case folders or
-        on different harm scales, an unreadable table or one whose design is not complete
-        and balanced, a table whose diagonal did not reproduce the outcome tables, or one
-        of other VUTs than the runs': a study whose VUTs changed and whose cross-play
-        could not run).
+        The :class:`CrossplayTables`: the tables as read, or why there is none (no table,
+        runs in several case folders, an unreadable record or table, a table whose
+        diagonal did not reproduce the outcome tables, or one of other VUTs than the runs':
+        a study whose VUTs changed and whose cross-play could not run). Scoring them is the
+        analysis's (:func:`sumo_ayss.analysis.crossplay.crossplay_input`).
     """
-    from sumo_ayss.analysis.crossplay import CrossplayInput
-    from sumo_ayss.analysis.harm import harm_scale_of
-
     case_dirs = sorted({r.path.parent.parent for rs in runs.values() for r in rs})
     if len(case_dirs) != 1:
         folders = ", ".join(map(str, case_dirs))
-        return CrossplayInput(
+        return CrossplayTables(
             missing=f"no cross-play table: the runs lie in several case folders ({folders})"
         )
     folder = CaseFolder(case_dirs[0])
     path = folder.crossplay_csv
     if not path.is_file():
-        return CrossplayInput()
-    try:
-        scales = {harm_scale_of(r) for rs in runs.values() for r in rs}
-    except ConfigError:
-        scales = set()
-    scale = next(iter(scales)) if len(scales) == 1 else None
-    if scale is None:
-        return CrossplayInput(
-            path=path,
-            missing="the cross-play table cannot be scored: the runs' config.yaml files do "
-            "not give one reward and episode length for all (harm scale)",
-        )
-    diagonal: tuple[tuple[str, int, int, int], ...] = ()
+        return CrossplayTables(case_dir=folder.path)
+    found = CrossplayTables(case_dir=folder.path, path=path)
     if folder.crossplay_json.is_file():
         try:
             record = read_crossplay_json(folder.crossplay_json)
         except TableError as exc:
-            return CrossplayInput(
-                path=path,
+            return dataclasses.replace(
+                found,
                 missing=f"the cross-play record is unreadable ({exc})",
                 problem=str(exc),  # names the file
             )
@@ -353,7 +350,7 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
                 f"runs are of {', '.join(runs)} (the pipeline drives the missing cells when "
                 "every job of the case is done)"
             )
-            return CrossplayInput(path=path, missing=why, problem=f"{path}: {why}")
+            return dataclasses.replace(found, missing=why, problem=f"{path}: {why}")
         diagonal = tuple((d.vut, d.seed, d.n, d.n_equal) for d in record.diagonal)
         bad = [d for d in record.diagonal if not d.ok]
         if bad:
@@ -363,31 +360,30 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayInput:
                 f"tables of {names}; it would rank another vehicle than the one the opponents "
                 "were trained against"
             )
-            return CrossplayInput(
-                path=path, missing=why, problem=f"{path}: {why}", diagonal=diagonal
+            return dataclasses.replace(
+                found, missing=why, problem=f"{path}: {why}", diagonal=diagonal
             )
+        found = dataclasses.replace(found, diagonal=diagonal)
     try:
-        matrix = read_crossplay_matrix(path, scale)
-    except (TableError, ConfigError) as exc:
+        found = dataclasses.replace(found, table=read_crossplay_table(path))
+    except TableError as exc:
         text = str(exc)  # a TableError names the file already
         problem = text if text.startswith(str(path)) else f"{path}: {text}"
-        return CrossplayInput(
-            path=path, missing=f"the cross-play table is unreadable ({problem})", problem=problem
+        return CrossplayTables(
+            case_dir=folder.path,
+            path=path,
+            missing=f"the cross-play table is unreadable ({problem})",
+            problem=problem,
         )
-    reference = None
     if folder.crossplay_reference_csv.is_file():
         try:
-            reference = read_crossplay_matrix(folder.crossplay_reference_csv, scale)
-        except (TableError, ConfigError) as exc:  # the ranking stands without it
-            return CrossplayInput(
-                matrix, path, diagonal=diagonal, problem=f"reference rows unreadable: {exc}"
-            )
-    ics: tuple[int, int, tuple[int, ...]] | None = None
+            reference = read_crossplay_table(folder.crossplay_reference_csv)
+        except TableError as exc:  # the ranking stands without it
+            return dataclasses.replace(found, reference_problem=f"reference rows unreadable: {exc}")
+        found = dataclasses.replace(found, reference=reference)
     if folder.inevitable_json.is_file():
         try:
-            ics = read_inevitable(folder.inevitable_json)
+            return dataclasses.replace(found, inevitable=read_inevitable(folder.inevitable_json))
         except TableError as exc:
-            return CrossplayInput(
-                matrix, path, diagonal=diagonal, reference=reference, problem=str(exc)
-            )
-    return CrossplayInput(matrix, path, diagonal=diagonal, reference=reference, inevitable=ics)
+            return dataclasses.replace(found, inevitable_problem=str(exc))
+    return found

@@ -8,25 +8,21 @@ from collections import defaultdict
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from sumo_ayss.cases import case_names
-from sumo_ayss.run_folder.crossplay import load_crossplay
+from sumo_ayss.run_folder.crossplay import CrossplayTables, load_crossplay
 from sumo_ayss.run_folder.layout import CONFIG_YAML, find_run_dirs
 from sumo_ayss.run_folder.record import RunRecord, Training, read_run
-from sumo_ayss.util.errors import ConfigError, TableError
+from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.paths import display_path
-
-if TYPE_CHECKING:
-    from sumo_ayss.analysis.crossplay import CrossplayInput, CrossplayMatrix
 
 __all__ = [
     "CaseRuns",
+    "case_of",
     "case_runs",
     "group_runs",
     "load_runs",
     "mixing_problems",
-    "read_case_matrix",
 ]
 
 
@@ -37,13 +33,13 @@ class CaseRuns:
     Attributes:
         case: Case name.
         runs: ``{vut: runs sorted by seed}`` (:func:`group_runs`).
-        crossplay: The case's cross-play table as :func:`~.crossplay.load_crossplay` found
-            it (or why there is none).
+        crossplay: The case's cross-play files as :func:`~.crossplay.load_crossplay` found
+            them (or why there are none); the analysis scores them.
     """
 
     case: str
     runs: dict[str, list[RunRecord]]
-    crossplay: CrossplayInput
+    crossplay: CrossplayTables
 
 
 def load_runs(paths: Sequence[str | Path]) -> list[RunRecord]:
@@ -105,17 +101,11 @@ def case_runs(runs: Sequence[RunRecord]) -> list[CaseRuns]:
     ]
 
 
-def read_case_matrix(runs: Sequence[RunRecord]) -> CrossplayMatrix:
-    """The cross-play matrix of one case's runs, scored on their harm scale, with its
-    diagonal check (:func:`~.crossplay.load_crossplay`).
-
-    Raises:
-        TableError: If there is no usable table (the message says why).
-    """
-    found = load_crossplay(next(iter(group_runs(runs).values())))
-    if found.matrix is None:
-        raise TableError(found.missing or f"no cross-play table for {runs[0].path}")
-    return found.matrix
+def case_of(runs: Sequence[RunRecord]) -> CaseRuns:
+    """The first case among ``runs`` (:func:`group_runs` order) with its cross-play files;
+    its matrix is :func:`sumo_ayss.analysis.crossplay_scoring.case_matrix`'s."""
+    case, by_vut = next(iter(group_runs(runs).items()))
+    return CaseRuns(case, by_vut, load_crossplay(by_vut))
 
 
 def mixing_problems(

@@ -197,9 +197,11 @@ BRAKING_CUT_IN = PROJECT_ROOT / "results" / "ladders" / "braking_a" / "cut_in" /
 def test_the_braking_ladder_in_cut_in_ranks_d9_d6_d45() -> None:
     """The committed cut-in cross-play table of the braking ladder (issue 22): harm ranks
     d9 > d6 > d45 (more braking authority is safer)."""
-    from sumo_ayss.run_folder import read_crossplay_matrix
+    from sumo_ayss.analysis.crossplay_scoring import score_crossplay
+    from sumo_ayss.run_folder import read_crossplay_table
 
-    m = read_crossplay_matrix(Path(BRAKING_CUT_IN), HarmScale(MAX_PAY, ALPHA_C))
+    table = read_crossplay_table(Path(BRAKING_CUT_IN))
+    m = score_crossplay(table.columns, HarmScale(MAX_PAY, ALPHA_C))
     rows, _pairs = rank_crossplay(m)
     assert [r.name for r in rows] == ["d9", "d6", "d45"]
     crashes = {v: m.crashes(v)[0] for v in m.vuts}

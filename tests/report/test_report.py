@@ -62,6 +62,13 @@ EXPOSURE = {"pi1": 0.0, "pi2": -1.0, "pi1_again": 0.0}
 FAST = ReportOptions(n_boot=400)
 
 
+def scored_crossplay(runs):  # type: ignore[no-untyped-def]
+    """The case's cross-play files as stored (:func:`load_crossplay`), scored by the analysis."""
+    from sumo_ayss.analysis.crossplay_scoring import crossplay_input
+
+    return crossplay_input(load_crossplay(runs), runs)
+
+
 def _proportion(value: float, half: float, n: int = 200) -> Proportion:
     return Proportion(round(value * n), n, value, max(0.0, value - half), value + half, 0.95)
 
@@ -483,7 +490,7 @@ def test_crossplay_needs_two_vuts_and_a_table_of_these_runs(tmp_path: Path) -> N
     dirs += [make_run(root, "cut_in", "pi2", s) for s in range(2)]
     make_crossplay(root / "cut_in", ["pi1", "pi2"], range(3))  # a seed these runs lack
     runs = group_runs([read_run(d) for d in dirs])["cut_in"]
-    stale = analyse_case("cut_in", runs, FAST, crossplay=load_crossplay(runs))
+    stale = analyse_case("cut_in", runs, FAST, crossplay=scored_crossplay(runs))
     assert stale.crossplay_gap is not None and stale.ranking_mode == "exposure"
     assert (stale.crossplay_gap.reason, stale.crossplay_gap.n_runs) == ("not_these_runs", 4)
     assert "is not of these runs" in crossplay_gap_text(stale.crossplay_gap)
@@ -500,18 +507,20 @@ def test_the_loader_hands_analysis_the_crossplay_table_or_why_there_is_none(tmp_
     root = tmp_path / "runs"
     dirs = [make_run(root, "cut_in", v, s) for v in ("pi1", "pi2") for s in range(2)]
     runs = group_runs([read_run(d) for d in dirs])["cut_in"]
-    assert load_crossplay(runs).matrix is None and not load_crossplay(runs).missing  # no table
+    assert scored_crossplay(runs).matrix is None and not scored_crossplay(runs).missing  # no table
     path = make_crossplay(root / "cut_in", ["pi1", "pi2"], range(2))
-    found = load_crossplay(runs)
+    stored = load_crossplay(runs)  # the reader returns the stored columns, no harm
+    assert stored.table is not None and stored.path == path and "harm" not in stored.table.columns
+    found = scored_crossplay(runs)
     assert found.matrix is not None and found.path == path and found.matrix.vuts == ("pi1", "pi2")
     a = analyse_case("cut_in", runs, FAST, crossplay=found)
     assert a.crossplay is found.matrix and a.crossplay_path == path and a.crossplay_rows
     path.write_text("vut,opponent_vut\npi1,pi1\n")
-    broken = load_crossplay(runs)
+    broken = scored_crossplay(runs)
     assert broken.matrix is None and "unreadable" in broken.missing
     a = analyse_case("cut_in", runs, FAST, crossplay=broken)
     assert a.crossplay_gap == CrossplayGap("not_found", loader=broken.missing)
     assert crossplay_gap_text(a.crossplay_gap) == broken.missing and broken.problem in a.problems
     other = make_run(tmp_path / "elsewhere", "cut_in", "pi2", 5)
     mixed = group_runs([read_run(d) for d in [*dirs, other]])["cut_in"]
-    assert "several case folders" in load_crossplay(mixed).missing
+    assert "several case folders" in scored_crossplay(mixed).missing

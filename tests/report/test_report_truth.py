@@ -21,6 +21,13 @@ from sumo_ayss.run_folder import load_crossplay, read_run
 from tests.report.test_report import FAST, make_crossplay, make_run
 
 
+def scored_crossplay(runs):  # type: ignore[no-untyped-def]
+    """The case's cross-play files as stored (:func:`load_crossplay`), scored by the analysis."""
+    from sumo_ayss.analysis.crossplay_scoring import crossplay_input
+
+    return crossplay_input(load_crossplay(runs), runs)
+
+
 def _runs(root: Path, case: str, vuts: tuple[str, ...], seeds: range) -> dict:
     for vut in vuts:
         for seed in seeds:
@@ -43,7 +50,7 @@ def _section(html: str, start: str, end: str) -> str:
 def test_crossplay_caption_claim_matches_the_plotted_lines(tmp_path: Path) -> None:
     runs = _runs(tmp_path, "car_following", ("pi1", "pi2"), range(3))
     make_crossplay(tmp_path / "car_following", ["pi1", "pi2"], range(3))
-    a = analyse_case("car_following", runs, FAST, crossplay=load_crossplay(runs))
+    a = analyse_case("car_following", runs, FAST, crossplay=scored_crossplay(runs))
     assert a.crossplay is not None and a.crossplay_rows[0].vs_next is not None
     assert a.crossplay_rows[0].vs_next.significant  # the ranking is a finding here
     order = [r.name for r in a.crossplay_rows]
@@ -86,7 +93,7 @@ def test_leaderboard_comes_first_with_rank_score_crashes_and_verdict(
 def test_leaderboard_text_fits_80_columns_and_matches_the_report(tmp_path: Path) -> None:
     runs = _runs(tmp_path, "car_following", ("pi1", "pi2"), range(3))
     make_crossplay(tmp_path / "car_following", ["pi1", "pi2"], range(3))
-    a = analyse_case("car_following", runs, FAST, crossplay=load_crossplay(runs))
+    a = analyse_case("car_following", runs, FAST, crossplay=scored_crossplay(runs))
     text = leaderboard_text([a])
     rows = leaderboard_rows(a)
     assert [r.vut for r in rows] == ["pi2", "pi1"]

@@ -5,14 +5,15 @@ from __future__ import annotations
 import typing
 
 from sumo_ayss.analysis.crossplay import CrossplayInput, CrossplayMatrix
-from sumo_ayss.run_folder import Training, mixing_problems, read_case_matrix, study_runs
+from sumo_ayss.analysis.crossplay_scoring import case_matrix
+from sumo_ayss.run_folder import CrossplayTables, Training, mixing_problems, study_runs
 
 
 def test_the_study_readers_return_typed_records_not_any() -> None:
     names = {"CrossplayMatrix": CrossplayMatrix, "CrossplayInput": CrossplayInput}
-    assert typing.get_type_hints(read_case_matrix, localns=names)["return"] is CrossplayMatrix
+    assert typing.get_type_hints(case_matrix, localns=names)["return"] is CrossplayMatrix
     hints = typing.get_type_hints(study_runs.CaseRuns, localns=names)
-    assert hints["crossplay"] is CrossplayInput
+    assert hints["crossplay"] is CrossplayTables  # stored data: the analysis scores it
     for name in study_runs.__all__:
         obj = getattr(study_runs, name)
         if callable(obj) and not isinstance(obj, type):

@@ -1,0 +1,149 @@
+"""A case's cross-play tables, as stored, scored on its runs' harm scale: the analysis's
+side of :func:`sumo_ayss.run_folder.load_crossplay` (the reader returns the stored columns;
+the harm is computed here, not while reading).
+
+Reads no file.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any, Protocol
+
+from sumo_ayss.analysis.crossplay import CrossplayInput, CrossplayMatrix, crossplay_matrix
+from sumo_ayss.analysis.harm import (
+    ColumnsLike,
+    HarmScale,
+    ScorableRun,
+    episode_harm,
+    harm_scale_of,
+)
+from sumo_ayss.util.errors import ConfigError, TableError
+
+__all__ = ["CrossplayTablesLike", "case_matrix", "crossplay_input", "score_crossplay"]
+
+
+class CrossplayTablesLike(Protocol):
+    """A case's cross-play files as read (:class:`sumo_ayss.run_folder.CrossplayTables`)."""
+
+    @property
+    def case_dir(self) -> Path | None: ...
+    @property
+    def path(self) -> Path | None: ...
+    @property
+    def table(self) -> ColumnsLike | None: ...
+    @property
+    def missing(self) -> str: ...
+    @property
+    def problem(self) -> str: ...
+    @property
+    def diagonal(self) -> tuple[tuple[str, int, int, int], ...]: ...
+    @property
+    def reference(self) -> ColumnsLike | None: ...
+    @property
+    def reference_problem(self) -> str: ...
+    @property
+    def inevitable(self) -> tuple[int, int, tuple[int, ...]] | None: ...
+    @property
+    def inevitable_problem(self) -> str: ...
+
+
+def score_crossplay(columns: Mapping[str, Any], scale: HarmScale) -> CrossplayMatrix:
+    """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of a cross-play table's
+    columns, each episode's harm on ``scale`` (a table written before ``near_miss_pay``
+    existed derives it from the return).
+
+    Raises:
+        ConfigError: If the design is not complete and balanced
+            (:func:`~sumo_ayss.analysis.crossplay.crossplay_matrix`), or a pay does not fit
+            the scale.
+    """
+    c = columns
+    pay = scale.near_miss_pay(c["near_miss_pay"], c["episode_return"], c["collided"])
+    return crossplay_matrix(
+        c["vut"],
+        c["opponent_vut"],
+        c["opponent_seed"],
+        episode_harm(pay, c["collided"], scale.max_episode_pay),
+        c["collided"],
+        episode_return=c["episode_return"],
+        mobility=c["vut_mean_speed_mps"],
+        preventable=c["crash_preventable"],
+    )
+
+
+def _scale(runs: Mapping[str, Sequence[ScorableRun]]) -> HarmScale | None:
+    """The one harm scale of all ``runs``, or None (none, several or an invalid one)."""
+    try:
+        scales = {harm_scale_of(r) for rs in runs.values() for r in rs}
+    except ConfigError:
+        return None
+    return next(iter(scales)) if len(scales) == 1 else None
+
+
+def crossplay_input(
+    tables: CrossplayTablesLike, runs: Mapping[str, Sequence[ScorableRun]]
+) -> CrossplayInput:
+    """The cross-play input of one case: its tables as read, scored on its runs' harm
+    scale, or why there is none; never raises.
+
+    Args:
+        tables: The case's files (:func:`sumo_ayss.run_folder.load_crossplay`).
+        runs: ``{vut: runs}`` of the case.
+    """
+    path = tables.path
+    if path is None:
+        return CrossplayInput(missing=tables.missing)
+    if _scale(runs) is None:
+        return CrossplayInput(
+            path=path,
+            missing="the cross-play table cannot be scored: the runs' config.yaml files do "
+            "not give one reward and episode length for all (harm scale)",
+        )
+    scale = _scale(runs)
+    assert scale is not None
+    if tables.table is None:
+        return CrossplayInput(
+            path=path, missing=tables.missing, problem=tables.problem, diagonal=tables.diagonal
+        )
+    try:
+        matrix = score_crossplay(tables.table.columns, scale)
+    except ConfigError as exc:
+        text = str(exc)
+        problem = text if text.startswith(str(path)) else f"{path}: {text}"
+        return CrossplayInput(
+            path=path, missing=f"the cross-play table is unreadable ({problem})", problem=problem
+        )
+    diagonal = tables.diagonal
+    if tables.reference_problem:
+        return CrossplayInput(matrix, path, diagonal=diagonal, problem=tables.reference_problem)
+    reference = None
+    if tables.reference is not None:
+        try:
+            reference = score_crossplay(tables.reference.columns, scale)
+        except ConfigError as exc:  # the ranking stands without it
+            return CrossplayInput(
+                matrix, path, diagonal=diagonal, problem=f"reference rows unreadable: {exc}"
+            )
+    if tables.inevitable_problem:
+        return CrossplayInput(
+            matrix, path, diagonal=diagonal, reference=reference, problem=tables.inevitable_problem
+        )
+    return CrossplayInput(
+        matrix, path, diagonal=diagonal, reference=reference, inevitable=tables.inevitable
+    )
+
+
+def case_matrix(
+    tables: CrossplayTablesLike, runs: Mapping[str, Sequence[ScorableRun]]
+) -> CrossplayMatrix:
+    """The cross-play matrix of one case (:func:`crossplay_input`).
+
+    Raises:
+        TableError: If there is no usable table (the message says why).
+    """
+    found = crossplay_input(tables, runs)
+    if found.matrix is None:
+        raise TableError(found.missing or f"no cross-play table in {tables.case_dir}")
+    return found.matrix
