@@ -27,6 +27,7 @@ from sumo_ayss.config import PipelineConfig
 from sumo_ayss.grid.jobs import JobSpec
 from sumo_ayss.grid.progress import JobStatus
 from sumo_ayss.run_folder import (
+    AdaptiveLook,
     AdaptiveRecord,
     CaseFolder,
     RunRecord,
@@ -234,7 +235,8 @@ def _record_look(cfg: PipelineConfig, case: str, look: SettleCheck) -> AdaptiveR
         record = AdaptiveRecord(
             cfg.seeds, cfg.max_seeds, cfg.report.welch_alpha, cfg.seeds, (), grid_vuts(cfg, case)
         )
-    looks = (*tuple(x for x in record.looks if x.n_seeds < look.n_seeds), look)
+    stored = AdaptiveLook(**dataclasses.asdict(look))
+    looks = (*tuple(x for x in record.looks if x.n_seeds < look.n_seeds), stored)
     record = dataclasses.replace(record, looks=looks, vuts=grid_vuts(cfg, case))
     write_adaptive(CaseFolder(case_dir_for(cfg.out, case)).adaptive_json, record)
     return record

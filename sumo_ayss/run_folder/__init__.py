@@ -65,6 +65,7 @@ these names or parses one of these files. Imports neither SUMO nor torch.
 from __future__ import annotations
 
 from sumo_ayss.run_folder.adaptive import (
+    AdaptiveLook,
     AdaptiveRecord,
     read_adaptive,
     write_adaptive,
@@ -280,6 +281,7 @@ __all__ = [
     "TB_DIR",
     "TORCH_RNG_PT",
     "VERSIONS_JSON",
+    "AdaptiveLook",
     "AdaptiveRecord",
     "AyssRecord",
     "AyssSamples",

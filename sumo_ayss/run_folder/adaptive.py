@@ -2,8 +2,9 @@
 
 Written by the pipeline after every look (:mod:`sumo_ayss.grid.adaptive`); read by the pipeline
 when it resumes (the seeds already added are part of the grid) and by ``rank --no-run``.
-A look is the analysis's own record, :class:`sumo_ayss.analysis.sequential.SettleCheck`,
-stored field by field. ``vuts`` names the VUTs looked at, each with its definition's key
+A look is stored as an :class:`AdaptiveLook`, the fields of the analysis's
+:class:`sumo_ayss.analysis.sequential.SettleCheck`. ``vuts`` names the VUTs looked at, each
+with its definition's key
 (:func:`~sumo_ayss.run_folder.identity.vut_key`): a grid whose VUTs are others (one added,
 dropped, redefined or renamed) ignores the record and starts over (records written before
 ``vuts`` existed are taken as they are).
@@ -15,18 +16,42 @@ import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from sumo_ayss.run_folder.jsonio import json_field, read_json, write_json
-
-if TYPE_CHECKING:
-    from sumo_ayss.analysis.sequential import SettleCheck
 from sumo_ayss.util.errors import TableError
 
-__all__ = ["ADAPTIVE_FORMAT", "AdaptiveRecord", "read_adaptive", "write_adaptive"]
+__all__ = ["ADAPTIVE_FORMAT", "AdaptiveLook", "AdaptiveRecord", "read_adaptive", "write_adaptive"]
 
 ADAPTIVE_FORMAT = 1
 """Version of the file's layout."""
+
+
+@dataclass(frozen=True)
+class AdaptiveLook:
+    """One look as stored: the fields of the analysis's
+    :class:`sumo_ayss.analysis.sequential.SettleCheck` (storage imports no analysis; the
+    pipeline stores a check with ``AdaptiveLook(**dataclasses.asdict(check))``).
+
+    Attributes:
+        n_seeds: Seed blocks per VUT at this look.
+        omnibus_p: p of the F gate (NaN: no test).
+        gate_level: The calibrated level the gate must be below.
+        safest: The VUT with the lowest score.
+        least_safe: The VUT with the highest score.
+        ends_p: The paired-t p of ``safest`` against ``least_safe`` (NaN: no test).
+        alpha: The level ``ends_p`` must be below.
+        settled: Both tests passed.
+    """
+
+    n_seeds: int
+    omnibus_p: float
+    gate_level: float
+    safest: str
+    least_safe: str
+    ends_p: float
+    alpha: float
+    settled: bool
 
 
 @dataclass(frozen=True)
@@ -47,7 +72,7 @@ class AdaptiveRecord:
     max_seeds: int
     alpha: float
     seeds: tuple[int, ...]
-    looks: tuple[SettleCheck, ...]
+    looks: tuple[AdaptiveLook, ...]
     vuts: tuple[tuple[str, str], ...] = ()
 
     @property
@@ -97,8 +122,6 @@ def read_adaptive(path: str | Path) -> AdaptiveRecord:
     Raises:
         TableError: If the file is missing, unreadable or not in this layout.
     """
-    from sumo_ayss.analysis.sequential import SettleCheck
-
     data = read_json(path)
     where = str(path)
     if data.get("format") != ADAPTIVE_FORMAT:
@@ -109,7 +132,7 @@ def read_adaptive(path: str | Path) -> AdaptiveRecord:
         if not isinstance(x, Mapping):
             raise TableError(f"{at}: expected an object, got {x!r}")
         looks.append(
-            SettleCheck(
+            AdaptiveLook(
                 n_seeds=json_field(x, "n_seeds", int, at),
                 omnibus_p=_float(json_field(x, "omnibus_p", _NUMBER_OR_NULL, at)),
                 gate_level=float(json_field(x, "gate_level", _NUMBER, at)),

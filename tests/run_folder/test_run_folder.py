@@ -349,9 +349,14 @@ def test_adaptive_record_round_trips_and_refuses_another_layout(tmp_path: Path) 
     import math
 
     from sumo_ayss.analysis.sequential import SettleCheck
-    from sumo_ayss.run_folder import AdaptiveRecord, read_adaptive, write_adaptive
+    from sumo_ayss.run_folder import AdaptiveLook, AdaptiveRecord, read_adaptive, write_adaptive
 
-    look = SettleCheck(4, math.nan, 0.027, "a", "b", 0.11, 0.05, False)
+    check = SettleCheck(4, math.nan, 0.027, "a", "b", 0.11, 0.05, False)
+    # the stored look holds the analysis's check field by field (storage imports no analysis)
+    look = AdaptiveLook(**dataclasses.asdict(check))
+    assert [f.name for f in dataclasses.fields(AdaptiveLook)] == [
+        f.name for f in dataclasses.fields(SettleCheck)
+    ]
     record = AdaptiveRecord((0, 1, 2, 3), 6, 0.05, (0, 1, 2, 3, 4), (look,))
     path = tmp_path / "adaptive.json"
     write_adaptive(path, record)
