@@ -32,6 +32,8 @@ Pipeline YAML (every key optional)::
     budget: verdict             # a named budget: verdict (default) | paper | null (config.budget)
     total_timesteps: null       # override the budget's / every experiment's train.total_timesteps
     eval_every: null            # override the budget's / every experiment's train.eval_every
+    early_stop_patience: null   # every experiment's train.early_stop_patience (null: its own, off)
+    early_stop_margin_se: null  # every experiment's train.early_stop_margin_se
     evaluate: {n_outcome: 200, n_ayss: 100000}  # n_ayss: shorthand for ayss.n_samples
     #   ayss: {h_m: [0, 5], seed: 4242, ...}   # Monte Carlo (sumo_ayss.config.AyssConfig)
     vuts: {}                    # extra VUTs (name: vehicle type) added to every experiment
@@ -381,6 +383,14 @@ def add_config_flags(parser: argparse.ArgumentParser) -> None:
     )
     group.add_argument("--n-ayss", type=int, default=None, help="AYSS Monte Carlo draws per SPCP")
     group.add_argument(
+        "--early-stop-patience",
+        type=int,
+        default=None,
+        help="stop a run once this many candidates in a row have not beaten the best before "
+        "them by more than early_stop_margin_se standard errors (train.early_stop_patience; "
+        "default: off)",
+    )
+    group.add_argument(
         "--max-seeds",
         type=int,
         default=None,
@@ -402,6 +412,7 @@ def config_from_args(args: argparse.Namespace) -> PipelineConfig:
         n_outcome=args.n_outcome,
         n_ayss=args.n_ayss,
         max_seeds=args.max_seeds,
+        early_stop_patience=args.early_stop_patience,
     )
 
 

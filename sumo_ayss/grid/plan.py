@@ -67,6 +67,10 @@ def case_experiment(cfg: PipelineConfig, case: str) -> ExperimentConfig:
         overrides["total_timesteps"] = cfg.total_timesteps
     if cfg.eval_every is not None:
         overrides["eval_every"] = cfg.eval_every
+    if cfg.early_stop_patience is not None:
+        overrides["early_stop_patience"] = cfg.early_stop_patience
+    if cfg.early_stop_margin_se is not None:
+        overrides["early_stop_margin_se"] = cfg.early_stop_margin_se
     exp = dataclasses.replace(exp, train=dataclasses.replace(exp.train, **overrides))
     if cfg.vuts:
         exp = dataclasses.replace(

@@ -135,3 +135,18 @@ def test_a_run_stops_when_its_candidates_stop_moving(tmp_path: Path) -> None:
     # a resume of the stopped run stays stopped (it does not train on to the cap)
     train(cfg, seed=4, out=tmp_path / "stopped", resume=True)
     assert [r["step"] for r in read_eval_table(stopped / "eval.csv")] == [200, 400]
+
+
+def test_a_pipeline_switches_it_on_for_every_experiment(tmp_path: Path) -> None:
+    from sumo_ayss.config.pipeline import load_pipeline
+    from sumo_ayss.grid.plan import case_experiment
+
+    cfg = load_pipeline(None, early_stop_patience=2)
+    assert case_experiment(cfg, "cut_in").train.early_stop_patience == 2
+    assert case_experiment(load_pipeline(None), "cut_in").train.early_stop_patience is None
+    path = tmp_path / "p.yaml"
+    path.write_text(yaml.safe_dump({"early_stop_margin_se": -1}))
+    with pytest.raises(ConfigError, match="early_stop_margin_se must be in"):
+        load_pipeline(path)
+    with pytest.raises(ConfigError, match="early_stop_patience must be an int >= 1"):
+        load_pipeline(None, early_stop_patience=0)
