@@ -7,15 +7,16 @@
 
 ``cells``: for every run of the studies (one ladder; several studies of it are pooled, e.g.
 run A and run B with other seeds) and every budget B = 10k, 20k, ... (``--budget-step``) up
-to the run's last candidate, the SPCP the run would have selected with a training budget
-of B transitions is the best of its candidates up to B (the run's selection criterion on
-its ``eval.csv``). Every distinct such candidate is driven against every VUT of the case exactly as the
-cross-play stage drives an opponent (:func:`sumo_ayss.scenarios.crossplay.run_crossplay`: a
-fresh single env, SUMO seed = the opponent's seed, the outcome stage's ``n`` scenarios of
-its seed). One row per episode goes to ``OUT/<case>/cells.csv`` (appended cell by cell, so a
-killed run continues where it stopped), with the CPU-seconds of each cell. At each run's
-final SPCP the episodes of its own VUT are checked against the run's ``outcome.csv``
-(the cross-play diagonal check): this script drives the vehicle the product drives.
+to the run's last candidate, the SPCP the run would have selected with a training budget of
+B transitions is the best of its candidates up to B (the run's selection criterion on its
+``eval.csv``). Every distinct such candidate is driven against every VUT of the case exactly
+as the cross-play stage drives an opponent
+(:func:`sumo_ayss.scenarios.crossplay.run_crossplay`: a fresh single env, SUMO seed = the
+opponent's seed, the outcome stage's ``n`` scenarios of its seed). One row per episode goes
+to ``OUT/<case>/cells.csv`` (appended cell by cell, so a killed run continues where it
+stopped), with the CPU-seconds of each cell. At each run's final SPCP the episodes of its
+own VUT are checked against the run's ``outcome.csv`` (the cross-play diagonal check): this
+script drives the vehicle the product drives.
 
 ``curve``: for each budget B, each number of training seeds per VUT S (every subset of S of
 the pooled seeds) and each number of scenarios n (the first n), the cross-play ranking
@@ -483,6 +484,43 @@ def _paper_cpu(meta: dict, n: int) -> float:
     return _protocol_cpu(len(vuts), 3, 100_000, n, sec10k, meta["cpu_episode"])
 
 
+def holm_bound(outs: Sequence[Path], dest: Path, n: int) -> None:
+    """From ``curve.csv`` files written before the ranking used Holm (raw ends significance
+    and the count of raw-significant adjacent pairs, no adjacent p): per ladder, case,
+    budget and seeds per VUT, the share of subsets with τ = 1 and raw-significant ends, and
+    an **upper bound** on the share with Holm-significant ends (those need every adjacent
+    pair significant on its own too: τ = 1 and all adjacent pairs raw-significant). Writes
+    ``dest``."""
+    table = []
+    for out in outs:
+        for path in sorted(out.glob("*/curve.csv")):
+            groups: dict[tuple[int, int], list[dict]] = defaultdict(list)
+            with path.open() as f:
+                for r in csv.DictReader(f):
+                    if int(r["n"]) == n:
+                        groups[(int(r["budget"]), int(r["seeds_per_vut"]))].append(r)
+            for (budget, seeds), rows in sorted(groups.items()):
+                k = len(rows[0]["order"].split(" > "))
+                raw = [float(r["tau"]) == 1.0 and r["ends_significant"] == "True" for r in rows]
+                bound = [
+                    float(r["tau"]) == 1.0 and int(r["significant_adjacent"]) == k - 1 for r in rows
+                ]
+                table.append(
+                    {
+                        "ladder": out.name,
+                        "case": path.parent.name,
+                        "budget": budget,
+                        "seeds_per_vut": seeds,
+                        "subsets": len(rows),
+                        "share_both_raw": round(float(np.mean(raw)), 3),
+                        "share_both_holm_at_most": round(float(np.mean(bound)), 3),
+                        "cpu_s": int(rows[0]["cpu_s"]),
+                    }
+                )
+    _write_csv(dest, table)
+    print(f"wrote {dest}")
+
+
 # ----------------------------------------------------------------------------- early stop
 
 
@@ -633,6 +671,10 @@ def main(argv: Sequence[str] | None = None) -> None:
     fr = sub.add_parser("frontier")
     fr.add_argument("out", type=Path)
     fr.add_argument("--n", type=int, default=200)
+    hb = sub.add_parser("holm-bound")
+    hb.add_argument("dest", type=Path)
+    hb.add_argument("outs", type=Path, nargs="+")
+    hb.add_argument("--n", type=int, default=200)
     es = sub.add_parser("early-stop")
     es.add_argument("out", type=Path)
     es.add_argument("--expected", nargs="+", default=None)
@@ -654,6 +696,8 @@ def main(argv: Sequence[str] | None = None) -> None:
         figure(a.outs, a.dest, a.seeds, a.n)
     elif a.cmd == "cells":
         cells(a.out, a.studies, a.budget_step)
+    elif a.cmd == "holm-bound":
+        holm_bound(a.outs, a.dest, a.n)
     elif a.cmd == "frontier":
         frontier(a.out, a.n)
     elif a.cmd == "early-stop":
