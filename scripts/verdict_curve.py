@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import gzip
 import itertools
 import json
 import math
@@ -64,6 +65,7 @@ from collections import defaultdict
 from collections.abc import Sequence
 from datetime import datetime
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 
@@ -271,6 +273,18 @@ transitions of the CPU model instead of this study's ``job.log`` (whose wall-clo
 measure the machine's load as much as the job when other work shares the cores)."""
 
 
+def _has_cells(folder: Path) -> bool:
+    return (folder / "cells.csv").is_file() or (folder / "cells.csv.gz").is_file()
+
+
+def _open_cells(folder: Path) -> IO[str]:
+    """``cells.csv``, or the committed ``cells.csv.gz`` when it is absent (``gunzip -k`` it
+    before ``cells`` appends to it)."""
+    if (folder / "cells.csv").is_file():
+        return (folder / "cells.csv").open()
+    return gzip.open(folder / "cells.csv.gz", "rt")
+
+
 def _read_meta(folder: Path) -> dict:
     meta = json.loads((folder / "cells.json").read_text())
     if RATE_FROM is not None:
@@ -290,7 +304,7 @@ def _load_cells(folder: Path) -> tuple[dict, dict, float]:
         sys.exit(f"{first.path}: no harm scale ({'; '.join(first.problems)})")
     data: dict = defaultdict(list)
     cpu: dict = {}
-    with (folder / "cells.csv").open() as f:
+    with _open_cells(folder) as f:
         for r in csv.DictReader(f):
             key = (r["vut"], r["opponent_vut"], int(r["opponent_seed"]), int(r["opponent_step"]))
             data[key].append((int(r["scenario"]), float(r["near_miss_pay"]), int(r["collided"])))
@@ -308,7 +322,7 @@ def _load_cells(folder: Path) -> tuple[dict, dict, float]:
 
 def curve(out: Path, expected: Sequence[str] | None, max_subsets: int) -> None:
     summary = []
-    for folder in sorted(p for p in out.iterdir() if (p / "cells.csv").is_file()):
+    for folder in sorted(p for p in out.iterdir() if _has_cells(p)):
         case = folder.name
         data, meta, cpu_episode = _load_cells(folder)
         runs = meta["runs"]
@@ -483,7 +497,7 @@ def frontier(out: Path, n: int) -> None:
 
 def _load_meta(folder: Path) -> dict:
     meta = _read_meta(folder)
-    with (folder / "cells.csv").open() as f:
+    with _open_cells(folder) as f:
         cpu = {}
         for r in csv.DictReader(f):
             cpu[(r["vut"], r["opponent_vut"], r["opponent_seed"], r["opponent_step"])] = float(
@@ -556,7 +570,7 @@ def early_stop(
     from sumo_ayss.training.selection import CRITERIA
 
     table = []
-    for folder in sorted(p for p in out.iterdir() if (p / "cells.csv").is_file()):
+    for folder in sorted(p for p in out.iterdir() if _has_cells(p)):
         case = folder.name
         data, meta, cpu_episode = _load_cells(folder)
         runs = meta["runs"]
