@@ -174,6 +174,8 @@ def cells(out: Path, studies: Sequence[Path], budget_step: int = BUDGET_STEP) ->
                     for v in envs
                     if (v, r.experiment.env.vut, r.config_seed, step) not in done
                 ]
+        # the smallest budgets first: an interrupted run leaves whole budgets behind it
+        todo.sort(key=lambda t: (t[2], t[1].experiment.env.vut, t[1].config_seed, t[0]))
         atomic_write_text(folder / "cells.json", json.dumps(meta, indent=2) + "\n")
         print(f"{case}: {len(done)} cells done, {len(todo)} to run", flush=True)
         new = not path.is_file()
@@ -320,7 +322,9 @@ def _load_cells(folder: Path) -> tuple[dict, dict, float]:
     return cells_out, meta, per_episode
 
 
-def curve(out: Path, expected: Sequence[str] | None, max_subsets: int) -> None:
+def curve(
+    out: Path, expected: Sequence[str] | None, max_subsets: int, max_budget: int | None = None
+) -> None:
     summary = []
     for folder in sorted(p for p in out.iterdir() if _has_cells(p)):
         case = folder.name
@@ -333,6 +337,7 @@ def curve(out: Path, expected: Sequence[str] | None, max_subsets: int) -> None:
         }
         seeds = seeds_of[vuts[0]]
         budgets = sorted({int(b) for r in runs.values() for b in r["spcp_by_budget"]})
+        budgets = [b for b in budgets if max_budget is None or b <= max_budget]
         sec10k = float(np.nanmedian([r["sec_per_10k"] for r in runs.values()]))
         n_max = meta["n"]
         ns = [x for x in (50, 100, 200) if x <= n_max] or [n_max]
@@ -560,6 +565,7 @@ def early_stop(
     max_subsets: int,
     rules: Sequence[tuple[int, float]],
     n: int,
+    max_budget: int | None = None,
 ) -> None:
     """The verdict with every run stopped by the early-stopping rule
     (:func:`sumo_ayss.analysis.early_stop.stop_index` on the run's ``eval.csv``), each
@@ -579,6 +585,7 @@ def early_stop(
         seeds = sorted(int(k.split("/")[1]) for k in runs if k.startswith(f"{vuts[0]}/"))
         sec10k = float(np.nanmedian([r["sec_per_10k"] for r in runs.values()]))
         cap = max(int(b) for r in runs.values() for b in r["spcp_by_budget"])
+        cap = cap if max_budget is None else min(cap, max_budget)
         curves = {}
         for key, r in runs.items():
             run = read_run(PROJECT_ROOT / r["run_dir"])
@@ -721,6 +728,14 @@ def main(argv: Sequence[str] | None = None) -> None:
     g.add_argument("outs", type=Path, nargs="+")
     g.add_argument("--seeds", type=int, nargs="+", default=[3, 4])
     g.add_argument("--n", type=int, default=200)
+    for sp in (k, es):
+        sp.add_argument(
+            "--max-budget",
+            type=int,
+            default=None,
+            help="only budgets up to this (cells of larger ones may be missing); early-stop: "
+            "the runs' cap",
+        )
     for sp in (k, fr, es):
         sp.add_argument(
             "--rate-from",
@@ -743,9 +758,9 @@ def main(argv: Sequence[str] | None = None) -> None:
         frontier(a.out, a.n)
     elif a.cmd == "early-stop":
         rules = [(int(r.split(":")[0]), float(r.split(":")[1])) for r in a.rules]
-        early_stop(a.out, a.expected, a.max_subsets, rules, a.n)
+        early_stop(a.out, a.expected, a.max_subsets, rules, a.n, a.max_budget)
     else:
-        curve(a.out, a.expected, a.max_subsets)
+        curve(a.out, a.expected, a.max_subsets, a.max_budget)
 
 
 if __name__ == "__main__":
