@@ -410,7 +410,13 @@ def _expected(meta: dict) -> list[str]:
     return list(read_order_check(study.order_check_json).expected)
 
 
+EPISODE_S: float | None = None
+"""``--episode-ms`` / 1000: the CPU model's seconds per episode instead of the cells' own
+(whose CPU time grows with the machine's load)."""
+
+
 def _protocol_cpu(v: int, s: int, budget: int, n: int, sec10k: float, cpu_episode: float) -> float:
+    cpu_episode = cpu_episode if EPISODE_S is None else EPISODE_S
     train = v * s * sec10k * budget / BUDGET_STEP
     episodes = v * s * n + v * v * s * n
     return train + episodes * cpu_episode
@@ -738,6 +744,12 @@ def main(argv: Sequence[str] | None = None) -> None:
         )
     for sp in (k, fr, es):
         sp.add_argument(
+            "--episode-ms",
+            type=float,
+            default=None,
+            help="CPU milliseconds per episode of the CPU model (default: the cells' own)",
+        )
+        sp.add_argument(
             "--rate-from",
             type=Path,
             default=None,
@@ -746,8 +758,10 @@ def main(argv: Sequence[str] | None = None) -> None:
             " of the CPU model (default: this study's job.log)",
         )
     a = p.parse_args(argv)
-    global RATE_FROM
+    global RATE_FROM, EPISODE_S
     RATE_FROM = getattr(a, "rate_from", None)
+    ms = getattr(a, "episode_ms", None)
+    EPISODE_S = None if ms is None else ms / 1000
     if a.cmd == "figure":
         figure(a.outs, a.dest, a.seeds, a.n)
     elif a.cmd == "cells":
