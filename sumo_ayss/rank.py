@@ -41,7 +41,15 @@ from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.seeds import kendall_tau
-from sumo_ayss.modes import Mode, get_mode, missing_rows_line, mode_names, registered_modes
+from sumo_ayss.modes import (
+    Mode,
+    analyse_cases,
+    check_mode,
+    get_mode,
+    missing_rows_line,
+    mode_names,
+    registered_modes,
+)
 from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.run_folder import (
     OUTCOME_JSON,
@@ -49,6 +57,7 @@ from sumo_ayss.run_folder import (
     OrderChecks,
     RunRecord,
     StudyFolder,
+    case_runs,
     read_run,
     write_order_check,
     write_ranking_csv,
@@ -70,11 +79,13 @@ __all__ = [
 ]
 
 
-def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> list[CaseAnalysis]:
+def analyse(
+    run_dirs: Sequence[Path], options: ReportOptions | None = None
+) -> list[CaseAnalysis[RunRecord]]:
     """The analysis of every case among ``run_dirs``, for ranking without the pipeline.
 
     Each run folder is read once (:func:`sumo_ayss.run_folder.read_run`) and each case
-    analysed once (:func:`sumo_ayss.report.load.analyse_runs`); the AYSS bootstrap runs in
+    analysed once (:func:`sumo_ayss.modes.analyse_cases`); the AYSS bootstrap runs in
     paper mode only.
     """
     return analyse_loaded([read_run(d) for d in run_dirs], options)
@@ -82,17 +93,17 @@ def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> l
 
 def analyse_loaded(
     runs: Sequence[RunRecord], options: ReportOptions | None = None
-) -> list[CaseAnalysis]:
+) -> list[CaseAnalysis[RunRecord]]:
     """:func:`analyse` of runs already loaded."""
     from sumo_ayss.config.report import ReportOptions
-    from sumo_ayss.report.load import analyse_runs
 
     options = options or ReportOptions()
     # The AYSS bootstrap only where the mode ranks by the safety index.
-    return analyse_runs(runs, options, paper=get_mode(options.mode).needs_safety_index)
+    paper = check_mode(options.mode).needs_safety_index
+    return analyse_cases(case_runs(runs), options, paper=paper)
 
 
-def available_modes(a: CaseAnalysis) -> list[str]:
+def available_modes(a: CaseAnalysis[RunRecord]) -> list[str]:
     """The modes with a ranking for this case (:attr:`~sumo_ayss.modes.Mode.available`),
     the analysis's own mode first, then the others in registry order.
     """
@@ -100,7 +111,7 @@ def available_modes(a: CaseAnalysis) -> list[str]:
     return sorted(have, key=lambda m: m != a.mode)
 
 
-def _rows(a: CaseAnalysis, mode: Mode) -> list[dict[str, Any]]:
+def _rows(a: CaseAnalysis[RunRecord], mode: Mode) -> list[dict[str, Any]]:
     """The ``ranking.csv`` rows of one case in one mode, with crashes and mobility where
     the mode reads outcomes (``CaseAnalysis.outcomes``)."""
     outcomes = a.outcomes.get(mode.name, {})
@@ -143,7 +154,7 @@ def _finite_or_empty(x: float) -> float | str:
     return x if math.isfinite(x) else ""
 
 
-def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
+def ranking_rows(analyses: Sequence[CaseAnalysis[RunRecord]]) -> list[dict[str, Any]]:
     """Ranking rows of every case, for every mode available (:func:`available_modes`: the
     analysis's mode first), safest first within a (case, mode); ``mode`` tags each row.
 
@@ -159,7 +170,7 @@ def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
 
 
 def order_check(
-    a: CaseAnalysis, expected: Sequence[str], mode: str | None = None
+    a: CaseAnalysis[RunRecord], expected: Sequence[str], mode: str | None = None
 ) -> OrderCheck | None:
     """How one case's ranking in one mode compares with a known order (safest first).
 
@@ -197,7 +208,9 @@ def order_check(
     )
 
 
-def order_checks(analyses: Sequence[CaseAnalysis], expected: Sequence[str]) -> list[OrderCheck]:
+def order_checks(
+    analyses: Sequence[CaseAnalysis[RunRecord]], expected: Sequence[str]
+) -> list[OrderCheck]:
     """:func:`order_check` of every (case, mode) available, the analysis's mode first."""
     return [
         c
@@ -294,7 +307,7 @@ def _mobility_cell(row: dict[str, Any]) -> str:
 def main(argv: Sequence[str] | None = None) -> None:
     import dataclasses
 
-    from sumo_ayss.cli import prog
+    from sumo_ayss.cli import STRICT_HELP, prog
     from sumo_ayss.pipeline import (
         add_config_flags,
         config_from_args,
@@ -303,7 +316,6 @@ def main(argv: Sequence[str] | None = None) -> None:
         plan_jobs,
         run_pipeline,
     )
-    from sumo_ayss.report.__main__ import STRICT_HELP
     from sumo_ayss.report.checks import input_problems
 
     parser = argparse.ArgumentParser(

@@ -8,17 +8,22 @@ import sys
 
 import pytest
 
+from sumo_ayss.analysis.case import CROSSPLAY_MODE, EXPOSURE_MODE, PAPER_MODE
+from sumo_ayss.config.report import DEFAULT_MODE as CONFIG_DEFAULT_MODE
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import (
     CROSSPLAY,
     DEFAULT_MODE,
     EXPOSURE,
     PAPER,
+    Mode,
+    check_mode,
     get_mode,
     mode_names,
     register_mode,
     unregister_mode,
 )
+from sumo_ayss.modes.exposure import ExposureMode
 from sumo_ayss.rank import analyse, ranking_rows
 from sumo_ayss.util.errors import ConfigError
 from tests.report.test_report import make_run
@@ -26,7 +31,12 @@ from tests.report.test_report import make_run
 
 def test_built_in_modes_in_registry_order_with_the_default_first() -> None:
     assert mode_names()[:3] == ("crossplay", "exposure", "paper")
-    assert DEFAULT_MODE == CROSSPLAY.name == ReportOptions().mode
+    assert DEFAULT_MODE == CROSSPLAY.name == ReportOptions().mode == CONFIG_DEFAULT_MODE
+    assert (CROSSPLAY.name, EXPOSURE.name, PAPER.name) == (
+        CROSSPLAY_MODE,
+        EXPOSURE_MODE,
+        PAPER_MODE,
+    )
     assert get_mode("paper") is PAPER
     assert CROSSPLAY.runs_crossplay and not EXPOSURE.runs_crossplay
     assert PAPER.needs_safety_index and not CROSSPLAY.needs_safety_index
@@ -35,8 +45,20 @@ def test_built_in_modes_in_registry_order_with_the_default_first() -> None:
 def test_an_unknown_mode_is_refused_with_the_registered_ones_named() -> None:
     with pytest.raises(ConfigError, match=r"unknown mode 'exposur'.*'exposure'"):
         get_mode("exposur")
-    with pytest.raises(ConfigError, match=r"report\.mode must be one of"):
-        ReportOptions(mode="nonsense")
+    with pytest.raises(ConfigError, match=r"report\.mode must be one of .*'exposure'"):
+        check_mode("nonsense")
+    with pytest.raises(ConfigError, match=r"report\.mode must be a mode's name"):
+        ReportOptions(mode="Not a name")
+    assert ReportOptions(mode="nonsense").mode == "nonsense"  # the stages check the registry
+
+
+def test_a_mode_is_an_object_without_callable_fields() -> None:
+    """Its behaviour is methods; its fields are data (no callables, no lambdas)."""
+    for mode in (CROSSPLAY, EXPOSURE, PAPER):
+        assert isinstance(mode, Mode)
+        assert not any(callable(getattr(mode, f.name)) for f in dataclasses.fields(mode))
+    with pytest.raises(TypeError, match="abstract"):
+        Mode(name="x", description="", score_name="", interval_name="", digits=1)  # type: ignore[abstract]
 
 
 def test_registering_another_record_under_a_taken_name_needs_replace() -> None:
@@ -48,7 +70,14 @@ def test_registering_another_record_under_a_taken_name_needs_replace() -> None:
 def test_a_new_mode_is_one_record_that_config_and_rank_pick_up(tmp_path) -> None:
     """A mode registered at run time (here: exposure's ranking under another name and
     unit) is accepted by ``report.mode``, heads the ranking and tags its rows."""
-    mode = dataclasses.replace(EXPOSURE, name="own_harm", unit=lambda a: "harm (plug-in)")
+
+    @dataclasses.dataclass(frozen=True)
+    class OwnHarm(ExposureMode):
+        def unit(self, a: object) -> str:
+            return "harm (plug-in)"
+
+    fields = {f.name: getattr(EXPOSURE, f.name) for f in dataclasses.fields(EXPOSURE)}
+    mode = OwnHarm(**{**fields, "name": "own_harm"})
     register_mode(mode)
     try:
         dirs = [make_run(tmp_path, "car_following", v, s) for v in ("pi1", "pi2") for s in (0, 1)]
@@ -70,3 +99,15 @@ def test_the_registry_loads_without_the_analysis() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_the_pipeline_refuses_an_unknown_mode_before_any_job(tmp_path) -> None:
+    """The configuration imports no mode; the pipeline checks ``report.mode`` first."""
+    from sumo_ayss.config import load_pipeline
+    from sumo_ayss.pipeline import run_pipeline
+
+    cfg = load_pipeline("configs/ladders/min_gap.yaml", out=tmp_path / "study")
+    bad = dataclasses.replace(cfg, report=dataclasses.replace(cfg.report, mode="exposur"))
+    with pytest.raises(ConfigError, match=r"report\.mode must be one of .*did you mean 'exposure'"):
+        run_pipeline(bad, live=False)
+    assert not (tmp_path / "study").exists()
