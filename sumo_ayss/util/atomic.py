@@ -11,12 +11,15 @@ the ones a killed process left behind.
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import shutil
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
+
+from sumo_ayss.util.errors import DiskFullError
 
 #: Suffix of every temporary file written here (``.<name>.<pid>.tmp``).
 TMP_SUFFIX = ".tmp"
@@ -34,6 +37,48 @@ def fsync_dir(folder: str | Path) -> None:
         pass
     finally:
         os.close(fd)
+
+
+#: Errors of a file system without room: no space left, quota exceeded.
+FULL_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT})
+#: A writer that hides the errno (``torch.save`` raises a ``RuntimeError``) counts as having
+#: met a full disk when less than this is free after it failed, bytes.
+NEARLY_FULL_B = 1 << 20
+
+
+def free_bytes(folder: str | Path) -> int | None:
+    """Bytes free to this user on ``folder``'s file system (None when it cannot be asked)."""
+    try:
+        st = os.statvfs(folder)
+    except OSError:
+        return None
+    return st.f_bavail * st.f_frsize
+
+
+def disk_full_error(path: Path, needed: int | None, cause: BaseException) -> DiskFullError | None:
+    """The :class:`DiskFullError` for a failed write of ``path`` (``needed`` bytes; None when
+    unknown: the bytes written before it failed are named instead), or None when ``cause``
+    is not a full file system."""
+    full = isinstance(cause, OSError) and cause.errno in FULL_ERRNOS
+    free = free_bytes(path.parent)
+    if not full and not (free is not None and free < NEARLY_FULL_B):
+        return None
+    tmp_sizes = [p.stat().st_size for p in path.parent.glob(f".{path.stem}*{TMP_SUFFIX}*")]
+    size = (
+        f"{needed:,} bytes"
+        if needed is not None
+        else (
+            f"more than the {max(tmp_sizes):,} bytes it had written"
+            if tmp_sizes
+            else "an unknown size"
+        )
+    )
+    return DiskFullError(
+        f"no space left on the file system of {path}: writing it needed {size}, and "
+        f"{'?' if free is None else f'{free:,}'} bytes are free there ({cause}). Every file "
+        "written before is complete; free some space (or move the output folder) and rerun "
+        "the same command to continue"
+    )
 
 
 def _tmp_path(path: Path) -> Path:
@@ -56,6 +101,11 @@ def atomic_write_with(path: str | Path, write: Callable[[Path], object]) -> None
             os.fsync(f.fileno())
         os.replace(tmp, path)
         fsync_dir(path.parent)
+    except Exception as e:
+        full = disk_full_error(path, None, e)
+        if full is not None:
+            raise full from e
+        raise
     finally:
         tmp.unlink(missing_ok=True)
 
@@ -72,6 +122,11 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
             os.fsync(f.fileno())
         os.replace(tmp, path)
         fsync_dir(path.parent)
+    except OSError as e:
+        full = disk_full_error(path, len(data), e)
+        if full is not None:
+            raise full from e
+        raise
     finally:
         tmp.unlink(missing_ok=True)
 
