@@ -215,7 +215,13 @@ class Cluster:
         """The README's token command, run with the head's home folder; returns the token."""
         self.head_home.mkdir(parents=True, exist_ok=True)
         env = {**os.environ, "HOME": str(self.head_home)}
-        subprocess.run(["bash", "-c", self._readme("token")], env=env, check=True, timeout=60)
+        subprocess.run(  # it prints the token: kept out of the drill's output
+            ["bash", "-c", self._readme("token")],
+            env=env,
+            check=True,
+            timeout=60,
+            capture_output=True,
+        )
         return self.token_file.read_text()
 
     def _ports(self, n: int) -> list[int]:

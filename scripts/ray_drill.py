@@ -12,6 +12,7 @@ directory and home folder (no token file: the token reaches it in ``RAY_AUTH_TOK
 this machine allows a private mount namespace, with the driver's folder (study YAML and output
 folders) covered by an empty tmpfs, so that run folders can only travel inside the tasks.
 
+- ``refused``: the pipeline without the README's variables (no token): a clear error;
 - ``worker``: SIGKILL the Ray worker process running a job on the worker node, 2 s into it;
 - ``node``: SIGKILL every process of the worker node, 2 s into a job there (then a new one);
 - ``head``: SIGKILL every process of the head once a job has finished and others are still
@@ -186,6 +187,28 @@ class Drill:
             "ok": bool(killed) and code == 0 and once and bool(retried) and not differ,
         }
 
+    def refused(self) -> dict[str, Any]:
+        """The pipeline without the README's variables (no RAY_AUTH_MODE, no token): the
+        head refuses it; the error must say so, and nothing is written."""
+        self.start()
+        env = {k: v for k, v in self.cluster.driver_env().items() if not k.startswith("RAY_AUTH")}
+        out = self.driver / "out_refused"
+        cmd = self.cluster.pipeline_command(self.pipe, *self.flags, "--out", str(out))
+        t0 = time.monotonic()
+        done = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+        wall = time.monotonic() - t0
+        self.cluster.stop()
+        error = [ln for ln in done.stderr.splitlines() if ln.startswith("error:")]
+        ok = done.returncode == 1 and bool(error) and "token" in error[0]
+        return {
+            "drill": "refused",
+            "exit": done.returncode,
+            "after_s": round(wall, 1),
+            "error": error[:1],
+            "wrote": out.exists() and any(out.rglob("*.csv")),
+            "ok": ok and not (out.exists() and any(out.rglob("*.csv"))),
+        }
+
     def kill_head(self) -> dict[str, Any]:
         head, worker = self.start()
         proc, out, log = self.launch("head")
@@ -246,7 +269,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--work", type=Path, default=Path("/tmp/ray_drill"))
     p.add_argument("--total-timesteps", type=int, default=3000)
     p.add_argument("--n-outcome", type=int, default=20)
-    p.add_argument("--drills", default="worker,node,head")
+    p.add_argument("--drills", default="refused,worker,node,head")
     args = p.parse_args(argv)
     if args.work.exists():
         shutil.rmtree(args.work)
@@ -259,6 +282,8 @@ def main(argv: list[str] | None = None) -> int:
         for name in args.drills.split(","):
             if name == "head":
                 r = drill.kill_head()
+            elif name == "refused":
+                r = drill.refused()
             else:
                 r = drill.kill_in_job(name, whole_node=name == "node")
             results.append(r)

@@ -39,6 +39,7 @@ from typing import Any
 
 from sumo_ayss.grid.jobs import NOT_RETRIED, JobSpec, is_finished, run_job
 from sumo_ayss.grid.progress import GridProgress, JobStatus
+from sumo_ayss.util.atomic import disk_full_error
 from sumo_ayss.util.errors import ClusterError, ConfigError
 
 logger = logging.getLogger(__name__)
@@ -61,7 +62,15 @@ def unpack(data: bytes, folder: Path) -> None:
     shutil.rmtree(tmp, ignore_errors=True)
     tmp.mkdir(parents=True)
     with tarfile.open(fileobj=io.BytesIO(data), mode="r:gz") as tar:
-        tar.extractall(tmp, filter="data")
+        try:
+            tar.extractall(tmp, filter="data")
+        except OSError as e:
+            shutil.rmtree(tmp, ignore_errors=True)  # the run folder itself is untouched
+            needed = sum(m.size for m in tar.getmembers())
+            full = disk_full_error(folder, needed, e)  # the folder unpacked
+            if full is None:
+                raise
+            raise full from e
     old = folder.with_name(f".{folder.name}.old")
     shutil.rmtree(old, ignore_errors=True)
     if folder.exists():
