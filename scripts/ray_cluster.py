@@ -22,10 +22,12 @@ import contextlib
 import os
 import re
 import shlex
+import shutil
 import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -175,6 +177,9 @@ class Cluster:
         self.port = port or free_port_block()
         self.ip = "127.0.0.1"
         self.head_home = work / "head_home"
+        # Ray's socket paths live under --temp-dir and may not exceed 107 bytes (AF_UNIX):
+        # a short folder of its own, removed by stop().
+        self.temp_root = Path(tempfile.mkdtemp(prefix="rc", dir="/tmp"))
         self.nodes: dict[str, Node] = {}
         self.started: list[Node] = []
         self.commands = readme_commands()
@@ -235,7 +240,7 @@ class Cluster:
             "--block",
             f"--num-cpus {cpus}",
             f"--resources '{{\"{name}\": 1}}'",
-            f"--temp-dir {self.work / ('t_' + name)}",
+            f"--temp-dir {self.temp_root / name}",
             f"--dashboard-agent-listen-port {agent}",
             f"--min-worker-port {worker_lo} --max-worker-port {worker_lo + 199}",
             "--object-store-memory 100000000",
@@ -277,7 +282,8 @@ class Cluster:
     ) -> Node:
         home.mkdir(parents=True, exist_ok=True)
         (cwd or home).mkdir(parents=True, exist_ok=True)
-        temp = self.work / f"t_{name}"
+        temp = self.temp_root / name
+        temp.mkdir(parents=True, exist_ok=True)
         log = self.work / f"{name}.log"
         full = f"{command} {self._isolation(name, head, cpus)}"
         argv = ["bash", "-c", f"exec env {full}"]
@@ -339,6 +345,7 @@ class Cluster:
         for name in sorted(self.nodes, key=lambda n: n == "head"):
             self.nodes[name].stop()
         self.nodes.clear()
+        shutil.rmtree(self.temp_root, ignore_errors=True)
 
     def leftovers(self) -> list[str]:
         """Processes of nodes started here that are still alive (should be none)."""

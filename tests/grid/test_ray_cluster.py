@@ -32,9 +32,9 @@ def test_pipeline_on_a_two_node_cluster_retries_a_killed_worker(tmp_path: Path) 
     cluster = Cluster(tmp_path / "cluster")
     try:
         cluster.start_head(cpus=1)
-    except RuntimeError as e:  # pragma: no cover - depends on the machine
+    except RuntimeError:
         cluster.stop()
-        pytest.skip(f"Ray cannot start a head node on this machine: {e}")
+        raise
     driver = tmp_path / "driver"
     driver.mkdir()
     pipe = write_configs(driver, [0, 1], total_timesteps=1500, eval_every=500)
@@ -56,7 +56,7 @@ def test_pipeline_on_a_two_node_cluster_retries_a_killed_worker(tmp_path: Path) 
         )
         assert refused.returncode == 1
         assert "error: --address" in refused.stderr and "token" in refused.stderr
-        assert not (driver / "runs").exists()
+        assert not list(driver.glob("runs/*/*/seed_*"))  # no job started
 
         # With it: 4 jobs on 2 nodes; the first job's worker process on w1 is killed.
         log = tmp_path / "pipeline.log"
