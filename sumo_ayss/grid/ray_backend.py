@@ -124,7 +124,7 @@ def _connect(ray: Any, address: str | None) -> None:
     except ConnectionError as e:
         raise ClusterError(
             f"--address {address}: no Ray cluster answered ({e}). Start one first "
-            "(README, 'A cluster'): `RAY_AUTH_MODE=token .venv/bin/ray start --head` on the "
+            "(README, 'The whole grid'): `RAY_AUTH_MODE=token .venv/bin/ray start --head` on the "
             "head, `RAY_AUTH_MODE=token RAY_AUTH_TOKEN=<the head's token> .venv/bin/ray start "
             "--address <head-ip>:6379` on each worker. If the head is running, it may require a "
             "token this process lacks: set RAY_AUTH_MODE=token and the head's token "
