@@ -11,9 +11,14 @@ of machine load hits every kind alike), on the same scenes:
 * FMU resets: microseconds per episode start, ``reinstantiate`` vs ``reset``;
 * ``--ladder N``: CPU seconds (this process and its children) and wall seconds of a 3-VUT
   ACC ladder (T = 0.6, 1.2, 2.0 s) through the pipeline, N transitions per run, one seed,
-  per kind (python, C FMU, process).
+  per kind (python, C FMU, process);
+* ``--verdict``: the same ladder at the default ``verdict`` budget (20,000 transitions, 4
+  seeds per VUT, adaptive up to 6), car-following, per kind: CPU and wall seconds to the
+  verdict, and the verdict itself (the order against T = 2.0 > 1.2 > 0.6, Kendall τ, whether
+  the ends differ significantly). ``--keep DIR`` keeps the run folders.
 
     python benchmarks/vut_kinds.py [--steps 20000] [--repeats 3] [--states 5000] [--ladder 0]
+    python benchmarks/vut_kinds.py --verdict [--kinds python,fmu2,process] [--keep DIR]
 """
 
 from __future__ import annotations
@@ -142,13 +147,26 @@ def cpu_s() -> float:
     return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
-def bench_ladder(folder: Path, kind: str, steps: int) -> tuple[float, float, str]:
-    """(CPU s, wall s, ranking) of a 3-VUT ACC ladder through the pipeline."""
+LADDER_KINDS = {"python": "python controller", "fmu2": "C FMU, FMI 2.0", "process": "process"}
+"""``--kinds`` names of the ladder's VUT kinds."""
+
+
+def bench_ladder(
+    folder: Path, kind: str, steps: int | None, out_root: Path | None = None
+) -> tuple[float, float, str]:
+    """(CPU s, wall s, ranking) of a 3-VUT ACC ladder through the pipeline.
+
+    ``steps`` None runs the default (``verdict``) budget with its own seeds and adaptive
+    seeding, and reads the verdict from ``order_check.json``.
+    """
+    import json
+
     import yaml
 
     from sumo_ayss.pipeline import load_pipeline, run_pipeline
+    from sumo_ayss.rank import main as rank_main
 
-    out = folder / f"ladder_{kind.split()[0]}"
+    out = (out_root or folder) / f"ladder_{kind.split()[0]}"
     gaps = {"tg06": 0.6, "tg12": 1.2, "tg20": 2.0}
     vuts = {}
     for name, tg in gaps.items():
@@ -160,20 +178,36 @@ def bench_ladder(folder: Path, kind: str, steps: int) -> tuple[float, float, str
     exp["env"]["vuts"] = vuts
     out.mkdir(parents=True, exist_ok=True)
     (out / "cf.yaml").write_text(yaml.safe_dump(exp))
-    pipe = {
-        "grid": {"cases": ["car_following"], "vuts": list(gaps), "seeds": [0]},
+    pipe: dict[str, object] = {
+        "grid": {"cases": ["car_following"], "vuts": list(gaps)},
         "experiments": {"car_following": "cf.yaml"},
         "out": "runs",
-        "total_timesteps": steps,
-        "eval_every": max(steps // 2, 1),
-        "workers": 1,
+        "expected_order": ["tg20", "tg12", "tg06"],
     }
+    if steps is None:
+        pipe["workers"] = 2
+    else:
+        pipe.update(total_timesteps=steps, eval_every=max(steps // 2, 1), workers=1)
+        pipe["grid"] = {"cases": ["car_following"], "vuts": list(gaps), "seeds": [0]}
+        del pipe["expected_order"]
     (out / "pipe.yaml").write_text(yaml.safe_dump(pipe))
-    cfg = load_pipeline(out / "pipe.yaml")
     c0, w0 = cpu_s(), time.perf_counter()
-    statuses, report, *_ = run_pipeline(cfg, live=False)
-    states = {s.state for s in statuses}
-    return cpu_s() - c0, time.perf_counter() - w0, f"jobs {sorted(states)}; report {report}"
+    if steps is not None:
+        statuses, report, *_ = run_pipeline(load_pipeline(out / "pipe.yaml"), live=False)
+        states = sorted({s.state for s in statuses})
+        return cpu_s() - c0, time.perf_counter() - w0, f"jobs {states}; report {report}"
+    # `rank` runs the same pipeline and also writes order_check.json
+    rank_main([str(out / "pipe.yaml"), "--no-live"])
+    cpu, wall = cpu_s() - c0, time.perf_counter() - w0
+    check = json.loads((out / "runs" / "order_check.json").read_text())
+    row = next(c for c in check["cases"] if c["mode"] == "crossplay")
+    seeds = len({p.name for p in (out / "runs" / "car_following" / "tg06").glob("seed_*")})
+    sig = "significant" if row["ends_significant"] else "not significant"
+    what = (
+        f"seeds {seeds}; order {' > '.join(row['order'])}; tau {row['tau']:.2f}; "
+        f"ends p {row['ends_p']:.2g} ({sig})"
+    )
+    return cpu, wall, what
 
 
 def main() -> None:
@@ -182,7 +216,27 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--states", type=int, default=5_000)
     parser.add_argument("--ladder", type=int, default=0, help="transitions per ladder run")
+    parser.add_argument(
+        "--verdict", action="store_true", help="only the ladder, at the default verdict budget"
+    )
+    parser.add_argument(
+        "--kinds", default=",".join(LADDER_KINDS), help=f"ladder kinds, of {list(LADDER_KINDS)}"
+    )
+    parser.add_argument("--keep", type=Path, default=None, help="keep the ladders' run folders")
     args = parser.parse_args()
+    chosen = [k.strip() for k in args.kinds.split(",") if k.strip()]
+    unknown = sorted(set(chosen) - set(LADDER_KINDS))
+    if unknown:
+        parser.error(f"--kinds: unknown {unknown}; choose from {list(LADDER_KINDS)}")
+    if args.verdict:
+        with tempfile.TemporaryDirectory(prefix="vut_kinds_") as tmp:
+            print("3-VUT ACC ladder (T = 2.0 > 1.2 > 0.6 s), car-following, verdict budget:")
+            print(f"{'VUT kind':<20}{'CPU s':>8}{'wall s':>8}  verdict")
+            for key in chosen:
+                name = LADDER_KINDS[key]
+                cpu, wall, what = bench_ladder(Path(tmp), name, None, args.keep)
+                print(f"{name:<20}{cpu:>8.1f}{wall:>8.1f}  {what}", flush=True)
+        return
     with tempfile.TemporaryDirectory(prefix="vut_kinds_") as tmp:
         folder = Path(tmp)
         vuts = kinds(folder)
