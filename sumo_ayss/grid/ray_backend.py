@@ -107,6 +107,15 @@ PROBE_EVERY_S = 2.0
 PROBE_FAILURES = 2
 
 
+def _gcs_address(ray: Any) -> str | None:
+    """The head's GCS address as ``host:port`` (None where Ray does not say, e.g. a client)."""
+    try:
+        found = ray.get_runtime_context().gcs_address
+    except Exception:  # pragma: no cover - depends on how Ray was joined
+        return None
+    return found if isinstance(found, str) and ":" in found else None
+
+
 def _head_answers(gcs_address: str) -> bool:
     """Whether the head's GCS port accepts a TCP connection (within 2 s)."""
     host, _, port = gcs_address.rpartition(":")
@@ -183,7 +192,7 @@ def run_grid_ray(
     resources = ray.cluster_resources() if hasattr(ray, "cluster_resources") else {}
     progress = GridProgress(statuses, int(resources.get("CPU", 1)), after)
     pending: dict[Any, JobStatus] = {}
-    gcs = ray.get_runtime_context().gcs_address if address is not None else None
+    gcs = _gcs_address(ray) if address is not None else None
     logger.info("%d jobs as Ray tasks (one CPU each)", len(jobs))
 
     def submit(s: JobStatus) -> None:
