@@ -24,7 +24,7 @@ pytestmark = pytest.mark.skipif(
 
 ATOMIC = textwrap.dedent(
     """
-    import json, subprocess, sys
+    import json, os, subprocess, sys
     from pathlib import Path
     from sumo_ayss.util.atomic import atomic_write_bytes, atomic_write_text, atomic_write_with
     from sumo_ayss.util.errors import DiskFullError
@@ -44,6 +44,19 @@ ATOMIC = textwrap.dedent(
             out[name] = str(e)
     out["old"] = target.read_text()
     out["files"] = sorted(p.name for p in fs.iterdir())
+    # A run folder coming back from a Ray task that does not fit: the one there stays whole.
+    from sumo_ayss.grid.ray_backend import pack, unpack
+    src = Path(sys.argv[2])
+    (src / "ckpt").mkdir(parents=True)
+    (src / "ckpt" / "model.zip").write_bytes(os.urandom(102400))
+    run = fs / "run"
+    atomic_write_text(run / "eval.csv", "step\\n1\\n")
+    try:
+        unpack(pack(src), run)
+        out["unpack"] = None
+    except DiskFullError as e:
+        out["unpack"] = str(e)
+    out["run"] = sorted(str(p.relative_to(fs)) for p in fs.rglob("*"))
     print(json.dumps(out))
     """
 )
@@ -55,7 +68,7 @@ def test_atomic_write_on_a_full_disk_names_file_and_bytes_and_keeps_the_old(
     fs = tmp_path / "fs"
     fs.mkdir()
     done = subprocess.run(
-        [*_unshare(), sys.executable, "-c", ATOMIC, str(fs)],
+        [*_unshare(), sys.executable, "-c", ATOMIC, str(fs), str(tmp_path / "src")],
         cwd=PROJECT_ROOT,
         capture_output=True,
         text=True,
@@ -70,6 +83,12 @@ def test_atomic_write_on_a_full_disk_names_file_and_bytes_and_keeps_the_old(
         assert "rerun the same command" in out[name]
     assert out["old"] == "old,content\n"  # the file written before is whole
     assert out["files"] == ["table.csv"]  # no temporary left behind
+    assert out["unpack"] is not None, "unpack did not raise DiskFullError"
+    assert (
+        f"no space left on the file system of {fs}/run: the file needs 102,400 bytes"
+        in (out["unpack"])
+    )
+    assert out["run"] == ["run", "run/eval.csv", "table.csv"]  # untouched, nothing half-done
 
 
 @pytest.mark.sumo
