@@ -197,7 +197,11 @@ def bench_ladder(
         states = sorted({s.state for s in statuses})
         return cpu_s() - c0, time.perf_counter() - w0, f"jobs {states}; report {report}"
     # `rank` runs the same pipeline and also writes order_check.json
-    rank_main([str(out / "pipe.yaml"), "--no-live"])
+    try:
+        rank_main([str(out / "pipe.yaml"), "--no-live"])
+    except SystemExit as e:  # rank exits 0 when every job finished, 1 otherwise
+        if e.code not in (0, None):
+            raise
     cpu, wall = cpu_s() - c0, time.perf_counter() - w0
     check = json.loads((out / "runs" / "order_check.json").read_text())
     row = next(c for c in check["cases"] if c["mode"] == "crossplay")

@@ -163,14 +163,13 @@ def _cells_blocks() -> dict[str, tuple[list[str], np.ndarray]]:
 def _run_blocks(study: str, case: str) -> tuple[list[str], np.ndarray, list[int]] | None:
     """A fresh-seed validation run's per-seed cross-play blocks (``runs/verdict``), VUTs in
     the known order; None where the run folders are not here."""
-    from sumo_ayss.crossplay import read_matrix
-    from sumo_ayss.run_folder import find_run_dirs, read_run
+    from sumo_ayss.run_folder import find_run_dirs, read_case_matrix, read_run
 
     folder = PROJECT_ROOT / "runs" / "verdict" / study
     if not (folder / case / "crossplay.csv").is_file():
         return None
     order = json.loads((folder / "order_check.json").read_text())["expected"]
-    m = read_matrix([read_run(d) for d in find_run_dirs([folder / case])])
+    m = read_case_matrix([read_run(d) for d in find_run_dirs([folder / case])])
     by = {s.name: s for s in m.scores("seed")}
     return order, np.array([by[v].array for v in order]), list(by[order[0]].seeds)
 

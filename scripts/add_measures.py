@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from sumo_ayss.agents.weights import load_spcp
 from sumo_ayss.envs import make_env
-from sumo_ayss.evaluate import load_spcp
 from sumo_ayss.run_folder import OUTCOME_SCHEMA, RunRecord, read_run, write_table
 from sumo_ayss.scenarios import rollout
 from sumo_ayss.scenarios.outcome import run_outcome

@@ -40,7 +40,7 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from kill_drill import write_study
-from ray_cluster import ROOT, _unshare, can_hide
+from ray_cluster import ROOT, unshare_argv, can_hide
 from ray_drill import rank_no_run, study_files
 
 INSIDE = "SUMO_AYSS_DISK_DRILL_INSIDE"
@@ -179,7 +179,7 @@ def main(argv: list[str] | None = None) -> int:
         shutil.rmtree(args.work)
     args.work.mkdir(parents=True)
     env = {**os.environ, INSIDE: "1"}
-    argv = [*_unshare(), sys.executable, str(Path(__file__).resolve()), *(argv or sys.argv[1:])]
+    argv = [*unshare_argv(), sys.executable, str(Path(__file__).resolve()), *(argv or sys.argv[1:])]
     return subprocess.run(argv, env=env).returncode
 
 

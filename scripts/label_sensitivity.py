@@ -22,9 +22,9 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
+from sumo_ayss.agents.weights import load_spcp
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import sample_initial_conditions
-from sumo_ayss.evaluate import load_spcp
 from sumo_ayss.run_folder import read_crossplay_json, read_run
 from sumo_ayss.scenarios.preventability import label_crashes
 from sumo_ayss.scenarios.rollout import run_episodes

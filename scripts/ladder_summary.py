@@ -29,9 +29,9 @@ import matplotlib as mpl
 mpl.use("Agg")
 from matplotlib.figure import Figure
 
-from sumo_ayss.report.load import group_runs
 from sumo_ayss.run_folder import (
     StudyFolder,
+    group_runs,
     load_crossplay,
     read_order_check,
     read_ranking_csv,

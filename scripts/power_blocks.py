@@ -21,8 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from sumo_ayss.analysis.stats import student_t_sf
-from sumo_ayss.report.load import group_runs
-from sumo_ayss.run_folder import StudyFolder, load_crossplay, read_order_check, read_run
+from sumo_ayss.run_folder import StudyFolder, group_runs, load_crossplay, read_order_check, read_run
 
 NS = (3, 4, 5, 6, 8, 10)
 REPS = 4000

@@ -69,7 +69,7 @@ def can_hide() -> bool:
     probe.mkdir(exist_ok=True)
     try:
         ok = subprocess.run(
-            [*_unshare(), "sh", "-c", f"mount -t tmpfs -o size=1m tmpfs {probe}"],
+            [*unshare_argv(), "sh", "-c", f"mount -t tmpfs -o size=1m tmpfs {probe}"],
             capture_output=True,
             timeout=20,
         )
@@ -80,7 +80,7 @@ def can_hide() -> bool:
         probe.rmdir()
 
 
-def _unshare() -> list[str]:
+def unshare_argv() -> list[str]:
     user = [] if os.geteuid() == 0 else ["--user", "--map-root-user"]
     return ["unshare", *user, "--mount", "--propagation", "private"]
 
@@ -289,7 +289,7 @@ class Cluster:
         argv = ["bash", "-c", f"exec env {full}"]
         if hide is not None:
             mount = f"mount -t tmpfs -o size=1m tmpfs {shlex.quote(str(hide))}"
-            argv = [*_unshare(), "bash", "-c", f"{mount} && exec env {full}"]
+            argv = [*unshare_argv(), "bash", "-c", f"{mount} && exec env {full}"]
         env = {**os.environ, "HOME": str(home)}
         for key in ("RAY_AUTH_MODE", "RAY_AUTH_TOKEN", "RAY_AUTH_TOKEN_PATH", "RAY_ADDRESS"):
             env.pop(key, None)  # only what the README's command sets

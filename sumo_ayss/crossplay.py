@@ -53,7 +53,7 @@ from sumo_ayss.run_folder import (
     Table,
     case_dir_for,
     is_done,
-    load_crossplay,
+    read_case_matrix,
     read_crossplay_json,
     read_inevitable,
     read_outcome_json,
@@ -130,7 +130,7 @@ def run_case(
         TableError: If a run's outcome table is missing or was run on other scenarios.
         CheckpointError: If a run's configuration or SPCP cannot be read.
     """
-    from sumo_ayss.evaluate import load_spcp
+    from sumo_ayss.agents.weights import load_spcp
     from sumo_ayss.scenarios.crossplay import (
         Opponent,
         check_diagonal,
@@ -250,7 +250,7 @@ def _reference_rows(
     ``earlier``, the case's record, which is written after this file: a kill between the
     two drives a cell again, never keeps a stale one); only the others are driven, and the
     file is written in the order a run over the whole pool writes it."""
-    from sumo_ayss.evaluate import load_spcp
+    from sumo_ayss.agents.weights import load_spcp
     from sumo_ayss.scenarios.crossplay import Opponent, run_crossplay
     from sumo_ayss.scenarios.preventability import reference_config
 
@@ -403,23 +403,6 @@ def _outcome_table(run: RunRecord, n: int, seed: int) -> Table:
     return read_table(folder.outcome_csv, OUTCOME_SCHEMA)
 
 
-def read_matrix(runs: Sequence[RunRecord]) -> Any:
-    """The :class:`~sumo_ayss.analysis.crossplay.CrossplayMatrix` of one case's runs, scored
-    on their harm scale, with its diagonal check (:func:`sumo_ayss.run_folder.
-    load_crossplay`).
-
-    Raises:
-        TableError: If there is no usable table (the message says why).
-    """
-    from sumo_ayss.report.load import group_runs
-
-    groups = group_runs(runs)
-    found = load_crossplay(next(iter(groups.values())))
-    if found.matrix is None:
-        raise TableError(found.missing or f"no cross-play table for {runs[0].path}")
-    return found.matrix
-
-
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(
         prog=prog("python -m sumo_ayss.crossplay"),
@@ -473,7 +456,7 @@ def main(argv: Sequence[str] | None = None) -> None:
                 reference=cfg.evaluate.reference,
                 references=cfg.evaluate.reference_rows,
             )
-            matrix = read_matrix(runs)
+            matrix = read_case_matrix(runs)
             rows, _pairs = rank_crossplay(matrix, blocks=args.blocks)
             print(f"\n{case}: cross-play ranking, safest first (lower harm = safer)")
             for r in rows:

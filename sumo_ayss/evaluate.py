@@ -60,12 +60,12 @@ from sumo_ayss.scenarios.outcome import (
 )
 from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
 from sumo_ayss.scenarios.rollout import Policy
-from sumo_ayss.util.errors import AyssError, CheckpointError
+from sumo_ayss.util.errors import AyssError
 from sumo_ayss.util.paths import portable_path
 from sumo_ayss.vuts.catalog import controller_imports
 from sumo_ayss.vuts.reference_types import REFERENCE_VUTS
 
-__all__ = ["EvaluationResult", "evaluate_run", "load_spcp", "main"]
+__all__ = ["EvaluationResult", "evaluate_run", "main"]
 
 logger = logging.getLogger(__name__)
 
@@ -81,25 +81,6 @@ class EvaluationResult:
     ayss_json: Path
     ran_outcome: bool
     ran_ayss: bool
-
-
-def load_spcp(run: RunRecord, env: PairEnv) -> Policy:
-    """The run's SPCP as a greedy policy, its weights read without unpickling (trust model).
-
-    Raises:
-        CheckpointError: If the run has no ``spcp.zip`` or no readable ``config.yaml``.
-    """
-    from sumo_ayss.agents.weights import load_greedy_policy
-
-    path = run.folder.spcp_zip
-    if not path.is_file():
-        raise CheckpointError(f"{run.path}: no {path.name} (was the SPCP selected?)")
-    return load_greedy_policy(
-        path,
-        run.experiment.agent,
-        env.observation_space,  # type: ignore[arg-type]
-        env.action_space,  # type: ignore[arg-type]
-    )
 
 
 def _header(run: RunRecord) -> StageHeader:
@@ -213,7 +194,7 @@ def evaluate_run(
 
     Args:
         run: The run, as read by :func:`~sumo_ayss.run_folder.read_run` (or its folder,
-            written by :func:`sumo_ayss.train.train`, read here).
+            written by :func:`sumo_ayss.training.trainer.train`, read here).
         n_outcome: Outcome episodes (paper: 200).
         outcome_seed: Seed of the outcome scenario set (same for every compared run).
         ayss: Monte Carlo settings; default :class:`AyssConfig()` (its seed included).
@@ -257,7 +238,11 @@ def _evaluate_run(
     if do_outcome or do_ayss:
         env = make_env(cfg.env, sumo_seed=run.config_seed)
         try:
-            pol = policy if policy is not None else load_spcp(run, env)
+            if policy is None:
+                from sumo_ayss.agents.weights import load_spcp  # torch: only when needed
+
+                policy = load_spcp(run, env)
+            pol = policy
             if do_outcome:
                 outcome = _outcome_stage(env, pol, run, n_outcome, outcome_seed, progress)
             if do_ayss:

@@ -65,8 +65,8 @@ from sumo_ayss.grid.jobs import JobSpec
 from sumo_ayss.grid.local import run_grid_local
 from sumo_ayss.grid.plan import plan_jobs, plan_seed
 from sumo_ayss.grid.progress import JobStatus
-from sumo_ayss.modes import get_mode
-from sumo_ayss.run_folder import RunRecord, StudyFolder, write_pipeline_json
+from sumo_ayss.modes import analyse_cases, check_mode, get_mode
+from sumo_ayss.run_folder import RunRecord, StudyFolder, case_runs, load_runs, write_pipeline_json
 from sumo_ayss.util.errors import AyssError, DiskFullError
 
 if TYPE_CHECKING:
@@ -95,7 +95,7 @@ class PipelineResult(NamedTuple):
         report: The report's ``report.html``, or None when no job finished.
         runs: The finished jobs' run folders, read once
             (:func:`sumo_ayss.run_folder.read_run`), in the order of ``statuses``.
-        analyses: Every case's analysis (:func:`sumo_ayss.report.load.analyse_runs`, paper
+        analyses: Every case's analysis (:func:`sumo_ayss.modes.analyse_cases`, paper
             mode included), computed once; the report's verdicts, and rank's rows.
         cfg: The configuration it ran.
         notes: What it said about the output folder before the jobs ran (a renamed VUT
@@ -191,6 +191,7 @@ def run_pipeline(
     :class:`rich.console.Console` to draw it on, default a new one); job events are logged
     either way.
     """
+    check_mode(cfg.report.mode)
     jobs = plan_jobs(cfg)
     check_out_dir(cfg.out, "out")
     with output_lock(cfg.out):  # one writer per output folder
@@ -237,8 +238,7 @@ def _run_locked(
     if not finished:
         return PipelineResult(statuses, None, [], [], cfg, notes)
     from sumo_ayss.grid.adaptive import is_adaptive, run_adaptive
-    from sumo_ayss.report.document import load_runs, write_report_for
-    from sumo_ayss.report.load import analyse_runs
+    from sumo_ayss.report.document import write_report_for
 
     runs = load_runs(finished)  # read once: cross-play, the report and rank use them
     if get_mode(cfg.report.mode).runs_crossplay:
@@ -249,7 +249,7 @@ def _run_locked(
         )
     write_discriminability(cfg)
     logger.info("report: analysing %d run folders and drawing the figures", len(runs))
-    analyses = analyse_runs(runs, cfg.report)  # once per case: the report's and rank's
+    analyses = analyse_cases(case_runs(runs), cfg.report)  # once per case: the report's and rank's
     report = write_report_for(runs, study.report_dir, analyses=analyses, options=cfg.report)
     return PipelineResult(statuses, report, runs, analyses, cfg, notes)
 
@@ -394,8 +394,9 @@ def add_config_flags(parser: argparse.ArgumentParser) -> None:
 
 
 def config_from_args(args: argparse.Namespace) -> PipelineConfig:
-    """``args.config`` with the flags of :func:`add_config_flags` applied."""
-    return load_pipeline(
+    """``args.config`` with the flags of :func:`add_config_flags` applied, its
+    ``report.mode`` checked against the registered modes."""
+    cfg = load_pipeline(
         args.config,
         out=args.out,
         workers=args.workers,
@@ -407,6 +408,8 @@ def config_from_args(args: argparse.Namespace) -> PipelineConfig:
         n_ayss=args.n_ayss,
         max_seeds=args.max_seeds,
     )
+    check_mode(cfg.report.mode)
+    return cfg
 
 
 def main(argv: Sequence[str] | None = None) -> None:

@@ -41,7 +41,15 @@ from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.seeds import kendall_tau
-from sumo_ayss.modes import Mode, get_mode, missing_rows_line, mode_names, registered_modes
+from sumo_ayss.modes import (
+    Mode,
+    analyse_cases,
+    check_mode,
+    get_mode,
+    missing_rows_line,
+    mode_names,
+    registered_modes,
+)
 from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.run_folder import (
     OUTCOME_JSON,
@@ -49,6 +57,7 @@ from sumo_ayss.run_folder import (
     OrderChecks,
     RunRecord,
     StudyFolder,
+    case_runs,
     read_run,
     write_order_check,
     write_ranking_csv,
@@ -74,7 +83,7 @@ def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> l
     """The analysis of every case among ``run_dirs``, for ranking without the pipeline.
 
     Each run folder is read once (:func:`sumo_ayss.run_folder.read_run`) and each case
-    analysed once (:func:`sumo_ayss.report.load.analyse_runs`); the AYSS bootstrap runs in
+    analysed once (:func:`sumo_ayss.modes.analyse_cases`); the AYSS bootstrap runs in
     paper mode only.
     """
     return analyse_loaded([read_run(d) for d in run_dirs], options)
@@ -85,11 +94,11 @@ def analyse_loaded(
 ) -> list[CaseAnalysis]:
     """:func:`analyse` of runs already loaded."""
     from sumo_ayss.config.report import ReportOptions
-    from sumo_ayss.report.load import analyse_runs
 
     options = options or ReportOptions()
     # The AYSS bootstrap only where the mode ranks by the safety index.
-    return analyse_runs(runs, options, paper=get_mode(options.mode).needs_safety_index)
+    paper = check_mode(options.mode).needs_safety_index
+    return analyse_cases(case_runs(runs), options, paper=paper)
 
 
 def available_modes(a: CaseAnalysis) -> list[str]:

@@ -41,7 +41,7 @@ What is compared, and where the worlds legitimately differ:
   it everywhere else);
 * up to the decision during which highway-env's speed first goes negative: highway-env
   lets an IDM car at standstill too close to its leader back away (down to −40 m/s); a
-  SUMO vehicle cannot, ours stops at 0 (documented in :mod:`sumo_ayss.hwenv_laws`). Over
+  SUMO vehicle cannot, ours stops at 0 (documented in :mod:`sumo_ayss.laws.hwenv`). Over
   the paper's ODD (speeds 0-40 m/s) with these random POV commands that happens in a few
   of the 50 episodes (measured: car-following 0 (pi1) / 1 (pi2), cut-in 0 / 1); those are
   compared up to it and counted (at most ``MAX_REVERSALS``), and collisions are compared

@@ -6,12 +6,14 @@ when ``y`` is a module, else ``a -> sumo_ayss.x``; importing a submodule also ru
 packages' ``__init__``, counted as edges too, except a module's own ancestor packages: their
 ``__init__`` is already running when the module is, and Python resolves a sibling import
 through ``sys.modules`` without it). *Module-level* edges are the imports run when
-``a`` is imported (top level, incl. ``if``/``try`` blocks, but not ``if TYPE_CHECKING:``);
-*function-level* edges are imports inside a function or method body, run when it is called.
+``a`` is imported (top level, incl. ``if``/``try`` blocks) and the type-only imports
+(``if TYPE_CHECKING:``): a type named across layers is a dependency too, even if Python never
+runs it; *function-level* edges are imports inside a function or method body, run when it is
+called.
 
 An import circle is a strongly connected component of more than one module. Module-level
-circles must not exist; function-level ones (a lazy import that closes a loop) are reported
-by ``python tests/test_layers.py``.
+circles (type-only imports counted) must not exist; function-level ones (a lazy import that
+closes a loop) are reported by ``python tests/test_layers.py``.
 
 Run as a script it prints the circles of both kinds and the largest modules.
 """
@@ -28,18 +30,28 @@ ROOT = Path(__file__).resolve().parents[1] / PACKAGE
 #: The largest module allowed [lines].
 MAX_MODULE_LINES = 500
 #: What :mod:`sumo_ayss.analysis` may import from the package besides itself: the error
-#: tree, range checks, the case records and the ranking modes. It reads no file (no
-#: run_folder, report or config) and runs nothing (no sim, envs or agents): the run records
-#: (:func:`sumo_ayss.run_folder.read_run`) and the cross-play table
-#: (:func:`sumo_ayss.run_folder.load_crossplay`) are read outside and handed to it. The
-#: ranking modes (:mod:`sumo_ayss.modes`) are held to the same rule, so that analysis stays
-#: pure through them.
+#: tree, range checks, the registry type and the case records. It reads no file (no
+#: run_folder, report or config), runs nothing (no sim, envs or agents) and knows no ranking
+#: mode: the run records (:func:`sumo_ayss.run_folder.read_run`, typed by analysis's own
+#: :class:`~sumo_ayss.analysis.case.RunLike`) and the cross-play table
+#: (:func:`sumo_ayss.run_folder.load_crossplay`) are read outside and handed to it, and the
+#: modes (:mod:`sumo_ayss.modes`) sit above it.
 ANALYSIS_MAY_IMPORT = (
     "sumo_ayss.analysis",
     "sumo_ayss.util.errors",
     "sumo_ayss.util.validation",
+    "sumo_ayss.util.registry",
     "sumo_ayss.cases",
-    "sumo_ayss.modes",
+)
+#: What :mod:`sumo_ayss.modes` may import: what analysis may, and analysis itself; held to
+#: the same purity (no file, no loader), so that a mode computes and words from data only.
+MODES_MAY_IMPORT = (*ANALYSIS_MAY_IMPORT, "sumo_ayss.modes")
+#: Pairs of layers with no import edge of any kind (module, function or type-only level):
+#: the configuration is below the ranking modes, the analysis below the modes and the files.
+NO_IMPORTS = (
+    ("sumo_ayss.config", "sumo_ayss.modes"),
+    ("sumo_ayss.analysis", "sumo_ayss.modes"),
+    ("sumo_ayss.analysis", "sumo_ayss.run_folder"),
 )
 #: Packages whose ``__init__`` is a docstring: importing one of their modules runs nothing
 #: else of them (checked below), so the package edge itself carries no import.
@@ -79,12 +91,6 @@ def module_files() -> dict[str, Path]:
     return out
 
 
-def _is_type_checking(test: ast.expr) -> bool:
-    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
-        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING"
-    )
-
-
 def _imports(body: list[ast.stmt], in_function: bool) -> Iterator[tuple[ast.stmt, bool]]:
     """Every import statement under ``body`` with whether it runs inside a function."""
     for node in body:
@@ -92,9 +98,7 @@ def _imports(body: list[ast.stmt], in_function: bool) -> Iterator[tuple[ast.stmt
             yield node, in_function
         elif isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
             yield from _imports(node.body, True)
-        elif isinstance(node, ast.If) and _is_type_checking(node.test):
-            continue  # annotations only: never run
-        else:
+        else:  # incl. ``if TYPE_CHECKING:``: a type-only import is a dependency too
             for field in ("body", "orelse", "finalbody", "handlers", "cases"):
                 children = getattr(node, field, None)
                 if isinstance(children, list):
@@ -189,6 +193,7 @@ def module_lines() -> dict[str, int]:
 
 
 def test_no_module_level_import_circles() -> None:
+    """Type-only (``if TYPE_CHECKING:``) imports counted."""
     modules = module_files()
     top, _ = import_edges(modules)
     assert circles(set(modules), top) == []
@@ -199,17 +204,19 @@ def _within(name: str, prefixes: tuple[str, ...]) -> bool:
 
 
 def test_analysis_imports_no_loader_and_reads_no_file() -> None:
-    """analysis/ (and modes/, which it calls) is pure: it imports nothing from run_folder,
-    report, config or the stages, at module or function level, and calls no file reader or
-    writer."""
+    """analysis/ (and modes/, above it) is pure: it imports nothing from run_folder, report,
+    config or the stages, at module, function or type-only level, and calls no file reader or
+    writer; analysis imports no mode."""
     modules = module_files()
     assert "sumo_ayss.analysis.case" in modules
     top, lazy = import_edges(modules)
     outside = sorted(
         (a, b)
         for a, b in top | lazy
-        if _within(a, ("sumo_ayss.analysis", "sumo_ayss.modes"))
-        and not _within(b, ANALYSIS_MAY_IMPORT)
+        if (
+            (_within(a, ("sumo_ayss.analysis",)) and not _within(b, ANALYSIS_MAY_IMPORT))
+            or (_within(a, ("sumo_ayss.modes",)) and not _within(b, MODES_MAY_IMPORT))
+        )
         and b not in PACKAGES_WITHOUT_CODE
     )
     assert outside == []
@@ -226,6 +233,18 @@ def test_analysis_imports_no_loader_and_reads_no_file() -> None:
     assert calls == []
 
 
+def test_layers_that_must_not_import_each_other() -> None:
+    modules = module_files()
+    top, lazy = import_edges(modules)
+    found = sorted(
+        (a, b)
+        for a, b in top | lazy
+        for low, high in NO_IMPORTS
+        if _within(a, (low,)) and _within(b, (high,))
+    )
+    assert found == []
+
+
 def test_packages_counted_as_without_code_hold_only_a_docstring() -> None:
     for package in PACKAGES_WITHOUT_CODE:
         path = ROOT.parent / package.replace(".", "/") / "__init__.py"
@@ -238,6 +257,31 @@ def test_the_analysis_rule_catches_a_loader_import() -> None:
     assert not _within("sumo_ayss.run_folder", ANALYSIS_MAY_IMPORT)
     assert not _within("sumo_ayss.report.load", ANALYSIS_MAY_IMPORT)
     assert _within("sumo_ayss.cases.cut_in", ANALYSIS_MAY_IMPORT)
+    assert not _within("sumo_ayss.modes.crossplay", ANALYSIS_MAY_IMPORT)
+    assert _within("sumo_ayss.analysis.case", MODES_MAY_IMPORT)
+
+
+def private_imports(modules: dict[str, Path]) -> list[str]:
+    """``module: from other import _name`` for every private name imported from another
+    module of the package (a helper two modules share belongs in a module of its own)."""
+    found = []
+    for name, path in modules.items():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(PACKAGE):
+                for alias in node.names:
+                    if alias.name.startswith("_") and not alias.name.startswith("__"):
+                        found.append(f"{name}: from {node.module} import {alias.name}")
+    return found
+
+
+def test_no_module_imports_a_private_name_of_another() -> None:
+    assert private_imports(module_files()) == []
+
+
+def test_the_private_import_rule_sees_one(tmp_path: Path) -> None:
+    path = tmp_path / "x.py"
+    path.write_text(f"from {PACKAGE}.replay.record import _row, Kind\n")
+    assert private_imports({"x": path}) == [f"x: from {PACKAGE}.replay.record import _row"]
 
 
 def modules_over_limit() -> dict[str, int]:
@@ -259,8 +303,9 @@ def test_no_module_over_500_lines() -> None:
 
 
 def test_the_walker_sees_circles_and_tells_lazy_imports(tmp_path: Path) -> None:
-    """The walker itself, on a hand-made package: a module-level circle, a lazy one, and a
-    sibling import through the package's ``__init__`` (not a circle)."""
+    """The walker itself, on a hand-made package: a module-level circle, a lazy one, a
+    type-only import (counted as module-level), and a sibling import through the package's
+    ``__init__`` (not a circle)."""
     pkg = tmp_path / "p"
     pkg.mkdir()
     files = {
@@ -275,7 +320,7 @@ def test_the_walker_sees_circles_and_tells_lazy_imports(tmp_path: Path) -> None:
         (pkg / name).write_text(text)
     modules = {"p": pkg / "__init__.py"} | {f"p.{n[:-3]}": pkg / n for n in files if n[0] != "_"}
     top, lazy = import_edges(modules)
-    assert top == {("p", "p.a"), ("p.a", "p.b"), ("p.b", "p.a"), ("p.d", "p.c")}
+    assert top == {("p", "p.a"), ("p.a", "p.b"), ("p.b", "p.a"), ("p.d", "p.c"), ("p.d", "p.a")}
     assert lazy == {("p.c", "p.d")}
     assert circles(set(modules), top) == [["p.a", "p.b"]]
     assert circles(set(modules), top | lazy) == [["p.a", "p.b"], ["p.c", "p.d"]]

@@ -219,10 +219,7 @@ def test_jobs_carry_the_config_parsed_once_and_it_pickles(
     ("extra", "match"),
     [
         ({"expected_order": ["pi1"]}, r"expected_order must list exactly the grid's VUTs"),
-        (
-            {"report": {"mode": "fancy"}},
-            r"report\.mode must be one of \['crossplay', 'exposure', 'paper'\]",
-        ),
+        ({"report": {"mode": "Fancy"}}, r"report\.mode must be a mode's name"),
         (
             {"report": {"crossplay_blocks": "seeds"}},
             r"report\.crossplay_blocks must be one of \['seed', 'opponent'\], got 'seeds'",
@@ -245,6 +242,22 @@ def test_jobs_carry_the_config_parsed_once_and_it_pickles(
 def test_bad_pipeline_sections_are_refused(tmp_path: Path, extra: dict, match: str) -> None:
     with pytest.raises(ConfigError, match=match):
         load_pipeline(write_configs(tmp_path, [0], **extra))
+
+
+def test_an_unregistered_mode_is_refused_when_the_stage_reads_the_config(tmp_path: Path) -> None:
+    """The configuration imports no mode; ``pipeline`` and ``rank`` check ``report.mode``
+    against the registry as they read their YAML (:func:`sumo_ayss.pipeline.config_from_args`)."""
+    import argparse
+
+    from sumo_ayss.pipeline import add_config_flags, config_from_args
+
+    path = write_configs(tmp_path, [0], report={"mode": "fancy"})
+    assert load_pipeline(path).report.mode == "fancy"
+    parser = argparse.ArgumentParser()
+    parser.add_argument("config", type=Path)
+    add_config_flags(parser)
+    with pytest.raises(ConfigError, match=r"report\.mode must be one of \['crossplay', 'exp"):
+        config_from_args(parser.parse_args([str(path)]))
 
 
 @pytest.mark.sumo

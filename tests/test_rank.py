@@ -89,8 +89,8 @@ def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, mon
     table once and analyses each case once (one bootstrap per VUT) for its report, and rank
     ranks those analyses; the rows equal ``--no-run``'s, which also computes once."""
     import sumo_ayss.analysis.case as case_mod
+    import sumo_ayss.modes.analyse as analyse_mod
     import sumo_ayss.pipeline as pipeline_mod
-    import sumo_ayss.report.load as load_mod
     import sumo_ayss.run_folder.crossplay as crossplay_mod
     import sumo_ayss.run_folder.record as record_mod
     from sumo_ayss.grid.progress import JobStatus
@@ -133,7 +133,7 @@ def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, mon
         counted("bootstrap", case_mod.vut_safety_index, lambda runs, *a: runs[0].vut),
     )
     monkeypatch.setattr(
-        load_mod, "analyse_case", counted("case", load_mod.analyse_case, lambda c, *a, **k: c)
+        analyse_mod, "analyse_case", counted("case", analyse_mod.analyse_case, lambda c, *a, **k: c)
     )
     with pytest.raises(SystemExit) as done:
         main([str(pipe), "--no-live", "--mode", "paper"])
@@ -160,11 +160,12 @@ def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, mon
 def test_paper_rows_only_in_paper_mode_even_from_the_pipelines_analyses(tmp_path, monkeypatch):
     """The pipeline's analyses carry the paper mode (its report shows it); rank lists paper
     rows in paper mode only, as ``--no-run`` (which skips the bootstrap otherwise) does."""
-    from sumo_ayss.report.load import analyse_runs
+    from sumo_ayss.modes import analyse_cases
+    from sumo_ayss.run_folder import case_runs
 
     dirs = _three_vuts(tmp_path, monkeypatch)
     options = ReportOptions(mode="exposure", n_boot=200)
-    full = analyse_runs([read_run(d) for d in dirs], options)  # paper mode computed
+    full = analyse_cases(case_runs([read_run(d) for d in dirs]), options)  # paper mode computed
     assert full[0].ranking
     assert ranking_rows(full) == ranking_rows(analyse(dirs, options))
     assert {r["mode"] for r in ranking_rows(full)} == {"exposure"}

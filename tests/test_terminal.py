@@ -128,8 +128,8 @@ def test_eta_names_every_stage_after_the_grid() -> None:
 
 
 def test_leaderboard_with_one_seed_says_there_is_no_test(tmp_path, monkeypatch) -> None:
-    from sumo_ayss.analysis.case import analyse_case
     from sumo_ayss.config.report import ReportOptions
+    from sumo_ayss.modes import analyse_case
     from sumo_ayss.report.leaderboard import leaderboard_rows
     from sumo_ayss.run_folder import read_run
     from tests.report.test_report import make_run

@@ -13,7 +13,9 @@ import io
 import zipfile
 from pathlib import Path
 from types import SimpleNamespace
+from typing import Any, Protocol
 
+import gymnasium as gym
 import torch as th
 from gymnasium import spaces
 from stable_baselines3.common.torch_layers import FlattenExtractor
@@ -95,3 +97,48 @@ def load_greedy_policy(
             f"in config.yaml): {str(e).splitlines()[0]}"
         ) from e
     return GreedyPolicy(SimpleNamespace(q_net=net, device=th.device("cpu")))  # type: ignore[arg-type]
+
+
+class _SpcpFiles(Protocol):
+    @property
+    def spcp_zip(self) -> Path: ...
+
+
+class _LearnerSettings(Protocol):
+    @property
+    def agent(self) -> DQNHyperParams: ...
+
+
+class SpcpRun(Protocol):
+    """What loading a run's SPCP asks of the run (a :class:`~sumo_ayss.run_folder.RunRecord`:
+    its folder, the ``spcp.zip`` in it and the learner settings of its ``config.yaml``)."""
+
+    @property
+    def path(self) -> Path: ...
+
+    @property
+    def folder(self) -> _SpcpFiles: ...
+
+    @property
+    def experiment(self) -> _LearnerSettings: ...
+
+
+def load_spcp(run: SpcpRun, env: gym.Env[Any, Any]) -> GreedyPolicy:
+    """The run's SPCP as a greedy policy, its weights read without unpickling (trust model).
+
+    Args:
+        run: The run whose ``spcp.zip`` is loaded.
+        env: An env of the run's case (its spaces set the network's input and output).
+
+    Raises:
+        CheckpointError: If the run has no ``spcp.zip`` or no readable ``config.yaml``.
+    """
+    path = run.folder.spcp_zip
+    if not path.is_file():
+        raise CheckpointError(f"{run.path}: no {path.name} (was the SPCP selected?)")
+    return load_greedy_policy(
+        path,
+        run.experiment.agent,
+        env.observation_space,  # type: ignore[arg-type]
+        env.action_space,  # type: ignore[arg-type]
+    )

@@ -1,15 +1,16 @@
 """Statistics of one case: safety indices, rankings and verdicts per mode.
 
-:func:`analyse_case` turns the runs of one case (any objects shaped like
-:class:`sumo_ayss.run_folder.RunRecord`) into a :class:`CaseAnalysis`: the paper mode (AYSS
+:func:`analyse_case` turns the runs of one case (any objects shaped like :class:`RunLike`,
+e.g. :class:`sumo_ayss.run_folder.RunRecord`) into a :class:`CaseAnalysis`: the paper mode (AYSS
 safety index per VUT, hierarchical bootstrap, pairwise verdicts under
 :func:`~.significance.pair_verdict`), the exposure mode (seed-level ranking of the mean harm
 per episode of each VUT's own SPCPs, :mod:`.harm`), the cross-play mode (the case's
 cross-play matrix, which its loader read from ``crossplay.csv``, :mod:`.crossplay`) and the
-premise check, and the verdict of the mode asked for as a record
-(:class:`~.case_verdict.CaseVerdict`). Both the report and :mod:`sumo_ayss.rank` read it
-(the modes word its verdicts); the pipeline analyses each case once and hands the analysis
-to both. Nothing here reads a file, draws, renders or words a verdict.
+premise check; the verdict of the mode asked for (a :class:`~.case_verdict.CaseVerdict`)
+is the mode's to give (:func:`sumo_ayss.modes.analyse_case` runs this and asks it). Both the
+report and :mod:`sumo_ayss.rank` read it (the modes word its verdicts); the pipeline analyses
+each case once and hands the analysis to both. Nothing here reads a file, draws, renders or
+words a verdict, and nothing here imports the run folders or the modes.
 """
 
 from __future__ import annotations
@@ -19,9 +20,10 @@ import zlib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol, TypeAlias
+from typing import Generic, Protocol, TypeVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from sumo_ayss.analysis.case_verdict import CaseVerdict, paper_verdict
 from sumo_ayss.analysis.crossplay import (
@@ -30,7 +32,7 @@ from sumo_ayss.analysis.crossplay import (
     CrossplayMatrix,
     rank_crossplay,
 )
-from sumo_ayss.analysis.harm import HARM_RANGE, VutOutcome, vut_outcomes
+from sumo_ayss.analysis.harm import HARM_RANGE, EpisodeStats, VutOutcome, vut_outcomes
 from sumo_ayss.analysis.premise import Premise, premise_check
 from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex, rank, safety_index
 from sumo_ayss.analysis.reference import (
@@ -42,20 +44,26 @@ from sumo_ayss.analysis.reference import (
 from sumo_ayss.analysis.seeds import SeedComparison, SeedRankRow, SeedScores, rank_seeds
 from sumo_ayss.analysis.significance import PairVerdict, family_adjusted, pair_verdict
 from sumo_ayss.cases import Case, case_info
-from sumo_ayss.modes import CROSSPLAY, EXPOSURE, PAPER, get_mode
 from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
+    "CROSSPLAY_MODE",
+    "EXPOSURE_MODE",
+    "PAPER_MODE",
     "CaseAnalysis",
     "CaseOptions",
     "CaseVerdict",
+    "RunLike",
     "analyse_case",
     "run_label",
     "vut_safety_index",
 ]
 
-if TYPE_CHECKING:
-    from sumo_ayss.run_folder import RunRecord
+#: The built-in ranking modes' names (:mod:`sumo_ayss.modes` registers them under these):
+#: the keys of :attr:`CaseAnalysis.outcomes` and the ``mode`` of the records computed here.
+CROSSPLAY_MODE = "crossplay"
+EXPOSURE_MODE = "exposure"
+PAPER_MODE = "paper"
 
 logger = logging.getLogger(__name__)
 
@@ -94,14 +102,67 @@ class CaseOptions(Protocol):
     def premise_tolerances(self) -> Mapping[str, float]: ...
 
 
-Run: TypeAlias = "RunRecord"
-"""A run as :func:`sumo_ayss.run_folder.read_run` returns it (read by attribute: ``case``,
-``vut``, ``seed``, ``problems``, ``ayss`` with ``indicator`` and ``h``, ``outcome`` with
-``mean_return``, ``crash_rate`` and ``mean_final_headway_m`` estimates, ``episodes``). Only
-a type: analysis imports no file reader (the loader hands it the records)."""
+class _Estimate(Protocol):
+    @property
+    def value(self) -> float: ...
 
 
-def run_label(run: Run) -> str:
+class OutcomeLike(Protocol):
+    """A run's outcome summary, as far as the premise check reads it."""
+
+    @property
+    def mean_return(self) -> _Estimate: ...
+
+    @property
+    def crash_rate(self) -> _Estimate: ...
+
+    @property
+    def mean_final_headway_m(self) -> _Estimate: ...
+
+
+class AyssLike(Protocol):
+    """A run's AYSS samples: the indicator and the headway [m] of each."""
+
+    @property
+    def h(self) -> NDArray[np.float64]: ...
+
+    @property
+    def indicator(self) -> NDArray[np.float64]: ...
+
+    def __len__(self) -> int: ...
+
+
+class RunLike(Protocol):
+    """What the analysis reads of a run (:class:`sumo_ayss.run_folder.RunRecord` is one, as
+    :func:`sumo_ayss.run_folder.read_run` returns it): analysis imports no file reader, the
+    loader hands it the records."""
+
+    @property
+    def case(self) -> str: ...
+
+    @property
+    def vut(self) -> str: ...
+
+    @property
+    def seed(self) -> int | None: ...
+
+    @property
+    def problems(self) -> Sequence[str]: ...
+
+    @property
+    def ayss(self) -> AyssLike | None: ...
+
+    @property
+    def outcome(self) -> OutcomeLike | None: ...
+
+    @property
+    def episodes(self) -> EpisodeStats | None: ...
+
+
+R = TypeVar("R", bound=RunLike)
+
+
+def run_label(run: RunLike) -> str:
     """``"<case>/<vut>/seed_<k>"`` of a run, for problem lists."""
     return f"{run.case}/{run.vut}/seed_{run.seed if run.seed is not None else '?'}"
 
@@ -112,7 +173,7 @@ def _vut_rng(options: CaseOptions, case: str, vut: str) -> np.random.Generator:
 
 
 def vut_safety_index(
-    runs: Sequence[Run], options: CaseOptions, rng: np.random.Generator | int | None = None
+    runs: Sequence[RunLike], options: CaseOptions, rng: np.random.Generator | int | None = None
 ) -> SafetyIndex | None:
     """Safety index of one VUT from the AYSS samples of its runs (one seed per run).
 
@@ -143,8 +204,8 @@ def vut_safety_index(
 
 
 @dataclass
-class CaseAnalysis:
-    """Statistics of one case.
+class CaseAnalysis(Generic[R]):
+    """Statistics of one case (of runs of type ``R``, e.g. a run folder's record).
 
     Attributes:
         case: Case name.
@@ -182,14 +243,14 @@ class CaseAnalysis:
 
     case: str
     info: Case
-    runs: dict[str, list[Run]]
+    runs: dict[str, list[R]]
     indices: dict[str, SafetyIndex] = field(default_factory=dict)
     ranking: list[RankedVut] = field(default_factory=list)
     pairs: list[PairVerdict] = field(default_factory=list)
-    verdict: CaseVerdict = field(default_factory=lambda: CaseVerdict(EXPOSURE.name, "warning"))
-    paper_verdict: CaseVerdict = field(default_factory=lambda: CaseVerdict(PAPER.name, "warning"))
+    verdict: CaseVerdict = field(default_factory=lambda: CaseVerdict(EXPOSURE_MODE, "warning"))
+    paper_verdict: CaseVerdict = field(default_factory=lambda: CaseVerdict(PAPER_MODE, "warning"))
     problems: list[str] = field(default_factory=list)
-    mode: str = EXPOSURE.name
+    mode: str = EXPOSURE_MODE
     exposure_rows: list[SeedRankRow] = field(default_factory=list)
     exposure_pairs: list[SeedComparison] = field(default_factory=list)
     exposure_scores: dict[str, dict[int, float]] = field(default_factory=dict)
@@ -212,7 +273,7 @@ class CaseAnalysis:
         return self.verdict.mode
 
 
-def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
+def _exposure(out: CaseAnalysis[R], options: CaseOptions) -> None:
     """Exposure-mode ranking (each VUT's own SPCPs: mean harm of their outcome episodes,
     per seed) and the premise check, from the runs' outcome tables and summaries."""
     scores = []
@@ -232,7 +293,7 @@ def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
             out.problems.append(f"{vut}: no outcome table with a seed, so no exposure")
     out.exposure_scores = {sc.name: dict(sc.values) for sc in scores}
     if counts:
-        out.outcomes[EXPOSURE.name] = vut_outcomes(counts, options.level)
+        out.outcomes[EXPOSURE_MODE] = vut_outcomes(counts, options.level)
     if scores:
         out.exposure_rows, out.exposure_pairs = rank_seeds(
             scores,
@@ -255,7 +316,7 @@ def _exposure(out: CaseAnalysis, options: CaseOptions) -> None:
     out.premise = premise_check(metrics, tolerances=options.premise_tolerances, level=options.level)
 
 
-def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -> None:
+def _crossplay(out: CaseAnalysis[R], options: CaseOptions, found: CrossplayInput) -> None:
     """Cross-play ranking from the case's cross-play table as its loader found it, or why
     there is none; a table not of exactly these VUTs and runs is not used."""
     out.crossplay_blocks = options.crossplay_blocks
@@ -290,7 +351,7 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -
         return
     out.crossplay, out.crossplay_path = m, found.path
     out.crossplay_diagonal = found.diagonal
-    out.outcomes[CROSSPLAY.name] = vut_outcomes(
+    out.outcomes[CROSSPLAY_MODE] = vut_outcomes(
         {v: (*m.crashes(v), m.vut_mobility(v)) for v in m.vuts}, options.level
     )
     out.crossplay_rows, out.crossplay_pairs = rank_crossplay(
@@ -315,13 +376,14 @@ def _crossplay(out: CaseAnalysis, options: CaseOptions, found: CrossplayInput) -
 
 def analyse_case(
     case: str,
-    runs: dict[str, list[Run]],
+    runs: dict[str, list[R]],
     options: CaseOptions,
     *,
     crossplay: CrossplayInput | None = None,
     paper: bool = True,
-) -> CaseAnalysis:
-    """Safety index per VUT, ranking, pairwise verdicts and the verdict of one case.
+) -> CaseAnalysis[R]:
+    """Safety index per VUT, ranking and pairwise verdicts of every mode of one case; its
+    ``verdict`` is left to the mode asked for (:func:`sumo_ayss.modes.analyse_case`).
 
     Args:
         case: Case name.
@@ -336,7 +398,7 @@ def analyse_case(
         The :class:`CaseAnalysis`.
     """
     info = case_info(case)
-    out = CaseAnalysis(case=case, info=info, runs=runs)
+    out: CaseAnalysis[R] = CaseAnalysis(case=case, info=info, runs=runs)
     for members in runs.values():
         for run in members:
             out.problems += [f"{run_label(run)}: {p}" for p in run.problems]
@@ -370,8 +432,7 @@ def analyse_case(
     out.pairs = family_adjusted(out.pairs, order)
     _exposure(out, options)
     premise_met = out.premise is None or not out.premise.metrics or out.premise.met
-    out.paper_verdict = paper_verdict(PAPER.name, out.ranking, out.pairs, premise_met=premise_met)
+    out.paper_verdict = paper_verdict(PAPER_MODE, out.ranking, out.pairs, premise_met=premise_met)
     _crossplay(out, options, crossplay or CrossplayInput())
     out.mode = options.mode
-    out.verdict = get_mode(options.mode).verdict(out)
     return out

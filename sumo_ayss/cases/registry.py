@@ -1,6 +1,7 @@
 """The case record, its registry and the naming records it holds (see :mod:`sumo_ayss.cases`).
 
-Standard library, :mod:`sumo_ayss.util.errors` and :mod:`sumo_ayss.util.validation` only.
+Standard library and :mod:`sumo_ayss.util` only (the registry: :class:`~sumo_ayss.util.
+registry.Registry`, shared with the ranking modes).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.util.registry import Registry
 from sumo_ayss.util.validation import require, suggest
 
 __all__ = [
@@ -214,7 +216,7 @@ def _resolve(case: Case, attr: str) -> Any:
 
 # --------------------------------------------------------------------------- the registry
 
-_REGISTRY: dict[str, Case] = {}
+_REGISTRY: Registry[Case] = Registry("case")
 
 
 def register_case(case: Case, *, replace: bool = False) -> Case:
@@ -227,23 +229,19 @@ def register_case(case: Case, *, replace: bool = False) -> Case:
         ConfigError: If the name is taken by another record, or its indicator column is
             another case's.
     """
-    old = _REGISTRY.get(case.name)
-    require(
-        old is None or old == case or replace,
-        f"case {case.name!r} is already registered (pass replace=True to replace it)",
-    )
+    if case.name in _REGISTRY and not replace:
+        _REGISTRY.register(case.name, case)  # raises unless it is the same record
     other = case_of_indicator(case.indicator_column) if case.indicator_column else None
     require(
         other in (None, case.name),
         f"case {case.name!r}: indicator column {case.indicator_column!r} is case {other!r}'s",
     )
-    _REGISTRY[case.name] = case
-    return case
+    return _REGISTRY.register(case.name, case, replace=replace)
 
 
 def unregister_case(name: str) -> Case:
     """Remove a registered case and return it (tests register toy cases and remove them)."""
-    return _REGISTRY.pop(get_case(name).name)
+    return _REGISTRY.unregister(name)
 
 
 def get_case(name: str) -> Case:
@@ -252,37 +250,33 @@ def get_case(name: str) -> Case:
     Raises:
         ConfigError: If no case of that name is registered; the message lists them.
     """
-    case = _REGISTRY.get(name) if isinstance(name, str) else None
-    if case is None:
-        names = case_names()
-        hint = suggest(name, names) if isinstance(name, str) else ""
-        raise ConfigError(f"unknown case {name!r}{hint}; allowed: {list(names)}")
-    return case
+    return _REGISTRY.get(name)
 
 
 def case_names() -> tuple[str, ...]:
     """Names of the registered cases, in registration order."""
-    return tuple(_REGISTRY)
+    return _REGISTRY.names()
 
 
 def registered_cases() -> tuple[Case, ...]:
     """The registered cases, in registration order."""
-    return tuple(_REGISTRY.values())
+    return _REGISTRY.records()
 
 
 def case_info(name: str) -> Case:
     """The registered case ``name``, else a generic description (for reading run folders of
     an unknown case without failing)."""
-    if name in _REGISTRY:
-        return _REGISTRY[name]
+    case = _REGISTRY.find(name)
+    if case is not None:
+        return case
     return Case(name=name if _NAME.fullmatch(name) else "unknown", title=name)
 
 
 def indicator_columns() -> tuple[str, ...]:
     """The AYSS indicator columns (``ayss.csv``'s ``indicator_name``) of the registered cases."""
-    return tuple(c.indicator_column for c in _REGISTRY.values() if c.indicator_column)
+    return tuple(c.indicator_column for c in _REGISTRY if c.indicator_column)
 
 
 def case_of_indicator(column: str) -> str | None:
     """The case whose AYSS rows carry ``indicator_name == column``, or None."""
-    return next((c.name for c in _REGISTRY.values() if c.indicator_column == column), None)
+    return next((c.name for c in _REGISTRY if c.indicator_column == column), None)

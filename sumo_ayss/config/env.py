@@ -107,7 +107,7 @@ class ActuatorConfig:
     ``env.sim.lanechange_duration_s``).
 
     ``mode: highway_env``: highway-env 1.8.2's ControlledVehicle (the paper's POV,
-    :mod:`sumo_ayss.hwenv_laws`): ``a = (v_target - v) / time_constant_s`` **unclipped**,
+    :mod:`sumo_ayss.laws.hwenv`): ``a = (v_target - v) / time_constant_s`` **unclipped**,
     re-evaluated at each of ``substeps`` explicit-Euler sub-steps per SUMO step (3 per
     0.2 s = highway-env's 15 Hz), and its lane-centring steering loop on a kinematic
     bicycle for the cut-in (the lateral speed rises and decays smoothly, so Δv̄ depends

@@ -46,7 +46,8 @@ class TrainConfig:
     """Torch device of the learner: ``"cpu"`` or ``"cuda"`` (``"cuda:<index>"`` for one GPU of
     several). SUMO, the replay buffer's storage and candidate evaluation stay on the CPU; the
     networks, the minibatches and the gradient steps run on ``device``. A CUDA device that
-    torch cannot see fails the run at its start (:func:`sumo_ayss.train.check_device`)."""
+    torch cannot see fails the run at its start
+    (:func:`sumo_ayss.training.trainer.check_device`)."""
     n_envs: int = 1
     """VUT-POV pairs collecting transitions side by side. 1: one env (SB3 ``DummyVecEnv``);
     > 1: that many pairs in the process's one SUMO simulation

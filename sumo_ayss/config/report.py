@@ -5,16 +5,22 @@ others (no heavy imports); the report and the leaderboard read it from here."""
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Literal
 
-from sumo_ayss.modes import DEFAULT_MODE, mode_names
 from sumo_ayss.util.validation import check_choice, check_int, check_number, require
 
 if TYPE_CHECKING:
     import numpy as np
 
 __all__ = ["CROSSPLAY_BLOCKS", "DEFAULT_MODE", "ReportOptions"]
+
+#: The mode of a report and a ranking unless ``report.mode`` says otherwise (a registered
+#: mode's name, :data:`sumo_ayss.modes.DEFAULT_MODE`; the configuration imports no mode).
+DEFAULT_MODE = "crossplay"
+
+_MODE_NAME = re.compile(r"[a-z][a-z0-9_]*")
 
 
 # --------------------------------------------------------------------------- options
@@ -37,8 +43,9 @@ class ReportOptions:
         rng_seed: Root seed of the bootstraps; each (case, VUT) gets its own stream.
         mode: Which ranking mode gives the verdicts and the ranking, one of the registered
             modes (:mod:`sumo_ayss.modes`: ``"crossplay"``, the default, ``"exposure"`` or
-            ``"paper"``). Every mode available is computed and shown; cross-play needs the
-            case's ``crossplay.csv``.
+            ``"paper"``; checked here to be a name, against the registry by the stages,
+            :func:`sumo_ayss.modes.check_mode`). Every mode available is computed and
+            shown; cross-play needs the case's ``crossplay.csv``.
         crossplay_blocks: Block unit of cross-play's paired test: ``"seed"`` (default,
             training seeds) or ``"opponent"`` (every opponent SPCP its own block).
         premise_reward: Tolerance on the spread of the VUTs' mean episode reward for the
@@ -70,7 +77,11 @@ class ReportOptions:
     def __post_init__(self) -> None:
         s = self.SECTION
         check_number(f"{s}.r157_time_s", self.r157_time_s, low=0.0)
-        check_choice(f"{s}.mode", self.mode, mode_names())
+        require(
+            isinstance(self.mode, str) and _MODE_NAME.fullmatch(self.mode) is not None,
+            f"{s}.mode must be a mode's name (lower-case letters, digits and '_'), "
+            f"got {self.mode!r}",
+        )
         check_choice(f"{s}.crossplay_blocks", self.crossplay_blocks, list(CROSSPLAY_BLOCKS))
         for name in ("premise_reward", "premise_crash_rate", "premise_final_headway_m"):
             value = getattr(self, name)

@@ -141,10 +141,10 @@ def case_seeds(cfg: PipelineConfig, case: str) -> tuple[int, ...]:
 def _look(cfg: PipelineConfig, case: str, runs: Sequence[RunRecord]) -> SettleCheck:
     """One look at a case from its cross-play table."""
     from sumo_ayss.analysis.sequential import looks_of, settle_check
-    from sumo_ayss.crossplay import read_matrix
+    from sumo_ayss.run_folder import read_case_matrix
 
     assert cfg.max_seeds is not None
-    matrix = read_matrix(runs)
+    matrix = read_case_matrix(runs)
     return settle_check(
         matrix.scores("seed"),  # seed blocks: the independent replications
         looks_of(len(cfg.seeds), cfg.max_seeds),

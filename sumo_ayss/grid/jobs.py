@@ -91,7 +91,7 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
     """Train (or resume, or skip) and evaluate one job. Runs in a worker process."""
     from sumo_ayss.evaluate import evaluate_run
     from sumo_ayss.grid.threads import set_torch_threads
-    from sumo_ayss.train import train
+    from sumo_ayss.training.trainer import train
 
     folder = spec.folder
     run_dir = folder.path

@@ -53,7 +53,7 @@ def _stop_workers(pool: ProcessPoolExecutor, grace_s: float = 3.0) -> None:
     """Terminate the pool's worker processes now (SIGTERM, then SIGKILL after ``grace_s``).
 
     Safe for the run folders: every result is written atomically and a rerun resumes from
-    the last checkpoint (:func:`sumo_ayss.train.train`).
+    the last checkpoint (:func:`sumo_ayss.training.trainer.train`).
     """
     processes = list(getattr(pool, "_processes", {}).values())  # CPython's worker table
     for proc in processes:

@@ -1,7 +1,7 @@
 """highway-env's laws driving SUMO vehicles (paper-fidelity mode, docs/paper_fidelity.md).
 
 The POV in ``env.actuator.mode: highway_env`` (:class:`HighwayEnvPovLaw`) and a VUT whose
-controller is :class:`~sumo_ayss.hwenv_laws.HighwayEnvIDM` (``hwenv_pi1``/``hwenv_pi2``,
+controller is :class:`~sumo_ayss.laws.hwenv.HighwayEnvIDM` (``hwenv_pi1``/``hwenv_pi2``,
 :class:`HighwayEnvIdmVut`) are integrated here, in Python, at ``env.actuator.substeps``
 explicit-Euler sub-steps per SUMO step, as highway-env's ``Road.act`` / ``Road.step`` do:
 the POV first (its law ignores the VUT), giving its state at every sub-instant; the VUT's
@@ -13,7 +13,7 @@ speeds are put back after the step (:meth:`~sumo_ayss.laws.base.VehicleLaw.sync`
 the clipped POV (:class:`~sumo_ayss.laws.clipped.ClippedPov`) the POV drives its commanded
 speed over the whole step, which the VUT sees sub-step by sub-step.
 
-Coordinates as in :mod:`sumo_ayss.hwenv_laws`: centres [m], y positive to the left,
+Coordinates as in :mod:`sumo_ayss.laws.hwenv`: centres [m], y positive to the left,
 headings [rad] from +x toward +y; speeds m/s, accelerations m/s².
 """
 
@@ -23,8 +23,8 @@ from collections.abc import Sequence
 from typing import Any
 
 from sumo_ayss.config import ActuatorConfig, EnvConfig
-from sumo_ayss.hwenv_laws import HighwayEnvPov, LateralParams
 from sumo_ayss.laws.base import PovLaw, VutLaw
+from sumo_ayss.laws.hwenv import HighwayEnvPov, LateralParams
 from sumo_ayss.sim.pair import VehiclePair
 from sumo_ayss.vuts.hwenv_kinematics import KinematicState, collision_check
 
@@ -122,7 +122,7 @@ class HighwayEnvIdmVut(VutLaw):
     """highway-env's IDMVehicle as the VUT, re-evaluated at every sub-step.
 
     Args:
-        idm: The :class:`~sumo_ayss.hwenv_laws.HighwayEnvIDM` built from the VUT's
+        idm: The :class:`~sumo_ayss.laws.hwenv.HighwayEnvIDM` built from the VUT's
             controller entry (its ``params``).
         step_length_s: SUMO step [s].
         substeps: Euler sub-steps per SUMO step.

@@ -16,11 +16,11 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 
 from sumo_ayss.config import ActuatorMode, EnvConfig
-from sumo_ayss.hwenv_laws import HIGHWAY_ENV_IDM_TARGET
 from sumo_ayss.laws.base import PovLaw, VehicleLaws, VutLaw
 from sumo_ayss.laws.clipped import ClippedPov
 from sumo_ayss.laws.controller import ControllerVut
 from sumo_ayss.laws.highway_env import HighwayEnvIdmVut, HighwayEnvPovLaw
+from sumo_ayss.laws.hwenv import HIGHWAY_ENV_IDM_TARGET
 from sumo_ayss.laws.sumo_model import SumoModelVut
 
 __all__ = ["INTEGRATED_CONTROLLERS", "POV_LAWS", "build_laws", "pov_law", "vut_law"]

@@ -5,15 +5,18 @@ A mode decides how a case's VUTs are scored, ranked and compared, and how its ve
 read: ``crossplay`` (default; every SPCP against every VUT), ``exposure`` (each VUT's own
 SPCPs) and ``paper`` (the paper's AYSS safety index). The rest of the package asks the
 registry (``get_mode(options.mode).standings(analysis)``) instead of branching on mode
-names: the configuration validates ``report.mode`` against it, the analysis asks
-:attr:`Mode.verdict` for the case's verdict record and the report words it with
-:attr:`Mode.headline` (:func:`headline_text`), ``rank`` writes ``ranking.csv`` from
-:attr:`Mode.standings`, the report's leaderboard and verdict callout read the mode's hooks,
-and the pipeline runs the cross-play stage when :attr:`Mode.runs_crossplay`.
+names: the stages check ``report.mode`` against it (:func:`check_mode`),
+:func:`analyse_case` runs the analysis and asks :attr:`Mode.verdict` for the case's verdict
+record and the report words it with :attr:`Mode.headline` (:func:`headline_text`), ``rank``
+writes ``ranking.csv`` from :attr:`Mode.standings`, the report's leaderboard and verdict
+callout read the mode's hooks, and the pipeline runs the cross-play stage when
+:attr:`Mode.runs_crossplay`.
 
-Layering: like the case records, this package imports only the standard library, the
-error tree and the range checks at module level (the configuration reads it without numpy);
-its hooks import :mod:`sumo_ayss.analysis` when called, and nothing above it.
+Layering: this package sits above :mod:`sumo_ayss.analysis` (which imports no mode) and
+below the report; at module level it imports only the standard library, the error tree and
+the range checks; its hooks import :mod:`sumo_ayss.analysis` when called, and nothing above
+it. The configuration imports no mode: it checks ``report.mode``'s form, and the stages check
+the name against this registry when they start (:func:`check_mode`).
 
 How numbers, intervals and rankings read, in the modes' sentences and the report's tables
 alike: :mod:`.formatting` (standard library only).
@@ -25,12 +28,14 @@ below (rows of the modes follow in registry order).
 from __future__ import annotations
 
 # The built-in modes, registered in import order (ranking rows follow it).
+from sumo_ayss.modes.analyse import analyse_case, analyse_cases
 from sumo_ayss.modes.crossplay import CROSSPLAY
 from sumo_ayss.modes.exposure import EXPOSURE
 from sumo_ayss.modes.paper import PAPER
 from sumo_ayss.modes.registry import (
     Mode,
     Standing,
+    check_mode,
     get_mode,
     headline_text,
     missing_rows_line,
@@ -40,7 +45,8 @@ from sumo_ayss.modes.registry import (
     unregister_mode,
 )
 
-#: The mode of a report and a ranking unless ``report.mode`` says otherwise.
+#: The mode of a report and a ranking unless ``report.mode`` says otherwise (the same name
+#: as :data:`sumo_ayss.config.report.DEFAULT_MODE`, which the configuration holds).
 DEFAULT_MODE = CROSSPLAY.name
 
 __all__ = [
@@ -50,6 +56,9 @@ __all__ = [
     "PAPER",
     "Mode",
     "Standing",
+    "analyse_case",
+    "analyse_cases",
+    "check_mode",
     "get_mode",
     "headline_text",
     "missing_rows_line",

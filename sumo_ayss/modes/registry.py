@@ -13,8 +13,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from sumo_ayss.util.errors import ConfigError
-from sumo_ayss.util.validation import require, suggest
+from sumo_ayss.util.registry import Registry
+from sumo_ayss.util.validation import check_choice, require
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 __all__ = [
     "Mode",
     "Standing",
+    "check_mode",
     "get_mode",
     "headline_text",
     "missing_rows_line",
@@ -153,7 +154,7 @@ class Mode:
 
 # --------------------------------------------------------------------------- the registry
 
-_REGISTRY: dict[str, Mode] = {}
+_REGISTRY: Registry[Mode] = Registry("mode")
 
 
 def register_mode(mode: Mode, *, replace: bool = False) -> Mode:
@@ -164,18 +165,12 @@ def register_mode(mode: Mode, *, replace: bool = False) -> Mode:
     Raises:
         ConfigError: If the name is taken by another record.
     """
-    old = _REGISTRY.get(mode.name)
-    require(
-        old is None or old == mode or replace,
-        f"mode {mode.name!r} is already registered (pass replace=True to replace it)",
-    )
-    _REGISTRY[mode.name] = mode
-    return mode
+    return _REGISTRY.register(mode.name, mode, replace=replace)
 
 
 def unregister_mode(name: str) -> Mode:
     """Remove a registered mode (tests, plugins) and return its record."""
-    return _REGISTRY.pop(get_mode(name).name)
+    return _REGISTRY.unregister(name)
 
 
 def get_mode(name: str) -> Mode:
@@ -184,12 +179,18 @@ def get_mode(name: str) -> Mode:
     Raises:
         ConfigError: Naming the registered modes, if ``name`` is none of them.
     """
-    mode = _REGISTRY.get(name) if isinstance(name, str) else None
-    if mode is None:
-        names = mode_names()
-        hint = suggest(name, names) if isinstance(name, str) else ""
-        raise ConfigError(f"unknown mode {name!r}{hint}; allowed: {list(names)}")
-    return mode
+    return _REGISTRY.get(name)
+
+
+def check_mode(name: str, where: str = "report.mode") -> Mode:
+    """The registered mode ``name``, as the configuration field ``where`` names it (the
+    stages check ``report.mode`` here when they start: the configuration imports no mode).
+
+    Raises:
+        ConfigError: ``"report.mode must be one of [...]"``, if ``name`` is none of them.
+    """
+    check_choice(where, name, mode_names())
+    return get_mode(name)
 
 
 def headline_text(a: CaseAnalysis) -> str:
@@ -214,9 +215,9 @@ def missing_rows_line(a: CaseAnalysis) -> str | None:
 
 def mode_names() -> tuple[str, ...]:
     """The registered modes' names, in registry order."""
-    return tuple(_REGISTRY)
+    return _REGISTRY.names()
 
 
 def registered_modes() -> tuple[Mode, ...]:
     """The registered modes, in registry order."""
-    return tuple(_REGISTRY.values())
+    return _REGISTRY.records()

@@ -10,7 +10,7 @@ import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
@@ -28,21 +28,18 @@ from sumo_ayss.replay.playback import (
     TRAJECTORY_FILE,
     VTYPES_FILE,
 )
+from sumo_ayss.replay.source import Kind, initial_condition, load_policy, read_row, select_row
 from sumo_ayss.run_folder import (
     AYSS_CSV,
-    AYSS_SCHEMA,
     OUTCOME_CSV,
-    OUTCOME_SCHEMA,
-    RunFolder,
     RunRecord,
     read_run,
-    read_table,
 )
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.sim import export
 from sumo_ayss.sim.network import network_path
 from sumo_ayss.util.atomic import atomic_copy, atomic_write_text
-from sumo_ayss.util.errors import CheckpointError, ConfigError, SimulationError
+from sumo_ayss.util.errors import SimulationError
 from sumo_ayss.util.paths import portable_path
 from sumo_ayss.vuts.catalog import controller_imports, vtypes_xml
 
@@ -50,8 +47,6 @@ __all__ = ["ExportResult", "export_scenario"]
 
 #: The reset must reproduce a row's state to this tolerance [m/s, m] (float32 rows).
 _RESET_TOL = 1e-3
-
-Kind = Literal["ayss", "outcome"]
 
 
 @dataclass(frozen=True)
@@ -72,36 +67,6 @@ class ExportResult:
 
 
 # --------------------------------------------------------------------------- export
-
-
-def _row(folder: RunFolder, kind: Kind, index: int) -> dict[str, Any]:
-    path, schema = (
-        (folder.ayss_csv, AYSS_SCHEMA) if kind == "ayss" else (folder.outcome_csv, OUTCOME_SCHEMA)
-    )
-    if not path.is_file():
-        raise CheckpointError(
-            f"{folder.path}: no {path.name} (run `python -m sumo_ayss.evaluate` first)"
-        )
-    table = read_table(path, schema)
-    if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < len(table):
-        raise ConfigError(
-            f"--{kind}-row must be an integer in [0, {len(table) - 1}] (data rows of {path}), "
-            f"got {index!r}"
-        )
-    return dict(list(table.rows())[index])
-
-
-def _initial_condition(kind: Kind, row: dict[str, Any]) -> InitialCondition:
-    if kind == "ayss":
-        return InitialCondition(row["v_pov_mps"], row["v_vut_mps"], row["h_m"])
-    return InitialCondition(row["v_pov0_mps"], row["v_vut0_mps"], row["gap0_m"])
-
-
-def _load_policy(run: RunRecord) -> Policy:
-    """The run's SPCP, weights only (never unpickled: see "Trust model" in the README)."""
-    from sumo_ayss.evaluate import load_spcp  # torch: only when a policy is needed
-
-    return load_spcp(run, make_env(run.experiment.env))
 
 
 def _vehicle_name(vtype: str) -> str:
@@ -148,17 +113,7 @@ def export_scenario(
         CheckpointError: If the run folder, a table or the SPCP cannot be read.
         SimulationError: If SUMO fails or does not reproduce the row's initial state.
     """
-    if (ayss_row is None) == (outcome_row is None):
-        raise ConfigError(
-            "give exactly one of ayss_row (--ayss-row) or outcome_row (--outcome-row)"
-        )
-    kind: Kind = "ayss" if ayss_row is not None else "outcome"
-    index = ayss_row if ayss_row is not None else outcome_row
-    assert index is not None
-    if decisions is not None and (
-        isinstance(decisions, bool) or not isinstance(decisions, int) or decisions < 1
-    ):
-        raise ConfigError(f"decisions must be an integer >= 1, got {decisions!r}")
+    kind, index = select_row(ayss_row, outcome_row, decisions)
     out = Path(out)
     with controller_imports(trust_controller):
         return _export(read_run(run_dir), kind, index, out, policy, decisions)
@@ -168,9 +123,9 @@ def _export(
     run: RunRecord, kind: Kind, index: int, out: Path, policy: Policy | None, decisions: int | None
 ) -> Any:
     env_cfg = run.experiment.env  # raises first if the folder is not a run folder
-    row = _row(run.folder, kind, index)
-    ic = _initial_condition(kind, row)
-    pol = policy if policy is not None else _load_policy(run)
+    row = read_row(run.folder, kind, index)
+    ic = initial_condition(kind, row)
+    pol = policy if policy is not None else load_policy(run)
     limit = decisions if decisions is not None else (1 if kind == "ayss" else None)
     out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="sumo_ayss_rec_") as tmp:

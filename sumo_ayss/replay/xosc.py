@@ -38,7 +38,7 @@ from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.replay.record import Kind, _initial_condition, _load_policy, _row
+from sumo_ayss.replay.source import initial_condition, load_policy, read_row, select_row
 from sumo_ayss.run_folder import read_run
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.scenarios.trajectory import body_width_m, trajectory_from_infos
@@ -266,24 +266,14 @@ def export_xosc(
         CheckpointError: If the run folder, a table or the SPCP cannot be read.
         SimulationError: If SUMO fails.
     """
-    if (ayss_row is None) == (outcome_row is None):
-        raise ConfigError(
-            "give exactly one of ayss_row (--ayss-row) or outcome_row (--outcome-row)"
-        )
-    if decisions is not None and (
-        isinstance(decisions, bool) or not isinstance(decisions, int) or decisions < 1
-    ):
-        raise ConfigError(f"decisions must be an integer >= 1, got {decisions!r}")
-    kind: Kind = "ayss" if ayss_row is not None else "outcome"
-    index = ayss_row if ayss_row is not None else outcome_row
-    assert index is not None
+    kind, index = select_row(ayss_row, outcome_row, decisions)
     out = Path(out)
     with controller_imports(trust_controller):
         run = read_run(run_dir)
         env_cfg: EnvConfig = run.experiment.env  # raises first if not a run folder
-        row = _row(run.folder, kind, index)
-        ic = _initial_condition(kind, row)
-        pol = policy if policy is not None else _load_policy(run)
+        row = read_row(run.folder, kind, index)
+        ic = initial_condition(kind, row)
+        pol = policy if policy is not None else load_policy(run)
         limit = decisions if decisions is not None else (1 if kind == "ayss" else None)
         reset_info, infos, actions, rewards = _record(env_cfg, run.config_seed, ic, pol, limit)
     if not infos:

@@ -23,9 +23,9 @@ _LAZY = {
     "MARKDOWN_NAME": "sumo_ayss.report.document",
     "PairVerdict": "sumo_ayss.analysis.significance",
     "Report": "sumo_ayss.report.document",
-    "analyse_case": "sumo_ayss.analysis.case",
+    "analyse_case": "sumo_ayss.modes",
     "build_report": "sumo_ayss.report.document",
-    "load_runs": "sumo_ayss.report.document",
+    "load_runs": "sumo_ayss.run_folder",
     "pair_verdict": "sumo_ayss.analysis.significance",
     "render_html": "sumo_ayss.report.render",
     "render_markdown": "sumo_ayss.report.render",
@@ -33,8 +33,9 @@ _LAZY = {
     "vut_safety_index": "sumo_ayss.analysis.case",
     "write_report": "sumo_ayss.report.document",
     "write_report_for": "sumo_ayss.report.document",
-    "group_runs": "sumo_ayss.report.load",
-    "analyse_runs": "sumo_ayss.report.load",
+    "group_runs": "sumo_ayss.run_folder",
+    "case_runs": "sumo_ayss.run_folder",
+    "analyse_cases": "sumo_ayss.modes",
     "ReportOptions": "sumo_ayss.config.report",
 }
 """Public names and their modules, imported on first use: importing the package loads

@@ -19,9 +19,10 @@ from pathlib import Path
 
 from sumo_ayss.cli import prog
 from sumo_ayss.config import check_out_dir
+from sumo_ayss.modes import analyse_cases
 from sumo_ayss.report.checks import input_problems
-from sumo_ayss.report.document import DEFAULT_TITLE, ReportOptions, load_runs, write_report_for
-from sumo_ayss.report.load import analyse_runs
+from sumo_ayss.report.document import DEFAULT_TITLE, ReportOptions, write_report_for
+from sumo_ayss.run_folder import case_runs, load_runs
 from sumo_ayss.util.errors import AyssError
 
 #: ``--strict``'s help, also quoted by ``rank --strict``.
@@ -82,7 +83,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         if args.out is not None:
             check_out_dir(args.out, "--out")
         runs = load_runs(args.paths)
-        analyses = analyse_runs(runs, options)
+        analyses = analyse_cases(case_runs(runs), options)
         out = args.out if args.out is not None else args.paths[0] / "report"
         path = write_report_for(runs, out, analyses=analyses, title=args.title, options=options)
     except AyssError as exc:

@@ -15,8 +15,6 @@ They read the run records (:class:`~sumo_ayss.run_folder.RunRecord`: each run's
   :mod:`sumo_ayss.config.budget` covers the protocol), or SPCPs may still be improving at
   such a budget; :func:`budget_note` — at a validated budget, what was validated and what
   was not, once.
-- :func:`mixing_problems` — runs that must not be pooled: the same (case, VUT, seed) twice,
-  or runs of one case whose configurations differ other than by VUT and seed.
 - :func:`input_problems` — the missing, unreadable or empty input files of analysed cases,
   one console line each naming the file (``report`` and ``rank`` print them; ``--strict``
   makes them an error).
@@ -28,9 +26,8 @@ from __future__ import annotations
 
 import contextlib
 import os
-from collections import Counter, defaultdict
+from collections import Counter
 from collections.abc import Iterable, Sequence
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from sumo_ayss.config.budget import BUDGETS, Budget
@@ -177,48 +174,6 @@ def budget_note(runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None)
 def improving_runs(runs: Sequence[tuple[str, Training]]) -> list[str]:
     """The labels of the runs whose SPCP is the last candidate of their training."""
     return [label for label, t in runs if t.still_improving]
-
-
-def mixing_problems(
-    runs: Sequence[tuple[str, str, int | None, str | Path, Training]],
-) -> list[str]:
-    """Sentences naming runs that must not be pooled into one report.
-
-    Args:
-        runs: ``(case, vut, seed, path, training)`` per run.
-
-    Returns:
-        One sentence per duplicate (case, VUT, seed) and per case whose runs have different
-        budgets or configurations (besides VUT and seed); empty when the runs can be pooled.
-    """
-    out = []
-    by_key: dict[tuple[str, str, int | None], list[str | Path]] = defaultdict(list)
-    for case, vut, seed, path, _ in runs:
-        by_key[(case, vut, seed)].append(path)
-    for (case, vut, seed), paths in by_key.items():
-        if len(paths) > 1:
-            out.append(
-                f"{case} {vut} seed {seed} appears {len(paths)} times: "
-                + ", ".join(str(p) for p in paths)
-            )
-    by_case: dict[str, dict[tuple[int | None, int | None, str], list[str | Path]]] = defaultdict(
-        lambda: defaultdict(list)
-    )
-    for case, _, _, path, t in runs:
-        by_case[case][(t.total_timesteps, t.eval_every, t.config_key)].append(path)
-    for case, groups in by_case.items():
-        if len(groups) < 2:
-            continue
-        parts = []
-        for (total, every, key), paths in groups.items():
-            parts.append(
-                f"total_timesteps={total}, eval_every={every}, config {key or '?'}: "
-                + ", ".join(str(p) for p in paths)
-            )
-        out.append(
-            f"{case}: runs with different training budgets or configurations — " + "; ".join(parts)
-        )
-    return out
 
 
 def input_problems(analyses: Sequence[CaseAnalysis]) -> list[str]:

@@ -1,10 +1,11 @@
 """The report: run folders in, ``report.html`` + ``summary.md`` + PNG figures out.
 
-:func:`write_report` reads run folders (:func:`load_runs`, :mod:`.load`; and checks that they
-may be pooled, :mod:`.checks`), analyses each case (:func:`.load.analyse_runs`: safety
-indices, verdicts, exposure and cross-play rankings, premise) unless its caller hands the
-analyses in (the pipeline, which passes them on to rank), composes the sections
-(:mod:`.sections`) into one list of blocks (:mod:`.blocks`) and renders it twice
+:func:`write_report` reads run folders (:func:`~sumo_ayss.run_folder.load_runs`, which
+checks that they may be pooled), analyses each case
+(:func:`~sumo_ayss.modes.analyse_cases`: safety indices, verdicts, exposure and cross-play
+rankings, premise) unless its caller hands the analyses in (the pipeline, which passes them
+on to rank), composes the sections (:mod:`.sections`) into one list of blocks
+(:mod:`.blocks`) and renders it twice
 (:mod:`.render`):
 
 * ``report.html`` — one self-contained file: figures embedded as base64 PNG, inline CSS, no
@@ -25,10 +26,10 @@ import logging
 from collections.abc import Sequence
 from pathlib import Path
 
-from sumo_ayss.analysis.case import CaseAnalysis, analyse_case, vut_safety_index
+from sumo_ayss.analysis.case import CaseAnalysis, vut_safety_index
 from sumo_ayss.analysis.significance import PairVerdict, pair_verdict
 from sumo_ayss.config.report import ReportOptions
-from sumo_ayss.modes import get_mode
+from sumo_ayss.modes import analyse_case, analyse_cases, get_mode
 from sumo_ayss.modes.paper import significance_rule
 from sumo_ayss.report.blocks import (
     Block,
@@ -40,16 +41,13 @@ from sumo_ayss.report.blocks import (
     Report,
     Table,
 )
-from sumo_ayss.report.checks import budget_note, fewest_seeds, mixing_problems, trust_warnings
+from sumo_ayss.report.checks import budget_note, fewest_seeds, trust_warnings
 from sumo_ayss.report.figstyle import vut_colors
 from sumo_ayss.report.leaderboard import leaderboard_table
-from sumo_ayss.report.load import analyse_runs, group_runs
 from sumo_ayss.report.render import render_html, render_markdown
 from sumo_ayss.report.sections.case import case_blocks, verdict_lines
-from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.inputs import inputs_blocks
-from sumo_ayss.run_folder import CONFIG_YAML, RunRecord, find_run_dirs, read_run
-from sumo_ayss.util.errors import ConfigError
+from sumo_ayss.run_folder import RunRecord, case_runs, group_runs, load_runs
 
 __all__ = [
     "DEFAULT_TITLE",
@@ -67,7 +65,6 @@ __all__ = [
     "Table",
     "analyse_case",
     "build_report",
-    "load_runs",
     "pair_verdict",
     "render_html",
     "render_markdown",
@@ -99,7 +96,7 @@ def build_report(
         out_dir: Folder for the PNG figures (created).
         title: Report title.
         options: Statistical settings; defaults if None.
-        analyses: The analyses of ``runs`` (:func:`.load.analyse_runs` with ``options``
+        analyses: The analyses of ``runs`` (:func:`~sumo_ayss.modes.analyse_cases` with ``options``
             and the paper mode), when the caller already has them; computed here if None.
 
     Returns:
@@ -110,7 +107,7 @@ def build_report(
     groups = group_runs(runs)
     colors = vut_colors(sorted({r.vut for r in runs}))
     if analyses is None:
-        analyses = analyse_runs(runs, options)
+        analyses = analyse_cases(case_runs(runs), options)
     now = dt.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z")
     n_seeds = ", ".join(
         f"{case}: " + ", ".join(f"{vut} × {len(m)}" for vut, m in by_vut.items())
@@ -189,36 +186,6 @@ def modes_paragraph(analyses: Sequence[CaseAnalysis], mode: str) -> str:
     )
 
 
-def load_runs(paths: Sequence[str | Path]) -> list[RunRecord]:
-    """The run folders among ``paths`` (and below them), loaded, checked to be poolable.
-
-    Args:
-        paths: Run folders ``<out>/<case>/<vut>/seed_<k>`` and/or roots to search.
-
-    Returns:
-        The loaded runs (:func:`~sumo_ayss.run_folder.read_run`), in :func:`find_run_dirs` order.
-
-    Raises:
-        ConfigError: If ``paths`` is empty, a path is not a folder, no run folder is found,
-            or the runs must not be pooled into one report (:func:`.checks.mixing_problems`).
-    """
-    if not paths:
-        raise ConfigError("paths: expected at least one run folder or root")
-    run_dirs = find_run_dirs(paths)
-    if not run_dirs:
-        raise ConfigError(f"no run folder (with {CONFIG_YAML}) under {list(map(str, paths))}")
-    runs = [read_run(d) for d in run_dirs]
-    problems = mixing_problems(
-        [(r.case, r.vut, r.seed, display_path(r.path, Path.cwd()), r.training) for r in runs]
-    )
-    if problems:
-        raise ConfigError(
-            "these runs must not be pooled into one report (report each group separately, "
-            "e.g. one pipeline output folder at a time):\n  " + "\n  ".join(problems)
-        )
-    return runs
-
-
 def write_report(
     paths: Sequence[str | Path],
     out_dir: str | Path | None = None,
@@ -238,7 +205,7 @@ def write_report(
         The path of ``report.html``.
 
     Raises:
-        ConfigError: As :func:`load_runs`.
+        ConfigError: As :func:`~sumo_ayss.run_folder.load_runs`.
     """
     runs = load_runs(paths)
     target = Path(out_dir) if out_dir is not None else Path(paths[0]) / "report"
@@ -256,7 +223,7 @@ def write_report_for(
     """Writes ``report.html``, ``summary.md`` and the PNGs of loaded runs into ``out_dir``.
 
     Args:
-        runs: Loaded runs (:func:`load_runs`).
+        runs: Loaded runs (:func:`~sumo_ayss.run_folder.load_runs`).
         out_dir: Output folder.
         analyses: Their analyses, when the caller has them (see :func:`build_report`).
         title: Report title.

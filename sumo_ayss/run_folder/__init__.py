@@ -46,6 +46,9 @@ above the case's run folders, holds the cross-play and discriminability stages' 
 ``.superseded/``            (:mod:`sumo_ayss.grid.study`)   runs of redefined VUTs, set aside
 ==========================  ==============================  ==================================
 
+A study's runs are found, checked to be poolable and grouped by case, each case with its
+cross-play table, by :mod:`.study_runs` (:func:`load_runs`, :func:`case_runs`).
+
 The study folder ``<out>/`` (:class:`StudyFolder`) holds ``pipeline.json``, ``ranking.csv``,
 ``ranking.md``, ``order_check.json`` and ``measures.csv`` (:mod:`.study`).
 
@@ -202,6 +205,14 @@ from sumo_ayss.run_folder.study import (
     write_pipeline_json,
     write_ranking_csv,
 )
+from sumo_ayss.run_folder.study_runs import (
+    CaseRuns,
+    case_runs,
+    group_runs,
+    load_runs,
+    mixing_problems,
+    read_case_matrix,
+)
 from sumo_ayss.run_folder.summaries import (
     AyssRecord,
     Estimate,
@@ -275,6 +286,7 @@ __all__ = [
     "AyssSamples",
     "AyssStage",
     "CaseFolder",
+    "CaseRuns",
     "CellStore",
     "Column",
     "CrossplayOpponent",
@@ -304,15 +316,20 @@ __all__ = [
     "TrainStage",
     "Training",
     "case_dir_for",
+    "case_runs",
     "config_key",
     "find_run_dirs",
     "fingerprint",
+    "group_runs",
     "harm_scale_of",
     "is_done",
     "is_run_dir",
     "load_crossplay",
+    "load_runs",
+    "mixing_problems",
     "read_adaptive",
     "read_ayss_json",
+    "read_case_matrix",
     "read_checkpoint_state",
     "read_command",
     "read_crossplay_json",

@@ -205,7 +205,7 @@ class VehiclePair:
     def move_pov_xy(self, x_front_m: float, y_m: float, heading_rad: float) -> None:
         """Put the POV's front bumper centre at world ``(x, y)`` in the next step.
 
-        For highway-env's POV (:mod:`sumo_ayss.hwenv_laws`), whose state is integrated in
+        For highway-env's POV (:mod:`sumo_ayss.laws.hwenv`), whose state is integrated in
         Python: ``moveToXY`` (keepRoute 1: stay on the road, free lateral position with
         SUMO's sublane model; without it SUMO snaps the POV to the nearest lane centre,
         exact in car-following). SUMO's body stays aligned with the lane; ``heading_rad``

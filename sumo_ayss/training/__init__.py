@@ -1,4 +1,7 @@
-"""The pieces of :mod:`sumo_ayss.train`, one concern each.
+"""The training stage's work (:mod:`sumo_ayss.train` is its entry point), one concern each.
+
+- :mod:`~sumo_ayss.training.trainer`: :func:`~sumo_ayss.training.trainer.train` and the
+  :class:`~sumo_ayss.training.trainer.Trainer` that composes the pieces below.
 
 - :mod:`~sumo_ayss.training.run_metadata`: what a run's metadata files hold (written by
   :mod:`sumo_ayss.run_folder`, like every run-folder file).

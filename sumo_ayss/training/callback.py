@@ -15,7 +15,7 @@ from sumo_ayss.training.collectors import Collector, Rollout
 
 
 class Trainer(Protocol):
-    """What the callback asks of the training loop (:class:`sumo_ayss.train.Trainer`)."""
+    """What the callback asks of the training loop (:class:`sumo_ayss.training.trainer.Trainer`)."""
 
     run_dir: Path
     cfg: ExperimentConfig

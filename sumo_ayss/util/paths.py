@@ -23,6 +23,12 @@ def portable_path(path: str | Path, base: str | Path = PROJECT_ROOT) -> str:
         return p.as_posix()
 
 
+def display_path(path: str | Path, base: str | Path) -> str:
+    """``path`` relative to ``base`` (a report folder, the working directory), even where it
+    lies beside it (``../``), in POSIX form: what reports and messages show of a path."""
+    return Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()
+
+
 def portable_python() -> str:
     """The running interpreter for ``command.txt``: ``.venv/bin/python`` when it is the
     repository's virtual environment, else plain ``python``."""

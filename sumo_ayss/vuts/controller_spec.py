@@ -32,10 +32,19 @@ from sumo_ayss.vuts.vtype_params import as_number
 
 __all__ = [
     "DEFAULT_CALL_DEADLINE_S",
+    "TARGET_ALIASES",
     "ControllerSpec",
     "check_imports_allowed",
     "controller_imports",
 ]
+
+#: Controller targets stored under a name that is no longer a module path -> the class they
+#: name now. Run folders' ``config.yaml`` keep the name they were written with (it is part of
+#: the run's identity and fingerprints), so a moved class keeps its old name here instead of
+#: a module left behind at the old path: ``sumo_ayss.hwenv_laws`` moved into ``laws/``.
+TARGET_ALIASES: Mapping[str, str] = FrozenMap(
+    {"sumo_ayss.hwenv_laws:HighwayEnvIDM": "sumo_ayss.laws.hwenv:HighwayEnvIDM"}
+)
 
 #: Default per-call deadline of every VUT kind [s] (``call_deadline_s``): a VUT that takes
 #: longer than this for one step stops the run with a :class:`ControllerError`.
@@ -155,7 +164,7 @@ class ControllerSpec:
                 "a user controller, and importing it",
                 " (the package's own, sumo_ayss.*, is always allowed)",
             )
-        module_part, _, attr_part = self.target.rpartition(":")
+        module_part, _, attr_part = TARGET_ALIASES.get(self.target, self.target).rpartition(":")
         try:
             module = _import(module_part)
         except Exception as e:  # any error while importing user code

@@ -1,6 +1,6 @@
 """highway-env's (v1.8.2) vehicle kinematics and collision test, as pure functions.
 
-Used by :mod:`sumo_ayss.hwenv_laws` (read its docstring for the coordinates and the laws)
+Used by :mod:`sumo_ayss.laws.hwenv` (read its docstring for the coordinates and the laws)
 and :mod:`sumo_ayss.laws.highway_env`: the vehicle state, highway-env's kinematic bicycle
 (``Vehicle.step``) and its rotated-body collision test (``_is_colliding``). Positions are of
 the vehicle's centre [m], ``y`` positive to the left, headings [rad] from +x toward +y.

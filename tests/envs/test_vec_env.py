@@ -38,7 +38,7 @@ from sumo_ayss.sim.network import (
     build_parallel_network,
     parallel_road_edge,
 )
-from sumo_ayss.train import Trainer, evaluate_on_vec, hparams_for_n_envs, train
+from sumo_ayss.training.trainer import Trainer, evaluate_on_vec, hparams_for_n_envs, train
 from sumo_ayss.util.errors import ActionError, ConfigError
 from tests.helpers import TINY_AGENT
 

@@ -11,7 +11,7 @@ import torch as th
 
 from sumo_ayss.config import TrainConfig, load_experiment
 from sumo_ayss.grid.threads import THREAD_ENV_VARS, set_torch_threads, single_thread_env
-from sumo_ayss.train import check_device, train
+from sumo_ayss.training.trainer import check_device, train
 from sumo_ayss.util.errors import ConfigError
 from tests.training.test_train import tiny_config
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 
 from sumo_ayss.config import ActuatorConfig
-from sumo_ayss.hwenv_laws import HighwayEnvIDM
 from sumo_ayss.laws.clipped import ClippedPov
 from sumo_ayss.laws.highway_env import HighwayEnvIdmVut, HighwayEnvPovLaw
+from sumo_ayss.laws.hwenv import HighwayEnvIDM
 from tests.laws.fake_pair import FakePair
 
 HW = ActuatorConfig(mode="highway_env")

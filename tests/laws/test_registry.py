@@ -10,11 +10,11 @@ import pytest
 
 from examples.acc_controller import TimeGapACC
 from sumo_ayss.config import ActuatorConfig, ActuatorMode, EnvConfig
-from sumo_ayss.hwenv_laws import HIGHWAY_ENV_IDM_TARGET, HighwayEnvIDM
 from sumo_ayss.laws import build_laws
 from sumo_ayss.laws.clipped import ClippedPov
 from sumo_ayss.laws.controller import ControllerVut
 from sumo_ayss.laws.highway_env import HighwayEnvIdmVut, HighwayEnvPovLaw
+from sumo_ayss.laws.hwenv import HIGHWAY_ENV_IDM_TARGET, HighwayEnvIDM
 from sumo_ayss.laws.registry import INTEGRATED_CONTROLLERS, POV_LAWS
 from sumo_ayss.laws.sumo_model import SumoModelVut
 from sumo_ayss.util.errors import ConfigError
@@ -59,6 +59,18 @@ def test_the_catalogs_highway_env_vuts_are_integrated() -> None:
         spec = BUILTIN_VUTS[name].controller
         assert spec is not None and spec.target == HIGHWAY_ENV_IDM_TARGET
     assert set(INTEGRATED_CONTROLLERS) == {HIGHWAY_ENV_IDM_TARGET}
+
+
+def test_the_target_committed_run_folders_store_still_resolves() -> None:
+    """``results/*/config.yaml`` name highway-env's IDM by its old root path; the module
+    moved into ``laws/`` and the alias table resolves the stored name to its class."""
+    stored = "sumo_ayss.hwenv_laws:HighwayEnvIDM"
+    assert stored == HIGHWAY_ENV_IDM_TARGET
+    root = Path(__file__).resolve().parents[2]
+    assert stored in (root / "results/paper/cut_in/pi1/seed_0/config.yaml").read_text()
+    assert not (root / "sumo_ayss/hwenv_laws.py").exists()
+    spec = ControllerSpec(stored, 3.0, 6.0, params={})
+    assert spec.resolve() is HighwayEnvIDM
 
 
 def test_controllers_are_built_fresh_per_env_from_their_params() -> None:

@@ -8,12 +8,15 @@ import sys
 
 import pytest
 
+from sumo_ayss.analysis.case import CROSSPLAY_MODE, EXPOSURE_MODE, PAPER_MODE
+from sumo_ayss.config.report import DEFAULT_MODE as CONFIG_DEFAULT_MODE
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import (
     CROSSPLAY,
     DEFAULT_MODE,
     EXPOSURE,
     PAPER,
+    check_mode,
     get_mode,
     mode_names,
     register_mode,
@@ -26,7 +29,12 @@ from tests.report.test_report import make_run
 
 def test_built_in_modes_in_registry_order_with_the_default_first() -> None:
     assert mode_names()[:3] == ("crossplay", "exposure", "paper")
-    assert DEFAULT_MODE == CROSSPLAY.name == ReportOptions().mode
+    assert DEFAULT_MODE == CROSSPLAY.name == ReportOptions().mode == CONFIG_DEFAULT_MODE
+    assert (CROSSPLAY.name, EXPOSURE.name, PAPER.name) == (
+        CROSSPLAY_MODE,
+        EXPOSURE_MODE,
+        PAPER_MODE,
+    )
     assert get_mode("paper") is PAPER
     assert CROSSPLAY.runs_crossplay and not EXPOSURE.runs_crossplay
     assert PAPER.needs_safety_index and not CROSSPLAY.needs_safety_index
@@ -35,8 +43,11 @@ def test_built_in_modes_in_registry_order_with_the_default_first() -> None:
 def test_an_unknown_mode_is_refused_with_the_registered_ones_named() -> None:
     with pytest.raises(ConfigError, match=r"unknown mode 'exposur'.*'exposure'"):
         get_mode("exposur")
-    with pytest.raises(ConfigError, match=r"report\.mode must be one of"):
-        ReportOptions(mode="nonsense")
+    with pytest.raises(ConfigError, match=r"report\.mode must be one of .*'exposure'"):
+        check_mode("nonsense")
+    with pytest.raises(ConfigError, match=r"report\.mode must be a mode's name"):
+        ReportOptions(mode="Not a name")
+    assert ReportOptions(mode="nonsense").mode == "nonsense"  # the stages check the registry
 
 
 def test_registering_another_record_under_a_taken_name_needs_replace() -> None:
@@ -70,3 +81,15 @@ def test_the_registry_loads_without_the_analysis() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_the_pipeline_refuses_an_unknown_mode_before_any_job(tmp_path) -> None:
+    """The configuration imports no mode; the pipeline checks ``report.mode`` first."""
+    from sumo_ayss.config import load_pipeline
+    from sumo_ayss.pipeline import run_pipeline
+
+    cfg = load_pipeline("configs/ladders/min_gap.yaml", out=tmp_path / "study")
+    bad = dataclasses.replace(cfg, report=dataclasses.replace(cfg.report, mode="exposur"))
+    with pytest.raises(ConfigError, match=r"report\.mode must be one of .*did you mean 'exposure'"):
+        run_pipeline(bad, live=False)
+    assert not (tmp_path / "study").exists()

@@ -470,8 +470,8 @@ def test_crossplay_section_and_headline_from_the_case_table(tmp_path: Path) -> N
 
 
 def test_crossplay_needs_two_vuts_and_a_table_of_these_runs(tmp_path: Path) -> None:
-    from sumo_ayss.analysis.case import analyse_case
-    from sumo_ayss.report.load import group_runs
+    from sumo_ayss.modes import analyse_case
+    from sumo_ayss.run_folder import group_runs
 
     root = tmp_path / "runs"
     dirs = [make_run(root, "cut_in", "pi1", s) for s in range(2)]
@@ -494,8 +494,8 @@ def test_crossplay_needs_two_vuts_and_a_table_of_these_runs(tmp_path: Path) -> N
 
 def test_the_loader_hands_analysis_the_crossplay_table_or_why_there_is_none(tmp_path: Path) -> None:
     """analysis/ reads no file: :func:`load_crossplay` reads the case's crossplay.csv."""
-    from sumo_ayss.analysis.case import analyse_case
-    from sumo_ayss.report.load import group_runs
+    from sumo_ayss.modes import analyse_case
+    from sumo_ayss.run_folder import group_runs
 
     root = tmp_path / "runs"
     dirs = [make_run(root, "cut_in", v, s) for v in ("pi1", "pi2") for s in range(2)]

@@ -11,7 +11,7 @@ import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from sumo_ayss.analysis.case import analyse_case
+from sumo_ayss.modes import analyse_case
 from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.report import write_report
 from sumo_ayss.report.crossplay_figure import crossplay_lines

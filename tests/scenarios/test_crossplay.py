@@ -11,10 +11,10 @@ import pytest
 import yaml
 
 from sumo_ayss.config import AyssConfig, EnvConfig, OddConfig, load_experiment
-from sumo_ayss.crossplay import main, read_matrix
+from sumo_ayss.crossplay import main
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.evaluate import evaluate_run
-from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, read_run, table_from_rows
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, read_case_matrix, read_run, table_from_rows
 from sumo_ayss.scenarios.crossplay import (
     DIAGONAL_COLUMNS,
     Opponent,
@@ -179,7 +179,7 @@ def test_cli_cross_plays_a_tiny_grid_and_skips_when_done(tmp_path: Path, capsys)
     assert "cross-play ranking, safest first" in text and "Kendall tau" in text
     assert "crashes " in text and "mean speed" in text
     case = out / "car_following"
-    m = read_matrix([read_run(out / "car_following" / v / "seed_0") for v in ("pi1", "pi2")])
+    m = read_case_matrix([read_run(out / "car_following" / v / "seed_0") for v in ("pi1", "pi2")])
     assert m.vuts == ("pi1", "pi2") and m.opponents == (("pi1", 0), ("pi2", 0))
     assert m.n_scenarios == 6
     record = json.loads((case / "crossplay.json").read_text())

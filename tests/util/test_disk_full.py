@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from scripts.ray_cluster import _unshare, can_hide
+from scripts.ray_cluster import unshare_argv, can_hide
 from tests.test_pipeline import PROJECT_ROOT
 
 pytestmark = pytest.mark.skipif(
@@ -68,7 +68,7 @@ def test_atomic_write_on_a_full_disk_names_file_and_bytes_and_keeps_the_old(
     fs = tmp_path / "fs"
     fs.mkdir()
     done = subprocess.run(
-        [*_unshare(), sys.executable, "-c", ATOMIC, str(fs), str(tmp_path / "src")],
+        [*unshare_argv(), sys.executable, "-c", ATOMIC, str(fs), str(tmp_path / "src")],
         cwd=PROJECT_ROOT,
         capture_output=True,
         text=True,

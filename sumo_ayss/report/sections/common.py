@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Sequence
-from pathlib import Path
 
 from sumo_ayss.analysis.harm import VutOutcome
 from sumo_ayss.analysis.ranking import SafetyIndex
@@ -13,6 +11,7 @@ from sumo_ayss.analysis.seeds import SeedComparison
 from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p, fmt_prob
 from sumo_ayss.report.blocks import Table
 from sumo_ayss.run_folder import Estimate, RunRecord
+from sumo_ayss.util.paths import display_path
 
 __all__ = [
     "TIMID_NOTE",
@@ -46,11 +45,6 @@ def seed_points_text(members: Sequence[RunRecord], idx: SafetyIndex) -> str:
 
 def seeds_text(members: Sequence[RunRecord]) -> str:
     return ", ".join(str(r.seed) if r.seed is not None else "?" for r in members)
-
-
-def display_path(path: Path, base: Path) -> str:
-    """``path`` relative to ``base`` (the report folder), so reports carry no machine paths."""
-    return Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()
 
 
 def test_cell(c: SeedComparison | None) -> str:

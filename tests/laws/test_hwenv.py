@@ -7,7 +7,7 @@ import math
 import pytest
 
 from sumo_ayss.config import ActuatorConfig, EnvConfig, SimConfig
-from sumo_ayss.hwenv_laws import HighwayEnvIDM, HighwayEnvPov, idm_acceleration
+from sumo_ayss.laws.hwenv import HighwayEnvIDM, HighwayEnvPov, idm_acceleration
 from sumo_ayss.sim.actuator import pov_acceleration
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.vuts.hwenv_kinematics import KinematicState, bicycle_step, collision_check

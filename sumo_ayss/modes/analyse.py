@@ -1,0 +1,69 @@
+"""A case's analysis with the verdict of the mode asked for (the analysis computes every
+mode's data; the mode gives the verdict, :attr:`~sumo_ayss.modes.registry.Mode.verdict`)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Protocol, TypeVar
+
+from sumo_ayss.modes.registry import get_mode
+
+if TYPE_CHECKING:
+    from sumo_ayss.analysis.case import CaseAnalysis, CaseOptions, RunLike
+    from sumo_ayss.analysis.crossplay import CrossplayInput
+
+__all__ = ["CaseInput", "analyse_case", "analyse_cases"]
+
+R = TypeVar("R", bound="RunLike")
+
+
+class CaseInput(Protocol[R]):
+    """One case of a study as read (:class:`sumo_ayss.run_folder.CaseRuns`): its runs by VUT
+    and its cross-play table."""
+
+    @property
+    def case(self) -> str: ...
+
+    @property
+    def runs(self) -> dict[str, list[R]]: ...
+
+    @property
+    def crossplay(self) -> CrossplayInput: ...
+
+
+def analyse_case(
+    case: str,
+    runs: dict[str, list[R]],
+    options: CaseOptions,
+    *,
+    crossplay: CrossplayInput | None = None,
+    paper: bool = True,
+) -> CaseAnalysis[R]:
+    """:func:`sumo_ayss.analysis.case.analyse_case` (same arguments), its ``verdict`` given
+    by the mode ``options.mode``.
+
+    Raises:
+        ConfigError: If ``options.mode`` is not a registered mode.
+    """
+    from sumo_ayss.analysis.case import analyse_case as analyse
+
+    mode = get_mode(options.mode)
+    a = analyse(case, runs, options, crossplay=crossplay, paper=paper)
+    a.verdict = mode.verdict(a)
+    return a
+
+
+def analyse_cases(
+    cases: Sequence[CaseInput[R]], options: CaseOptions, *, paper: bool = True
+) -> list[CaseAnalysis[R]]:
+    """The analysis of every case of a study (:func:`sumo_ayss.run_folder.case_runs`), each
+    computed once, in order.
+
+    Args:
+        cases: The study's cases as read.
+        options: Statistical settings.
+        paper: Compute the paper mode (the AYSS bootstrap, the slow part).
+    """
+    return [
+        analyse_case(c.case, c.runs, options, crossplay=c.crossplay, paper=paper) for c in cases
+    ]

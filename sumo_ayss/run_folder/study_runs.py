@@ -1,0 +1,160 @@
+"""A study's runs, read: found under paths, checked to be poolable, grouped by case and VUT,
+each case with its cross-play table (:func:`load_runs`, :func:`group_runs`,
+:func:`case_runs`). Analysing them is :func:`sumo_ayss.modes.analyse_cases`'s."""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from sumo_ayss.cases import case_names
+from sumo_ayss.run_folder.crossplay import load_crossplay
+from sumo_ayss.run_folder.layout import CONFIG_YAML, find_run_dirs
+from sumo_ayss.run_folder.record import RunRecord, Training, read_run
+from sumo_ayss.util.errors import ConfigError, TableError
+from sumo_ayss.util.paths import display_path
+
+if TYPE_CHECKING:
+    from sumo_ayss.analysis.crossplay import CrossplayInput, CrossplayMatrix
+
+__all__ = [
+    "CaseRuns",
+    "case_runs",
+    "group_runs",
+    "load_runs",
+    "mixing_problems",
+    "read_case_matrix",
+]
+
+
+@dataclass(frozen=True)
+class CaseRuns:
+    """One case of a study as read: its runs by VUT and its cross-play table.
+
+    Attributes:
+        case: Case name.
+        runs: ``{vut: runs sorted by seed}`` (:func:`group_runs`).
+        crossplay: The case's cross-play table as :func:`~.crossplay.load_crossplay` found
+            it (or why there is none).
+    """
+
+    case: str
+    runs: dict[str, list[RunRecord]]
+    crossplay: CrossplayInput
+
+
+def load_runs(paths: Sequence[str | Path]) -> list[RunRecord]:
+    """The run folders among ``paths`` (and below them), loaded, checked to be poolable.
+
+    Args:
+        paths: Run folders ``<out>/<case>/<vut>/seed_<k>`` and/or roots to search.
+
+    Returns:
+        The loaded runs (:func:`~.record.read_run`), in :func:`~.layout.find_run_dirs` order.
+
+    Raises:
+        ConfigError: If ``paths`` is empty, a path is not a folder, no run folder is found,
+            or the runs must not be pooled into one report (:func:`mixing_problems`).
+    """
+    if not paths:
+        raise ConfigError("paths: expected at least one run folder or root")
+    run_dirs = find_run_dirs(paths)
+    if not run_dirs:
+        raise ConfigError(f"no run folder (with {CONFIG_YAML}) under {list(map(str, paths))}")
+    runs = [read_run(d) for d in run_dirs]
+    problems = mixing_problems(
+        [(r.case, r.vut, r.seed, display_path(r.path, Path.cwd()), r.training) for r in runs]
+    )
+    if problems:
+        raise ConfigError(
+            "these runs must not be pooled into one report (report each group separately, "
+            "e.g. one pipeline output folder at a time):\n  " + "\n  ".join(problems)
+        )
+    return runs
+
+
+def group_runs(runs: Sequence[RunRecord]) -> dict[str, dict[str, list[RunRecord]]]:
+    """Runs grouped by case, then VUT; cases in registry order (:mod:`sumo_ayss.cases`),
+    unknown ones last, VUTs and seeds sorted.
+
+    Args:
+        runs: Loaded runs.
+
+    Returns:
+        ``{case: {vut: [runs sorted by seed]}}``.
+    """
+    order = {name: i for i, name in enumerate(case_names())}
+    out: dict[str, dict[str, list[RunRecord]]] = {}
+    for case in sorted({r.case for r in runs}, key=lambda c: (order.get(c, len(order)), c)):
+        by_vut: dict[str, list[RunRecord]] = {}
+        for vut in sorted({r.vut for r in runs if r.case == case}):
+            members = [r for r in runs if r.case == case and r.vut == vut]
+            by_vut[vut] = sorted(members, key=lambda r: (r.seed is None, r.seed or 0, str(r.path)))
+        out[case] = by_vut
+    return out
+
+
+def case_runs(runs: Sequence[RunRecord]) -> list[CaseRuns]:
+    """Every case among ``runs`` in :func:`group_runs` order, each with its cross-play table
+    (:func:`~.crossplay.load_crossplay`)."""
+    return [
+        CaseRuns(case, by_vut, load_crossplay(by_vut)) for case, by_vut in group_runs(runs).items()
+    ]
+
+
+def read_case_matrix(runs: Sequence[RunRecord]) -> CrossplayMatrix:
+    """The cross-play matrix of one case's runs, scored on their harm scale, with its
+    diagonal check (:func:`~.crossplay.load_crossplay`).
+
+    Raises:
+        TableError: If there is no usable table (the message says why).
+    """
+    found = load_crossplay(next(iter(group_runs(runs).values())))
+    if found.matrix is None:
+        raise TableError(found.missing or f"no cross-play table for {runs[0].path}")
+    return found.matrix
+
+
+def mixing_problems(
+    runs: Sequence[tuple[str, str, int | None, str | Path, Training]],
+) -> list[str]:
+    """Sentences naming runs that must not be pooled into one report.
+
+    Args:
+        runs: ``(case, vut, seed, path, training)`` per run.
+
+    Returns:
+        One sentence per duplicate (case, VUT, seed) and per case whose runs have different
+        budgets or configurations (besides VUT and seed); empty when the runs can be pooled.
+    """
+    out = []
+    by_key: dict[tuple[str, str, int | None], list[str | Path]] = defaultdict(list)
+    for case, vut, seed, path, _ in runs:
+        by_key[(case, vut, seed)].append(path)
+    for (case, vut, seed), paths in by_key.items():
+        if len(paths) > 1:
+            out.append(
+                f"{case} {vut} seed {seed} appears {len(paths)} times: "
+                + ", ".join(str(p) for p in paths)
+            )
+    by_case: dict[str, dict[tuple[int | None, int | None, str], list[str | Path]]] = defaultdict(
+        lambda: defaultdict(list)
+    )
+    for case, _, _, path, t in runs:
+        by_case[case][(t.total_timesteps, t.eval_every, t.config_key)].append(path)
+    for case, groups in by_case.items():
+        if len(groups) < 2:
+            continue
+        parts = []
+        for (total, every, key), paths in groups.items():
+            parts.append(
+                f"total_timesteps={total}, eval_every={every}, config {key or '?'}: "
+                + ", ".join(str(p) for p in paths)
+            )
+        out.append(
+            f"{case}: runs with different training budgets or configurations — " + "; ".join(parts)
+        )
+    return out
