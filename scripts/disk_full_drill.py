@@ -40,7 +40,7 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from kill_drill import write_study
-from ray_cluster import ROOT, unshare_argv, can_hide
+from ray_cluster import ROOT, can_hide, unshare_argv
 from ray_drill import rank_no_run, study_files
 
 INSIDE = "SUMO_AYSS_DISK_DRILL_INSIDE"

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from scripts.ray_cluster import unshare_argv, can_hide
+from scripts.ray_cluster import can_hide, unshare_argv
 from tests.test_pipeline import PROJECT_ROOT
 
 pytestmark = pytest.mark.skipif(
