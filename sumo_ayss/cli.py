@@ -41,6 +41,15 @@ COMMANDS = {
 _invoked_as: str | None = None
 
 
+#: ``--strict``'s help, the same in every stage that prints input problems (``report``,
+#: ``rank``, ``pipeline``).
+STRICT_HELP = (
+    "exit non-zero when an input file is missing, unreadable, empty or damaged, or every "
+    "SPCP candidate of a run scored the same (each is printed as a WARNING line naming the "
+    "file, and listed in the report); for CI"
+)
+
+
 def prog(module_prog: str) -> str:
     """The program name for ``--help``: ``sumo-ayss <command>`` when run through this CLI,
     else ``module_prog`` (e.g. ``python -m sumo_ayss.train``)."""

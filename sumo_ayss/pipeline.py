@@ -52,7 +52,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, NamedTuple
 
-from sumo_ayss.cli import prog
+from sumo_ayss.cli import STRICT_HELP, prog
 from sumo_ayss.config import (
     PipelineConfig,
     check_out_dir,
@@ -107,7 +107,7 @@ class PipelineResult(NamedTuple):
     statuses: list[JobStatus]
     report: Path | None
     runs: list[RunRecord]
-    analyses: list[CaseAnalysis]
+    analyses: list[CaseAnalysis[RunRecord]]
     cfg: PipelineConfig | None = None
     notes: tuple[str, ...] = ()
 
@@ -428,7 +428,6 @@ def main(argv: Sequence[str] | None = None) -> None:
         help="no live table: one log line per job event (the default when stdout is not a "
         "terminal)",
     )
-    from sumo_ayss.report.__main__ import STRICT_HELP
 
     parser.add_argument("--strict", action="store_true", help=STRICT_HELP)
     args = parser.parse_args(argv)

@@ -79,7 +79,9 @@ __all__ = [
 ]
 
 
-def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> list[CaseAnalysis]:
+def analyse(
+    run_dirs: Sequence[Path], options: ReportOptions | None = None
+) -> list[CaseAnalysis[RunRecord]]:
     """The analysis of every case among ``run_dirs``, for ranking without the pipeline.
 
     Each run folder is read once (:func:`sumo_ayss.run_folder.read_run`) and each case
@@ -91,7 +93,7 @@ def analyse(run_dirs: Sequence[Path], options: ReportOptions | None = None) -> l
 
 def analyse_loaded(
     runs: Sequence[RunRecord], options: ReportOptions | None = None
-) -> list[CaseAnalysis]:
+) -> list[CaseAnalysis[RunRecord]]:
     """:func:`analyse` of runs already loaded."""
     from sumo_ayss.config.report import ReportOptions
 
@@ -101,7 +103,7 @@ def analyse_loaded(
     return analyse_cases(case_runs(runs), options, paper=paper)
 
 
-def available_modes(a: CaseAnalysis) -> list[str]:
+def available_modes(a: CaseAnalysis[RunRecord]) -> list[str]:
     """The modes with a ranking for this case (:attr:`~sumo_ayss.modes.Mode.available`),
     the analysis's own mode first, then the others in registry order.
     """
@@ -109,7 +111,7 @@ def available_modes(a: CaseAnalysis) -> list[str]:
     return sorted(have, key=lambda m: m != a.mode)
 
 
-def _rows(a: CaseAnalysis, mode: Mode) -> list[dict[str, Any]]:
+def _rows(a: CaseAnalysis[RunRecord], mode: Mode) -> list[dict[str, Any]]:
     """The ``ranking.csv`` rows of one case in one mode, with crashes and mobility where
     the mode reads outcomes (``CaseAnalysis.outcomes``)."""
     outcomes = a.outcomes.get(mode.name, {})
@@ -152,7 +154,7 @@ def _finite_or_empty(x: float) -> float | str:
     return x if math.isfinite(x) else ""
 
 
-def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
+def ranking_rows(analyses: Sequence[CaseAnalysis[RunRecord]]) -> list[dict[str, Any]]:
     """Ranking rows of every case, for every mode available (:func:`available_modes`: the
     analysis's mode first), safest first within a (case, mode); ``mode`` tags each row.
 
@@ -168,7 +170,7 @@ def ranking_rows(analyses: Sequence[CaseAnalysis]) -> list[dict[str, Any]]:
 
 
 def order_check(
-    a: CaseAnalysis, expected: Sequence[str], mode: str | None = None
+    a: CaseAnalysis[RunRecord], expected: Sequence[str], mode: str | None = None
 ) -> OrderCheck | None:
     """How one case's ranking in one mode compares with a known order (safest first).
 
@@ -206,7 +208,9 @@ def order_check(
     )
 
 
-def order_checks(analyses: Sequence[CaseAnalysis], expected: Sequence[str]) -> list[OrderCheck]:
+def order_checks(
+    analyses: Sequence[CaseAnalysis[RunRecord]], expected: Sequence[str]
+) -> list[OrderCheck]:
     """:func:`order_check` of every (case, mode) available, the analysis's mode first."""
     return [
         c
@@ -303,7 +307,7 @@ def _mobility_cell(row: dict[str, Any]) -> str:
 def main(argv: Sequence[str] | None = None) -> None:
     import dataclasses
 
-    from sumo_ayss.cli import prog
+    from sumo_ayss.cli import STRICT_HELP, prog
     from sumo_ayss.pipeline import (
         add_config_flags,
         config_from_args,
@@ -312,7 +316,6 @@ def main(argv: Sequence[str] | None = None) -> None:
         plan_jobs,
         run_pipeline,
     )
-    from sumo_ayss.report.__main__ import STRICT_HELP
     from sumo_ayss.report.checks import input_problems
 
     parser = argparse.ArgumentParser(

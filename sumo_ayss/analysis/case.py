@@ -239,6 +239,8 @@ class CaseAnalysis(Generic[R]):
             driver that drove in cross-play (:mod:`.reference`), the careful human first.
         scenario_set: The share of the case's scenarios that are inevitable-collision
             states, or None (not computed for this table).
+        results: ``{mode: its own result}`` for the modes that compute one from the data
+            above (:meth:`sumo_ayss.modes.Mode.compute`); opaque here.
     """
 
     case: str
@@ -265,6 +267,7 @@ class CaseAnalysis(Generic[R]):
     outcomes: dict[str, dict[str, VutOutcome]] = field(default_factory=dict)
     references: dict[str, ReferenceReading] = field(default_factory=dict)
     scenario_set: ScenarioSet | None = None
+    results: dict[str, object] = field(default_factory=dict)
 
     @property
     def ranking_mode(self) -> str:

@@ -1,4 +1,4 @@
-"""The ranking-mode registry: one :class:`Mode` record per way of ranking VUTs, one module
+"""The ranking-mode registry: one :class:`Mode` object per way of ranking VUTs, one module
 per mode, registered the way :mod:`sumo_ayss.cases` registers cases.
 
 A mode decides how a case's VUTs are scored, ranked and compared, and how its verdicts

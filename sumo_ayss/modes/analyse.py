@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Protocol, TypeVar
 
-from sumo_ayss.modes.registry import get_mode
+from sumo_ayss.modes.registry import get_mode, registered_modes
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis, CaseOptions, RunLike
@@ -39,8 +39,9 @@ def analyse_case(
     crossplay: CrossplayInput | None = None,
     paper: bool = True,
 ) -> CaseAnalysis[R]:
-    """:func:`sumo_ayss.analysis.case.analyse_case` (same arguments), its ``verdict`` given
-    by the mode ``options.mode``.
+    """:func:`sumo_ayss.analysis.case.analyse_case` (same arguments), then every registered
+    mode's own result (:meth:`~sumo_ayss.modes.registry.Mode.compute`, in ``results``), and
+    the ``verdict`` given by the mode ``options.mode``.
 
     Raises:
         ConfigError: If ``options.mode`` is not a registered mode.
@@ -49,6 +50,10 @@ def analyse_case(
 
     mode = get_mode(options.mode)
     a = analyse(case, runs, options, crossplay=crossplay, paper=paper)
+    for each in registered_modes():
+        result = each.compute(a)
+        if result is not None:
+            a.results[each.name] = result
     a.verdict = mode.verdict(a)
     return a
 

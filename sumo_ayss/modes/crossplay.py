@@ -7,19 +7,13 @@ without it the headline falls back to the exposure mode's and says so.
 
 from __future__ import annotations
 
+import functools
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.modes.formatting import fmt_p_family, ranking_line
-from sumo_ayss.modes.registry import Mode, Standing, get_mode, register_mode
-from sumo_ayss.modes.seed_level import (
-    INTERVAL_NAME,
-    paper_verdict_lines,
-    seed_ends,
-    seed_interval,
-    seed_score_text,
-    seed_standings,
-)
+from sumo_ayss.modes.registry import Standing, get_mode, register_mode
+from sumo_ayss.modes.seed_level import INTERVAL_NAME, SeedLevelMode, seed_ends, seed_standings
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
@@ -31,6 +25,7 @@ __all__ = [
     "CROSSPLAY",
     "CROSSPLAY_COMMAND",
     "NO_CROSSPLAY_TABLE",
+    "CrossplayMode",
     "crossplay_gap_text",
     "crossplay_headline",
     "crossplay_sentence",
@@ -102,14 +97,14 @@ def crossplay_gap_text(gap: CrossplayGap) -> str:
     return gap.loader or NO_CROSSPLAY_TABLE
 
 
-def _gap(a: CaseAnalysis) -> str:
+def _gap(a: CaseAnalysis[Any]) -> str:
     """Why the case has no cross-play ranking, one sentence."""
     if a.crossplay_gap is not None:
         return crossplay_gap_text(a.crossplay_gap)
     return "the cross-play table ranks fewer than two VUTs"
 
 
-def crossplay_verdict(a: CaseAnalysis) -> CaseVerdict:
+def crossplay_verdict(a: CaseAnalysis[Any]) -> CaseVerdict:
     """The cross-play mode's verdict; without a ranking of two VUTs, the exposure mode's
     in its place, as a warning."""
     import dataclasses
@@ -123,7 +118,7 @@ def crossplay_verdict(a: CaseAnalysis) -> CaseVerdict:
     return dataclasses.replace(exposure_verdict(a, EXPOSURE.name), kind="warning")
 
 
-def crossplay_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
+def crossplay_headline(a: CaseAnalysis[Any], v: CaseVerdict) -> str:
     """The cross-play mode's verdict in words; one that fell back to the exposure mode's
     says why first."""
     from sumo_ayss.analysis.seeds import SeedComparison
@@ -136,11 +131,7 @@ def crossplay_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
     return crossplay_sentence(v.top, a.crossplay_blocks)
 
 
-def _standings(a: CaseAnalysis) -> list[Standing]:
-    return seed_standings(a.crossplay_rows, lambda c: crossplay_sentence(c, a.crossplay_blocks))
-
-
-def _companion_lines(a: CaseAnalysis) -> list[str]:
+def _companion_lines(a: CaseAnalysis[Any]) -> list[str]:
     """The exposure ranking beside the cross-play one."""
     rows = a.exposure_rows
     if not rows:
@@ -149,8 +140,37 @@ def _companion_lines(a: CaseAnalysis) -> list[str]:
     return [f"Ranking (exposure mode), safest first: {line}"]
 
 
+class CrossplayMode(SeedLevelMode):
+    """Cross-play mode: its ranking, verdict and words (see the module docstring)."""
+
+    def available(self, a: CaseAnalysis[Any]) -> bool:
+        return bool(a.crossplay_rows)
+
+    def standings(self, a: CaseAnalysis[Any]) -> list[Standing]:
+        sentence = functools.partial(crossplay_sentence, blocks=a.crossplay_blocks)
+        return seed_standings(a.crossplay_rows, sentence)
+
+    def verdict(self, a: CaseAnalysis[Any]) -> CaseVerdict:
+        return crossplay_verdict(a)
+
+    def headline(self, a: CaseAnalysis[Any], v: CaseVerdict) -> str:
+        return crossplay_headline(a, v)
+
+    def unit(self, a: CaseAnalysis[Any]) -> str:
+        return "harm/episode, pooled SPCPs (lower = safer)"
+
+    def ends(self, a: CaseAnalysis[Any], safest: str, least: str) -> tuple[bool, float]:
+        return seed_ends(a.crossplay_pairs, safest, least)
+
+    def companion_lines(self, a: CaseAnalysis[Any]) -> list[str]:
+        return _companion_lines(a)
+
+    def gap_text(self, a: CaseAnalysis[Any]) -> str | None:
+        return _gap(a)
+
+
 CROSSPLAY = register_mode(
-    Mode(
+    CrossplayMode(
         name=NAME,
         description=(
             "Cross-play mode (default): every SPCP of a case drives against every VUT of the "
@@ -173,17 +193,6 @@ CROSSPLAY = register_mode(
         score_name="cross-play harm H per episode (lower = safer)",
         interval_name=INTERVAL_NAME,
         digits=3,
-        available=lambda a: bool(a.crossplay_rows),
-        standings=_standings,
-        verdict=crossplay_verdict,
-        headline=crossplay_headline,
-        unit=lambda a: "harm/episode, pooled SPCPs (lower = safer)",
-        ends=lambda a, safest, least: seed_ends(a.crossplay_pairs, safest, least),
-        score_text=seed_score_text,
-        interval_text=seed_interval,
-        companion_lines=_companion_lines,
-        closing_lines=paper_verdict_lines,
         runs_crossplay=True,
-        gap_text=_gap,
     )
 )

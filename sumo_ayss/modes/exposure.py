@@ -5,16 +5,13 @@ Always available (it reads the runs' outcome tables); a paired t-test over share
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-from sumo_ayss.modes.registry import Mode, Standing, register_mode
+from sumo_ayss.modes.registry import Standing, register_mode
 from sumo_ayss.modes.seed_level import (
     INTERVAL_NAME,
-    no_lines,
-    paper_verdict_lines,
+    SeedLevelMode,
     seed_ends,
-    seed_interval,
-    seed_score_text,
     seed_standings,
     verdict_sentence,
 )
@@ -27,6 +24,7 @@ if TYPE_CHECKING:
 __all__ = [
     "EXPOSURE",
     "EXPOSURE_SCORE",
+    "ExposureMode",
     "exposure_headline",
     "exposure_sentence",
     "exposure_verdict",
@@ -45,7 +43,7 @@ def exposure_sentence(c: SeedComparison) -> str:
     )
 
 
-def exposure_verdict(a: CaseAnalysis, name: str = NAME) -> CaseVerdict:
+def exposure_verdict(a: CaseAnalysis[Any], name: str = NAME) -> CaseVerdict:
     """The exposure mode's verdict, ranked under ``name`` (a plug-in built from this
     record ranks under its own name)."""
     from sumo_ayss.analysis.case_verdict import seed_verdict
@@ -54,7 +52,7 @@ def exposure_verdict(a: CaseAnalysis, name: str = NAME) -> CaseVerdict:
     return seed_verdict(name, a.exposure_rows, a.exposure_pairs, caution=caution)
 
 
-def exposure_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
+def exposure_headline(a: CaseAnalysis[Any], v: CaseVerdict) -> str:
     """The exposure mode's verdict in words."""
     from sumo_ayss.analysis.seeds import SeedComparison
 
@@ -66,12 +64,30 @@ def exposure_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
     return text
 
 
-def _standings(a: CaseAnalysis) -> list[Standing]:
-    return seed_standings(a.exposure_rows, exposure_sentence)
+class ExposureMode(SeedLevelMode):
+    """Exposure mode: its ranking, verdict and words (see the module docstring)."""
+
+    def available(self, a: CaseAnalysis[Any]) -> bool:
+        return bool(a.exposure_rows)
+
+    def standings(self, a: CaseAnalysis[Any]) -> list[Standing]:
+        return seed_standings(a.exposure_rows, exposure_sentence)
+
+    def verdict(self, a: CaseAnalysis[Any]) -> CaseVerdict:
+        return exposure_verdict(a, a.mode)
+
+    def headline(self, a: CaseAnalysis[Any], v: CaseVerdict) -> str:
+        return exposure_headline(a, v)
+
+    def unit(self, a: CaseAnalysis[Any]) -> str:
+        return "harm/episode, own SPCPs (lower = safer)"
+
+    def ends(self, a: CaseAnalysis[Any], safest: str, least: str) -> tuple[bool, float]:
+        return seed_ends(a.exposure_pairs, safest, least)
 
 
 EXPOSURE = register_mode(
-    Mode(
+    ExposureMode(
         name=NAME,
         description=(
             "Exposure mode: a VUT's score is the mean harm per episode its own SPCPs bring "
@@ -86,15 +102,5 @@ EXPOSURE = register_mode(
         score_name="exposure harm per episode (lower = safer)",
         interval_name=INTERVAL_NAME,
         digits=3,
-        available=lambda a: bool(a.exposure_rows),
-        standings=_standings,
-        verdict=lambda a: exposure_verdict(a, a.mode),
-        headline=exposure_headline,
-        unit=lambda a: "harm/episode, own SPCPs (lower = safer)",
-        ends=lambda a, safest, least: seed_ends(a.exposure_pairs, safest, least),
-        score_text=seed_score_text,
-        interval_text=seed_interval,
-        companion_lines=no_lines,
-        closing_lines=paper_verdict_lines,
     )
 )

@@ -12,11 +12,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p
 from sumo_ayss.modes.registry import Mode, Standing, register_mode
-from sumo_ayss.modes.seed_level import no_lines
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
@@ -27,6 +26,7 @@ if TYPE_CHECKING:
 __all__ = [
     "MIN_SEEDS_FOR_INTERVAL",
     "PAPER",
+    "PaperMode",
     "diff_interval",
     "pair_sentence",
     "paper_headline",
@@ -155,7 +155,7 @@ def significance_rule(options: SignificanceOptions) -> str:
     )
 
 
-def paper_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
+def paper_headline(a: CaseAnalysis[Any], v: CaseVerdict) -> str:
     """The paper mode's verdict in words."""
     from sumo_ayss.analysis.significance import PairVerdict
 
@@ -170,7 +170,7 @@ def paper_headline(a: CaseAnalysis, v: CaseVerdict) -> str:
     return text + _CONFOUNDED if v.caveat == "premise_not_met" else text
 
 
-def _standings(a: CaseAnalysis) -> list[Standing]:
+def _standings(a: CaseAnalysis[Any]) -> list[Standing]:
     pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
     order = [r.name for r in a.ranking]
     out = []
@@ -201,7 +201,7 @@ def _standings(a: CaseAnalysis) -> list[Standing]:
     return out
 
 
-def _ends(a: CaseAnalysis, safest: str, least: str) -> tuple[bool, float]:
+def _ends(a: CaseAnalysis[Any], safest: str, least: str) -> tuple[bool, float]:
     pair = next(
         (p for p in a.pairs if {p.verdict.name_a, p.verdict.name_b} == {safest, least}),
         None,
@@ -209,17 +209,42 @@ def _ends(a: CaseAnalysis, safest: str, least: str) -> tuple[bool, float]:
     return pair is not None and pair.safer == safest, math.nan
 
 
-def _score_text(a: CaseAnalysis, s: Standing) -> str:
+def _score_text(a: CaseAnalysis[Any], s: Standing) -> str:
     ci = fmt_interval(s.lo, s.hi)
     return f"{fmt_num(s.score)} {a.info.indicator.unit}" + (f" ({ci})" if ci else "")
 
 
-def _interval_text(lo: float, hi: float, n_seeds: int, digits: int) -> str:
-    return fmt_interval(lo, hi, digits)
+class PaperMode(Mode):
+    """Paper mode: its ranking, verdict and words (see the module docstring)."""
+
+    def available(self, a: CaseAnalysis[Any]) -> bool:
+        # Ranked in paper mode only: the bootstrap is skipped in the other modes.
+        return bool(a.ranking) and a.mode == NAME
+
+    def standings(self, a: CaseAnalysis[Any]) -> list[Standing]:
+        return _standings(a)
+
+    def verdict(self, a: CaseAnalysis[Any]) -> CaseVerdict:
+        return a.paper_verdict  # computed first, for every report
+
+    def headline(self, a: CaseAnalysis[Any], v: CaseVerdict) -> str:
+        return paper_headline(a, v)
+
+    def unit(self, a: CaseAnalysis[Any]) -> str:
+        return f"{a.info.indicator.unit} (higher = safer)"
+
+    def ends(self, a: CaseAnalysis[Any], safest: str, least: str) -> tuple[bool, float]:
+        return _ends(a, safest, least)
+
+    def score_text(self, a: CaseAnalysis[Any], s: Standing) -> str:
+        return _score_text(a, s)
+
+    def interval_text(self, lo: float, hi: float, n_seeds: int, digits: int) -> str:
+        return fmt_interval(lo, hi, digits)
 
 
 PAPER = register_mode(
-    Mode(
+    PaperMode(
         name=NAME,
         description=(
             "Paper mode: the paper's indicator, the aggressiveness of the SPCP's action in the "
@@ -230,17 +255,6 @@ PAPER = register_mode(
         score_name="safety index (higher = safer)",
         interval_name="bootstrap interval",
         digits=2,
-        # Ranked in paper mode only: the bootstrap is skipped in the other modes.
-        available=lambda a: bool(a.ranking) and a.mode == NAME,
-        standings=_standings,
-        verdict=lambda a: a.paper_verdict,  # computed first, for every report
-        headline=paper_headline,
-        unit=lambda a: f"{a.info.indicator.unit} (higher = safer)",
-        ends=_ends,
-        score_text=_score_text,
-        interval_text=_interval_text,
-        companion_lines=no_lines,
-        closing_lines=no_lines,
         needs_safety_index=True,
     )
 )

@@ -7,11 +7,11 @@ configuration validates ``report.mode`` against this registry without loading nu
 
 from __future__ import annotations
 
+import abc
 import math
 import re
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.util.registry import Registry
 from sumo_ayss.util.validation import check_choice, require
@@ -89,11 +89,13 @@ class Standing:
 
 
 @dataclass(frozen=True)
-class Mode:
+class Mode(abc.ABC):
     """A ranking mode: how a case's VUTs are scored, ranked and compared, and how that reads.
 
-    The hooks read a :class:`~sumo_ayss.analysis.case.CaseAnalysis`; a mode module imports
-    what they need inside them, so that this record stays light.
+    A mode is an object: its data are the fields below, its behaviour the methods, which
+    read a :class:`~sumo_ayss.analysis.case.CaseAnalysis`. A new mode subclasses this class
+    in one module of :mod:`sumo_ayss.modes` (its methods import what they need when called,
+    so that this module stays light) and registers an instance.
 
     Attributes:
         name: The mode's name in ``report.mode``, ``--mode`` and ``ranking.csv``.
@@ -104,26 +106,6 @@ class Mode:
         runs_crossplay: The pipeline runs the cross-play stage before the report.
         needs_safety_index: Ranking in this mode needs the AYSS safety indices (the slow
             bootstrap); a ranking in another mode skips them.
-        available: Whether the mode has a ranking of this case.
-        standings: The case's ranking in this mode, safest first.
-        verdict: The case's verdict when this mode was asked for, as a record (called by
-            the analysis after every mode's data is computed); its ``mode`` is another
-            mode's when this one has no ranking and falls back to it.
-        headline: The verdict record in words: ``(analysis, verdict) -> sentence``, for a
-            verdict this mode gave (or fell back from).
-        unit: The score's unit text in ``ranking.csv`` and ``ranking.md``.
-        ends: ``(found, p)`` for a known safest and least safe VUT: whether this mode
-            finds the first significantly safer than the second, and the p-value (NaN when
-            the mode has none).
-        score_text: The score with its interval as the leaderboard writes it.
-        interval_text: ``(lo, hi, n_seeds, digits)`` -> the interval as ``ranking.md``
-            writes it ("" without one).
-        companion_lines: Verdict-callout lines after the ranking line, when this mode gave
-            the headline (e.g. the other modes' rankings).
-        closing_lines: Verdict-callout lines after the premise check, when this mode was
-            asked for.
-        gap_text: Why the mode has no ranking of a case, one sentence
-            (:func:`missing_rows_line`); None: a generic sentence.
     """
 
     name: str
@@ -131,25 +113,76 @@ class Mode:
     score_name: str
     interval_name: str
     digits: int
-    available: Callable[[CaseAnalysis], bool]
-    standings: Callable[[CaseAnalysis], list[Standing]]
-    verdict: Callable[[CaseAnalysis], CaseVerdict]
-    headline: Callable[[CaseAnalysis, CaseVerdict], str]
-    unit: Callable[[CaseAnalysis], str]
-    ends: Callable[[CaseAnalysis, str, str], tuple[bool, float]]
-    score_text: Callable[[CaseAnalysis, Standing], str]
-    interval_text: Callable[[float, float, int, int], str]
-    companion_lines: Callable[[CaseAnalysis], list[str]]
-    closing_lines: Callable[[CaseAnalysis], list[str]]
     runs_crossplay: bool = False
     needs_safety_index: bool = False
-    gap_text: Callable[[CaseAnalysis], str] | None = None
 
     def __post_init__(self) -> None:
         require(
             isinstance(self.name, str) and _NAME.fullmatch(self.name) is not None,
             f"mode name must be lower-case letters, digits and '_', got {self.name!r}",
         )
+
+    @abc.abstractmethod
+    def available(self, a: CaseAnalysis[Any]) -> bool:
+        """Whether the mode has a ranking of this case."""
+
+    @abc.abstractmethod
+    def standings(self, a: CaseAnalysis[Any]) -> list[Standing]:
+        """The case's ranking in this mode, safest first."""
+
+    @abc.abstractmethod
+    def verdict(self, a: CaseAnalysis[Any]) -> CaseVerdict:
+        """The case's verdict when this mode was asked for, as a record (called after every
+        mode's data is computed); its ``mode`` is another mode's when this one has no
+        ranking and falls back to it."""
+
+    @abc.abstractmethod
+    def headline(self, a: CaseAnalysis[Any], v: CaseVerdict) -> str:
+        """The verdict record ``v`` in words, for a verdict this mode gave (or fell back
+        from)."""
+
+    @abc.abstractmethod
+    def unit(self, a: CaseAnalysis[Any]) -> str:
+        """The score's unit text in ``ranking.csv`` and ``ranking.md``."""
+
+    @abc.abstractmethod
+    def ends(self, a: CaseAnalysis[Any], safest: str, least: str) -> tuple[bool, float]:
+        """``(found, p)`` for a known safest and least safe VUT: whether this mode finds the
+        first significantly safer than the second, and the p-value (NaN when it has none)."""
+
+    @abc.abstractmethod
+    def score_text(self, a: CaseAnalysis[Any], s: Standing) -> str:
+        """The score with its interval as the leaderboard writes it."""
+
+    @abc.abstractmethod
+    def interval_text(self, lo: float, hi: float, n_seeds: int, digits: int) -> str:
+        """The interval as ``ranking.md`` writes it ("" without one)."""
+
+    def companion_lines(self, a: CaseAnalysis[Any]) -> list[str]:
+        """Verdict-callout lines after the ranking line, when this mode gave the headline
+        (e.g. the other modes' rankings); none by default."""
+        return []
+
+    def closing_lines(self, a: CaseAnalysis[Any]) -> list[str]:
+        """Verdict-callout lines after the premise check, when this mode was asked for;
+        none by default."""
+        return []
+
+    def compute(self, a: CaseAnalysis[Any]) -> object | None:
+        """The mode's own result from the case's data, kept in ``a.results[name]`` (by
+        :func:`~sumo_ayss.modes.analyse_case`, before any verdict); None (the default): the
+        mode reads what the analysis computed for every mode."""
+        return None
+
+    def section(self, a: CaseAnalysis[Any]) -> tuple[str, list[str]] | None:
+        """The report's section of this mode for a case, ``(title, paragraphs)``, after the
+        built-in sections; None (the default): none of its own."""
+        return None
+
+    def gap_text(self, a: CaseAnalysis[Any]) -> str | None:
+        """Why the mode has no ranking of a case, one sentence (:func:`missing_rows_line`);
+        None (the default): a generic sentence."""
+        return None
 
 
 # --------------------------------------------------------------------------- the registry
@@ -193,19 +226,19 @@ def check_mode(name: str, where: str = "report.mode") -> Mode:
     return get_mode(name)
 
 
-def headline_text(a: CaseAnalysis) -> str:
+def headline_text(a: CaseAnalysis[Any]) -> str:
     """The case's headline: its verdict (``a.verdict``) worded by the mode asked for."""
     return get_mode(a.mode).headline(a, a.verdict)
 
 
-def missing_rows_line(a: CaseAnalysis) -> str | None:
+def missing_rows_line(a: CaseAnalysis[Any]) -> str | None:
     """One line saying why the mode asked for (``a.mode``) has no rows for the case and
     which mode's rows stand in their place, for ``ranking.md``, the report's leaderboard
     and the terminal; None when it has them."""
     mode = get_mode(a.mode)
     if mode.available(a):
         return None
-    why = mode.gap_text(a) if mode.gap_text is not None else "this mode has no ranking of it"
+    why = mode.gap_text(a) or "this mode has no ranking of it"
     why = why.rstrip(". ")
     instead = (
         f"; the {a.ranking_mode}-mode rows stand in their place" if a.ranking_mode != a.mode else ""

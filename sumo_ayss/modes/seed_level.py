@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.modes.formatting import (
     fmt_interval,
@@ -18,7 +18,7 @@ from sumo_ayss.modes.formatting import (
     ranking_line,
     seed_interval_text,
 )
-from sumo_ayss.modes.registry import Standing, get_mode
+from sumo_ayss.modes.registry import Mode, Standing, get_mode
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
@@ -26,6 +26,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "INTERVAL_NAME",
+    "SeedLevelMode",
     "no_lines",
     "paper_verdict_lines",
     "seed_ends",
@@ -165,12 +166,12 @@ def seed_interval(lo: float, hi: float, n_seeds: int, digits: int) -> str:
     return seed_interval_text(lo, hi, n_seeds, digits)
 
 
-def seed_score_text(a: CaseAnalysis, s: Standing) -> str:
+def seed_score_text(a: CaseAnalysis[Any], s: Standing) -> str:
     """A seed-level score with its interval, three decimals, as the leaderboard writes it."""
     return f"{fmt_num(s.score, 3)} ({seed_interval(s.lo, s.hi, s.n_seeds, 3)})"
 
 
-def paper_verdict_lines(a: CaseAnalysis) -> list[str]:
+def paper_verdict_lines(a: CaseAnalysis[Any]) -> list[str]:
     """The paper mode's verdict, closing the callout of a mode that is not the paper's."""
     v = a.paper_verdict
     line = get_mode(v.mode).headline(a, v)
@@ -179,6 +180,21 @@ def paper_verdict_lines(a: CaseAnalysis) -> list[str]:
     return [line]
 
 
-def no_lines(a: CaseAnalysis) -> list[str]:
+def no_lines(a: CaseAnalysis[Any]) -> list[str]:
     """No further verdict lines."""
     return []
+
+
+class SeedLevelMode(Mode):
+    """A mode whose score is a per-seed mean compared by a paired test over seeds (exposure,
+    cross-play): its interval and score read alike, and its callout closes with the paper
+    mode's verdict."""
+
+    def score_text(self, a: CaseAnalysis[Any], s: Standing) -> str:
+        return seed_score_text(a, s)
+
+    def interval_text(self, lo: float, hi: float, n_seeds: int, digits: int) -> str:
+        return seed_interval(lo, hi, n_seeds, digits)
+
+    def closing_lines(self, a: CaseAnalysis[Any]) -> list[str]:
+        return paper_verdict_lines(a)

@@ -17,7 +17,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from sumo_ayss.cli import prog
+from sumo_ayss.cli import STRICT_HELP, prog
 from sumo_ayss.config import check_out_dir
 from sumo_ayss.modes import analyse_cases
 from sumo_ayss.report.checks import input_problems
@@ -26,11 +26,6 @@ from sumo_ayss.run_folder import case_runs, load_runs
 from sumo_ayss.util.errors import AyssError
 
 #: ``--strict``'s help, also quoted by ``rank --strict``.
-STRICT_HELP = (
-    "exit non-zero when an input file is missing, unreadable, empty or damaged, or every "
-    "SPCP candidate of a run scored the same (each is printed as a WARNING line naming the "
-    "file, and listed in the report); for CI"
-)
 
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:

@@ -35,6 +35,7 @@ from sumo_ayss.run_folder import Training
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
+    from sumo_ayss.run_folder import RunRecord
 
 TRUSTED_TIMESTEPS = min(b.total_timesteps for b in BUDGETS.values())
 """Training transitions per run below which verdicts are flagged as not to be trusted: the
@@ -176,7 +177,7 @@ def improving_runs(runs: Sequence[tuple[str, Training]]) -> list[str]:
     return [label for label, t in runs if t.still_improving]
 
 
-def input_problems(analyses: Sequence[CaseAnalysis]) -> list[str]:
+def input_problems(analyses: Sequence[CaseAnalysis[RunRecord]]) -> list[str]:
     """The problems of the analysed cases' input files, one console line each.
 
     They are the lines of the report's "Missing or incomplete data" callouts

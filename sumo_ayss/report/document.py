@@ -87,7 +87,7 @@ def build_report(
     *,
     title: str = DEFAULT_TITLE,
     options: ReportOptions | None = None,
-    analyses: Sequence[CaseAnalysis] | None = None,
+    analyses: Sequence[CaseAnalysis[RunRecord]] | None = None,
 ) -> Report:
     """Computes the statistics, draws the figures into ``out_dir`` and assembles the blocks.
 
@@ -166,7 +166,7 @@ def build_report(
     return Report(title, subtitle, tuple(blocks))
 
 
-def modes_paragraph(analyses: Sequence[CaseAnalysis], mode: str) -> str:
+def modes_paragraph(analyses: Sequence[CaseAnalysis[RunRecord]], mode: str) -> str:
     """Which mode the verdicts above are in, as it happened: the mode asked for, the one a
     case fell back to, or that no case had a verdict (fewer than two VUTs)."""
     with_verdict = [a for a in analyses if len(a.runs) >= 2]
@@ -216,7 +216,7 @@ def write_report_for(
     runs: Sequence[RunRecord],
     out_dir: Path,
     *,
-    analyses: Sequence[CaseAnalysis] | None = None,
+    analyses: Sequence[CaseAnalysis[RunRecord]] | None = None,
     title: str = DEFAULT_TITLE,
     options: ReportOptions | None = None,
 ) -> Path:

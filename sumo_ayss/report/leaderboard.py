@@ -36,6 +36,7 @@ from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p, rank_labels
 from sumo_ayss.report.blocks import Table
 from sumo_ayss.report.sections.common import crash_cell, mobility_cell
 from sumo_ayss.report.sections.reference import preventable_text
+from sumo_ayss.run_folder import RunRecord
 
 __all__ = [
     "COLUMNS",
@@ -125,7 +126,7 @@ def _vs_next(s: Standing, digits: int) -> str:
     return f"{head} {margin}; {p}" if margin else f"{head}; {p}"
 
 
-def leaderboard_rows(a: CaseAnalysis) -> list[LeaderRow]:
+def leaderboard_rows(a: CaseAnalysis[RunRecord]) -> list[LeaderRow]:
     """The leaderboard of one case in its ranking mode, safest first (empty without one).
 
     The crash rates and mobility are the ranking mode's outcomes, else the VUTs' own
@@ -161,7 +162,7 @@ def _human_cells(r: ReferenceComparison | None) -> tuple[str, str]:
     return prevent, f"{r.verdict} (Holm p {fmt_p(r.p_adjusted)})"
 
 
-def leaderboard_table(a: CaseAnalysis, level: float) -> Table | None:
+def leaderboard_table(a: CaseAnalysis[RunRecord], level: float) -> Table | None:
     """The case's leaderboard as a report table, or None without a ranking."""
     rows = leaderboard_rows(a)
     if not rows:
@@ -195,7 +196,7 @@ def leaderboard_table(a: CaseAnalysis, level: float) -> Table | None:
     )
 
 
-def leaderboard_text(analyses: Sequence[CaseAnalysis], width: int = 80) -> str:
+def leaderboard_text(analyses: Sequence[CaseAnalysis[RunRecord]], width: int = 80) -> str:
     """Every case's leaderboard as plain text that fits ``width`` columns.
 
     A case takes a title line and a line naming its score; each VUT a line with rank, name,

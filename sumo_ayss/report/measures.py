@@ -32,7 +32,13 @@ from sumo_ayss.analysis.measure_ranking import (
 )
 from sumo_ayss.analysis.r157 import R157_TIME_MARGIN_S, R157_TIME_S, must_avoid_column
 from sumo_ayss.modes import CROSSPLAY, EXPOSURE
-from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, StudyFolder, read_table, write_measures_csv
+from sumo_ayss.run_folder import (
+    CROSSPLAY_SCHEMA,
+    RunRecord,
+    StudyFolder,
+    read_table,
+    write_measures_csv,
+)
 from sumo_ayss.util.errors import AyssError
 
 __all__ = ["CaseMeasures", "case_measures", "write_measures"]
@@ -76,13 +82,13 @@ class CaseMeasures:
     primary_apart: tuple[bool, ...] = ()
 
 
-def _primary(a: CaseAnalysis) -> tuple[str, tuple[str, ...]]:
+def _primary(a: CaseAnalysis[RunRecord]) -> tuple[str, tuple[str, ...]]:
     if a.crossplay_rows:
         return CROSSPLAY.name, tuple(r.name for r in a.crossplay_rows)
     return EXPOSURE.name, tuple(r.name for r in a.exposure_rows)
 
 
-def _pool_columns(a: CaseAnalysis) -> tuple[str, dict[str, np.ndarray]] | None:
+def _pool_columns(a: CaseAnalysis[RunRecord]) -> tuple[str, dict[str, np.ndarray]] | None:
     """The pool's episodes: vut, group (the bootstrap unit), collided and the measures."""
     if a.crossplay_path is not None and a.crossplay_path.is_file():
         t = read_table(a.crossplay_path, CROSSPLAY_SCHEMA)
@@ -115,7 +121,7 @@ def _measure_columns() -> list[str]:
 
 
 def case_measures(
-    a: CaseAnalysis, *, level: float = 0.95, r157_time_s: float = R157_TIME_S
+    a: CaseAnalysis[RunRecord], *, level: float = 0.95, r157_time_s: float = R157_TIME_S
 ) -> CaseMeasures | str:
     """The measures of case ``a``, or one sentence saying why there are none.
 
@@ -182,7 +188,7 @@ def case_measures(
     )
 
 
-def _primary_apart(a: CaseAnalysis, mode: str) -> tuple[bool, ...]:
+def _primary_apart(a: CaseAnalysis[RunRecord], mode: str) -> tuple[bool, ...]:
     """Per adjacent pair of the primary ranking, whether its (family-adjusted) test
     separates them."""
     rows = a.crossplay_rows if mode == CROSSPLAY.name else a.exposure_rows
@@ -242,7 +248,7 @@ def _rows(m: CaseMeasures) -> list[dict[str, object]]:
     return rows
 
 
-def write_measures(out: Path, analyses: Sequence[CaseAnalysis]) -> Path | None:
+def write_measures(out: Path, analyses: Sequence[CaseAnalysis[RunRecord]]) -> Path | None:
     """``<out>/measures.csv`` of every case with recorded measures
     (:func:`~sumo_ayss.run_folder.write_measures_csv`); None if none."""
     rows: list[dict[str, object]] = []

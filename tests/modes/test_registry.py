@@ -16,12 +16,14 @@ from sumo_ayss.modes import (
     DEFAULT_MODE,
     EXPOSURE,
     PAPER,
+    Mode,
     check_mode,
     get_mode,
     mode_names,
     register_mode,
     unregister_mode,
 )
+from sumo_ayss.modes.exposure import ExposureMode
 from sumo_ayss.rank import analyse, ranking_rows
 from sumo_ayss.util.errors import ConfigError
 from tests.report.test_report import make_run
@@ -50,6 +52,15 @@ def test_an_unknown_mode_is_refused_with_the_registered_ones_named() -> None:
     assert ReportOptions(mode="nonsense").mode == "nonsense"  # the stages check the registry
 
 
+def test_a_mode_is_an_object_without_callable_fields() -> None:
+    """Its behaviour is methods; its fields are data (no callables, no lambdas)."""
+    for mode in (CROSSPLAY, EXPOSURE, PAPER):
+        assert isinstance(mode, Mode)
+        assert not any(callable(getattr(mode, f.name)) for f in dataclasses.fields(mode))
+    with pytest.raises(TypeError, match="abstract"):
+        Mode(name="x", description="", score_name="", interval_name="", digits=1)  # type: ignore[abstract]
+
+
 def test_registering_another_record_under_a_taken_name_needs_replace() -> None:
     with pytest.raises(ConfigError, match="already registered"):
         register_mode(dataclasses.replace(EXPOSURE, digits=4))
@@ -59,7 +70,14 @@ def test_registering_another_record_under_a_taken_name_needs_replace() -> None:
 def test_a_new_mode_is_one_record_that_config_and_rank_pick_up(tmp_path) -> None:
     """A mode registered at run time (here: exposure's ranking under another name and
     unit) is accepted by ``report.mode``, heads the ranking and tags its rows."""
-    mode = dataclasses.replace(EXPOSURE, name="own_harm", unit=lambda a: "harm (plug-in)")
+
+    @dataclasses.dataclass(frozen=True)
+    class OwnHarm(ExposureMode):
+        def unit(self, a: object) -> str:
+            return "harm (plug-in)"
+
+    fields = {f.name: getattr(EXPOSURE, f.name) for f in dataclasses.fields(EXPOSURE)}
+    mode = OwnHarm(**{**fields, "name": "own_harm"})
     register_mode(mode)
     try:
         dirs = [make_run(tmp_path, "car_following", v, s) for v in ("pi1", "pi2") for s in (0, 1)]

@@ -14,7 +14,7 @@ import numpy as np
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.config.report import ReportOptions
-from sumo_ayss.modes import get_mode, headline_text
+from sumo_ayss.modes import get_mode, headline_text, registered_modes
 from sumo_ayss.modes.formatting import fmt_num, ranking_line
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragraph, Table
@@ -31,12 +31,13 @@ from sumo_ayss.report.sections.outcome import (
 )
 from sumo_ayss.report.sections.paper import paper_blocks
 from sumo_ayss.report.sections.reference import reference_blocks
+from sumo_ayss.run_folder import RunRecord
 
 __all__ = ["case_blocks", "verdict_lines"]
 
 
 def case_blocks(
-    a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
+    a: CaseAnalysis[RunRecord], colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
     info, case = a.info, a.case
     anchor = f"case-{case}"
@@ -58,10 +59,14 @@ def case_blocks(
     blocks += crossplay_blocks(a, colors, out_dir, options)
     blocks += measures_blocks(a, colors, out_dir, options)
     blocks += reference_blocks(a)
+    for mode in registered_modes():  # a mode's own section (none for the built-in ones)
+        section = mode.section(a)
+        if section is not None:
+            blocks += [Heading(section[0], 3), *(Paragraph(p) for p in section[1])]
     return blocks
 
 
-def verdict_lines(a: CaseAnalysis, options: ReportOptions) -> tuple[str, ...]:
+def verdict_lines(a: CaseAnalysis[RunRecord], options: ReportOptions) -> tuple[str, ...]:
     """The verdict callout: the mode's headline and ranking, the premise, the other modes."""
     v = a.verdict
     lines = [headline_text(a)]
@@ -73,7 +78,7 @@ def verdict_lines(a: CaseAnalysis, options: ReportOptions) -> tuple[str, ...]:
     return tuple(lines)
 
 
-def reward_blocks(a: CaseAnalysis, out_dir: Path) -> list[Block]:
+def reward_blocks(a: CaseAnalysis[RunRecord], out_dir: Path) -> list[Block]:
     blocks: list[Block] = [Heading("(a) Reward shapes", 3)]
     rewards = [r.reward for rs in a.runs.values() for r in rs if r.reward is not None]
     if not rewards:
@@ -90,7 +95,9 @@ def reward_blocks(a: CaseAnalysis, out_dir: Path) -> list[Block]:
     return [*blocks, FigureBlock(path, caption)]
 
 
-def learning_blocks(a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path) -> list[Block]:
+def learning_blocks(
+    a: CaseAnalysis[RunRecord], colors: Mapping[str, str], out_dir: Path
+) -> list[Block]:
     path = figures.learning_curves_figure(
         a.runs,
         colors,
@@ -130,7 +137,7 @@ def learning_blocks(a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path) -
 
 
 def indicator_blocks(
-    a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
+    a: CaseAnalysis[RunRecord], colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
     info = a.info
     edges = options.figure_edges

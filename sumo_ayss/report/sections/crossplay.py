@@ -28,7 +28,7 @@ from sumo_ayss.report.sections.common import (
     pairs_table,
     test_cell,
 )
-from sumo_ayss.run_folder import CaseFolder, read_adaptive
+from sumo_ayss.run_folder import CaseFolder, RunRecord, read_adaptive
 from sumo_ayss.util.errors import TableError
 
 __all__ = ["crossplay_blocks"]
@@ -40,7 +40,7 @@ BLOCK_WORDS = {
 
 
 def crossplay_blocks(
-    a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
+    a: CaseAnalysis[RunRecord], colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
     """(i) Explanation, ranking table, pairwise comparisons and the per-opponent figure."""
     blocks: list[Block] = [Heading("(i) Cross-play ranking", 3)]
@@ -142,7 +142,7 @@ def crossplay_blocks(
     return blocks
 
 
-def _diagonal_block(a: CaseAnalysis) -> Block:
+def _diagonal_block(a: CaseAnalysis[RunRecord]) -> Block:
     """The diagonal check: every SPCP against its own VUT reproduced its outcome table."""
     checks = a.crossplay_diagonal
     if not checks:
@@ -165,7 +165,7 @@ def _diagonal_block(a: CaseAnalysis) -> Block:
     )
 
 
-def _adaptive_blocks(a: CaseAnalysis) -> list[Block]:
+def _adaptive_blocks(a: CaseAnalysis[RunRecord]) -> list[Block]:
     """Adaptive seeding's looks at this case (``adaptive.json`` beside the cross-play table),
     when the pipeline added seeds adaptively; nothing for a fixed grid."""
     if a.crossplay_path is None:

@@ -23,6 +23,7 @@ from sumo_ayss.modes.formatting import fmt_num, ranking_line
 from sumo_ayss.report.blocks import Block, FigureBlock, Heading, Paragraph, Table
 from sumo_ayss.report.figstyle import save, style
 from sumo_ayss.report.measures import CaseMeasures, case_measures
+from sumo_ayss.run_folder import RunRecord
 
 __all__ = ["measures_blocks", "with_ceiling"]
 
@@ -32,7 +33,7 @@ def _cell(x: float, digits: int = 2) -> str:
 
 
 def measures_blocks(
-    a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
+    a: CaseAnalysis[RunRecord], colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
     """(j) Distribution table and figure per measure, the per-measure rankings, R157."""
     blocks: list[Block] = [Heading("(j) Surrogate safety measures", 3)]

@@ -30,7 +30,7 @@ from sumo_ayss.report.sections.common import (
     test_cell,
 )
 from sumo_ayss.report.seed_figure import seed_scores_figure
-from sumo_ayss.run_folder import Outcome
+from sumo_ayss.run_folder import Outcome, RunRecord
 
 __all__ = ["exposure_blocks", "outcome_blocks", "premise_blocks"]
 
@@ -51,7 +51,7 @@ def _outcome_cells(o: Outcome) -> dict[str, str]:
     }
 
 
-def outcome_blocks(a: CaseAnalysis) -> list[Block]:
+def outcome_blocks(a: CaseAnalysis[RunRecord]) -> list[Block]:
     columns = a.info.outcome_columns
     pct = "95 % CI"
     headers = ("VUT", "seed", "episodes", *(OUTCOME_COLUMNS[c] for c in columns))
@@ -131,7 +131,7 @@ def premise_sentence(premise: Premise | None, options: ReportOptions) -> str:
     )
 
 
-def premise_blocks(a: CaseAnalysis, options: ReportOptions) -> list[Block]:
+def premise_blocks(a: CaseAnalysis[RunRecord], options: ReportOptions) -> list[Block]:
     blocks: list[Block] = [Heading("(e) Premise check: the same overall outcome?", 3)]
     premise = a.premise
     if premise is None or not premise.metrics:
@@ -182,7 +182,7 @@ def premise_blocks(a: CaseAnalysis, options: ReportOptions) -> list[Block]:
 
 
 def exposure_blocks(
-    a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
+    a: CaseAnalysis[RunRecord], colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
     blocks: list[Block] = [Heading("(f) Exposure ranking", 3)]
     blocks.append(Paragraph(EXPOSURE.description))

@@ -19,6 +19,7 @@ from sumo_ayss.modes.paper import (
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, BulletList, FigureBlock, Heading, Paragraph, Table
 from sumo_ayss.report.sections.common import seed_points_text
+from sumo_ayss.run_folder import RunRecord
 
 __all__ = ["paper_blocks"]
 
@@ -37,7 +38,7 @@ def _index_interval(lo: float, hi: float, n_seeds: int) -> str:
 
 
 def paper_blocks(
-    a: CaseAnalysis, colors: Mapping[str, str], out_dir: Path, options: ReportOptions
+    a: CaseAnalysis[RunRecord], colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
     info = a.info
     unit = info.indicator.unit

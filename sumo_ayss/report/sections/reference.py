@@ -9,6 +9,7 @@ from sumo_ayss.analysis.reference import ReferenceComparison, ReferenceReading
 from sumo_ayss.modes.formatting import fmt_num, fmt_prob
 from sumo_ayss.report.blocks import Block, Heading, Paragraph, Table
 from sumo_ayss.report.sections.common import crash_text
+from sumo_ayss.run_folder import RunRecord
 
 __all__ = [
     "EXPLANATION",
@@ -118,7 +119,7 @@ def _scenario_line(reading: ReferenceReading, case: str) -> str:
     )
 
 
-def scenario_set_line(a: CaseAnalysis) -> str:
+def scenario_set_line(a: CaseAnalysis[RunRecord]) -> str:
     """One sentence on the scenario set's inevitable-collision states ("" without them)."""
     ss = a.scenario_set
     if ss is None:
@@ -133,7 +134,7 @@ def scenario_set_line(a: CaseAnalysis) -> str:
     )
 
 
-def reference_blocks(a: CaseAnalysis) -> list[Block]:
+def reference_blocks(a: CaseAnalysis[RunRecord]) -> list[Block]:
     """(k) The case's VUTs against each reference driver that drove in cross-play, and the
     scenario set's inevitable-collision states."""
     if not a.references and a.scenario_set is None:
@@ -159,7 +160,7 @@ def reference_blocks(a: CaseAnalysis) -> list[Block]:
     return blocks
 
 
-def reference_markdown(analyses: Sequence[CaseAnalysis]) -> list[str]:
+def reference_markdown(analyses: Sequence[CaseAnalysis[RunRecord]]) -> list[str]:
     """``ranking.md`` lines: per case, the VUTs against each reference driver."""
     lines: list[str] = []
     for a in analyses:
