@@ -69,7 +69,7 @@ from sumo_ayss.grid.plan import plan_jobs, plan_seed
 from sumo_ayss.grid.progress import JobStatus
 from sumo_ayss.modes import analyse_cases, check_mode, get_mode
 from sumo_ayss.run_folder import RunRecord, StudyFolder, case_runs, load_runs, write_pipeline_json
-from sumo_ayss.util.errors import AyssError
+from sumo_ayss.util.errors import AyssError, DiskFullError
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
@@ -319,6 +319,8 @@ def run_crossplay_stage(
                 reference=cfg.evaluate.reference,
                 references=cfg.evaluate.reference_rows,
             )
+        except DiskFullError:
+            raise
         except AyssError as e:  # never fatal: the report says the table is missing
             logger.warning("cross-play of %s failed: %s", case, e)
             continue
@@ -340,7 +342,7 @@ def write_discriminability(cfg: PipelineConfig) -> None:
     if len(cfg.grid.vuts) < 2:
         return
     from sumo_ayss import discriminability
-    from sumo_ayss.util.errors import AyssError
+    from sumo_ayss.util.errors import AyssError, DiskFullError
 
     for case in cfg.grid.cases:
         logger.info(
@@ -352,6 +354,8 @@ def write_discriminability(cfg: PipelineConfig) -> None:
         try:
             env = discriminability.pipeline_env(cfg, case)
             discriminability.ensure(env, cfg.grid.vuts, StudyFolder(cfg.out).case(case).path)
+        except DiskFullError:
+            raise
         except (AyssError, ImportError, OSError) as e:  # never fatal: the report says so
             logger.warning("discriminability of %s not computed: %s", case, e)
 
