@@ -141,6 +141,10 @@ class PipelineConfig:
     two ends differ significantly. Empty: no known order."""
     workers: int = 0
     retries: int = 1
+    follower: bool | None = None
+    """A follower behind the VUT in every case's evaluation episodes (true) or in none
+    (false; the paper's protocol); None: as each experiment's ``env.follower.enabled``
+    says (the shipped ``configs/<case>.yaml``: on)."""
 
     def __post_init__(self) -> None:
         if self.budget is not None:

@@ -261,18 +261,22 @@ def read_crossplay_matrix(path: Path, scale: HarmScale) -> CrossplayMatrix:
     """
     from sumo_ayss.analysis.crossplay import crossplay_matrix
     from sumo_ayss.analysis.harm import episode_harm
+    from sumo_ayss.analysis.hazards import VUT_HAZARD_COLUMNS, harm_crash
 
     c = read_table(path, CROSSPLAY_SCHEMA).columns
     pay = scale.near_miss_pay(c["near_miss_pay"], c["episode_return"], c["collided"])
+    # A rear-end the VUT caused by braking for nothing counts as a crash (issue 33).
+    crash = harm_crash(c["collided"], c["rear_end_unjustified"])
     return crossplay_matrix(
         c["vut"],
         c["opponent_vut"],
         c["opponent_seed"],
-        episode_harm(pay, c["collided"], scale.max_episode_pay),
+        episode_harm(pay, crash, scale.max_episode_pay),
         c["collided"],
         episode_return=c["episode_return"],
         mobility=c["vut_mean_speed_mps"],
         preventable=c["crash_preventable"],
+        hazards={name: c[name] for name in VUT_HAZARD_COLUMNS},
     )
 
 

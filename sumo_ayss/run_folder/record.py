@@ -263,10 +263,12 @@ def episode_stats(table: Table, scale: HarmScale) -> EpisodeStats:
     """An outcome table reduced to harm, crashes and mobility (:mod:`~sumo_ayss.analysis.
     harm`; a table written before ``near_miss_pay`` existed derives it from the return)."""
     from sumo_ayss.analysis.harm import EpisodeStats, episode_harm
+    from sumo_ayss.analysis.hazards import harm_crash
 
     c = table.columns
     pay = scale.near_miss_pay(c["near_miss_pay"], c["episode_return"], c["collided"])
-    harm = episode_harm(pay, c["collided"], scale.max_episode_pay)
+    crash = harm_crash(c["collided"], c["rear_end_unjustified"])  # issue 33
+    harm = episode_harm(pay, crash, scale.max_episode_pay)
     return EpisodeStats.of(harm, c["collided"], c["vut_mean_speed_mps"])
 
 
