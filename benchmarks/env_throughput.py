@@ -5,6 +5,10 @@ Both run in this one process, one after the other, on the same scene (one VUT-PO
 libsumo calls the scene needs, with no Python env around it: it is the ceiling.
 
     python benchmarks/env_throughput.py [--steps 60000] [--repeats 3]
+    python benchmarks/env_throughput.py --follower    # the cost of issue 33's follower
+
+With ``--follower`` each case runs twice on the outcome stage's path (every reset from a
+given initial condition of a scenario set): without and with the follower behind the VUT.
 
 Targets (issue 2): >= 30,000 env steps/s and >= 35 % of the raw loop.
 """
@@ -34,6 +38,31 @@ def bench_env(env_cls: type, steps: int) -> float:
         _, _, term, trunc, _ = env.step(int(a))
         if term or trunc:
             env.reset()
+    dt = time.perf_counter() - t0
+    env.close()
+    return steps / dt
+
+
+def bench_follower(case: str, steps: int, follower: bool) -> float:
+    """Env steps/s on given initial conditions (the outcome stage's resets), with or
+    without the follower (issue 33), random actions."""
+    from sumo_ayss.config import EnvConfig, FollowerConfig
+    from sumo_ayss.envs import make_env
+    from sumo_ayss.envs.odd import sample_initial_conditions, with_followers
+
+    cfg = EnvConfig(case=case, follower=FollowerConfig(enabled=follower))
+    ics = with_followers(sample_initial_conditions(cfg.odd, steps // 10 + 1, 0), cfg.follower, 0)
+    env = make_env(cfg, sumo_seed=0)
+    rng = np.random.default_rng(0)
+    actions = rng.integers(0, env.action_space.n, size=steps)
+    k = 0
+    env.reset(options={"initial_condition": ics[k]})
+    t0 = time.perf_counter()
+    for a in actions:
+        _, _, term, trunc, _ = env.step(int(a))
+        if term or trunc:
+            k += 1
+            env.reset(options={"initial_condition": ics[k]})
     dt = time.perf_counter() - t0
     env.close()
     return steps / dt
@@ -82,7 +111,19 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=60_000)
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--follower", action="store_true", help="the follower's cost")
     args = parser.parse_args()
+    if args.follower:
+        print(f"{'case':<16}{'follower':>9}{'steps/s (median)':>18}{'min':>10}{'max':>10}")
+        for case in ("car_following", "cut_in"):
+            for on in (False, True):
+                runs = [bench_follower(case, args.steps, on) for _ in range(args.repeats)]
+                med = statistics.median(runs)
+                print(
+                    f"{case:<16}{'on' if on else 'off':>9}{med:>18,.0f}{min(runs):>10,.0f}"
+                    f"{max(runs):>10,.0f}"
+                )
+        return
     cases: dict[str, object] = {"CarFollowing-v0": CarFollowingEnv}
     try:
         from sumo_ayss.envs.cut_in import CutInEnv

@@ -32,3 +32,4 @@ paper_study configs/paper.yaml results/paper
 paper_study configs/paper_fidelity.yaml results/paper_fidelity
 paper_study configs/fidelity_ablation/sumo_vut.yaml results/fidelity_ablation/sumo_vut
 paper_study configs/fidelity_ablation/clipped_pov.yaml results/fidelity_ablation/clipped_pov
+rank configs/overbraking.yaml --out results/overbraking  # issue 33

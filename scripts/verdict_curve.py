@@ -1,25 +1,31 @@
 """The verdict's learning curve: how the cross-play ranking of a ladder depends on the budget.
 
-    python scripts/verdict_curve.py cells OUT STUDY [STUDY ...]     # roll out (resumable)
+    python scripts/verdict_curve.py cells OUT STUDY [STUDY ...] [--budget-step 10000]
     python scripts/verdict_curve.py curve OUT                      # rank per budget
+    python scripts/verdict_curve.py frontier OUT                   # cheapest protocols
+    python scripts/verdict_curve.py early-stop OUT [--rules 2:1 ...]  # stopped runs' verdict
 
 ``cells``: for every run of the studies (one ladder; several studies of it are pooled, e.g.
-run A and run B with other seeds) and every budget B = 10k, 20k, ... up to the run's last
-candidate, the SPCP the run would have selected with a training budget of B transitions is
-the best of its candidates up to B (the run's selection criterion on its ``eval.csv``).
-Every distinct such candidate is driven against every VUT of the case exactly as the
-cross-play stage drives an opponent (:func:`sumo_ayss.scenarios.crossplay.run_crossplay`: a
-fresh single env, SUMO seed = the opponent's seed, the outcome stage's ``n`` scenarios of
-its seed). One row per episode goes to ``OUT/<case>/cells.csv`` (appended cell by cell, so a
-killed run continues where it stopped), with the CPU-seconds of each cell. At each run's
-final SPCP the episodes of its own VUT are checked against the run's ``outcome.csv``
-(the cross-play diagonal check): this script drives the vehicle the product drives.
+run A and run B with other seeds) and every budget B = 10k, 20k, ... (``--budget-step``) up
+to the run's last candidate, the SPCP the run would have selected with a training budget of
+B transitions is the best of its candidates up to B (the run's selection criterion on its
+``eval.csv``). Every distinct such candidate is driven against every VUT of the case exactly
+as the cross-play stage drives an opponent
+(:func:`sumo_ayss.scenarios.crossplay.run_crossplay`: a fresh single env, SUMO seed = the
+opponent's seed, the outcome stage's ``n`` scenarios of its seed). One row per episode goes
+to ``OUT/<case>/cells.csv`` (appended cell by cell, so a killed run continues where it
+stopped), with the CPU-seconds of each cell. At each run's final SPCP the episodes of its
+own VUT are checked against the run's ``outcome.csv`` (the cross-play diagonal check): this
+script drives the vehicle the product drives.
 
 ``curve``: for each budget B, each number of training seeds per VUT S (every subset of S of
 the pooled seeds) and each number of scenarios n (the first n), the cross-play ranking
 (:func:`sumo_ayss.analysis.crossplay.rank_crossplay`, the product's default: harm, paired
 t-test over seed blocks) against the known order: Kendall's τ, whether the ends differ
-significantly in the right direction, significant adjacent pairs. Writes
+significantly in the right direction (the product's rule: Holm over the adjacent pairs, the
+ends claimed through the chain between them; ``curve.csv`` keeps the raw ends p beside the
+adjusted one), significant adjacent pairs. Subsets: all of them, or ``--max-subsets`` drawn
+at random (seeded) where there are more. Writes
 ``OUT/<case>/curve.csv`` (one row per (B, S, n, seed subset)) and ``OUT/summary.csv`` (per
 (case, B, S, n): share of subsets with τ = 1, with significant ends, with both; mean τ; the
 CPU-seconds of that protocol for the ladder).
@@ -30,6 +36,16 @@ candidates in the runs' ``job.log``, where each job had one core), their outcome
 (V·S·n episodes) and cross-play (V·V·S·n episodes), episodes at the CPU-seconds per episode
 measured here. The AYSS stage (not needed by the cross-play verdict) is left out.
 
+``frontier``: from ``summary.csv`` (``n`` = 200 scenarios), every (budget, seeds per VUT)
+point with its share in each case and the CPU-seconds of both cases, as a share of the paper
+protocol's (3 seeds × 100k, the same model); the cheapest points reaching 100 % and 95 % in
+every case. Writes ``OUT/frontier.csv``.
+
+``early-stop``: the verdict when every run stops where the early-stopping rule
+(:mod:`sumo_ayss.analysis.early_stop`, on the run's ``eval.csv``) stops it, for each
+``patience:margin_se`` of ``--rules``, beside every run trained to its last candidate
+(``patience`` "off"). Writes ``OUT/early_stop.csv``.
+
 Pass ``--expected`` to override the study's known order (``order_check.json``).
 """
 
@@ -37,6 +53,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import gzip
 import itertools
 import json
 import math
@@ -48,6 +65,7 @@ from collections import defaultdict
 from collections.abc import Sequence
 from datetime import datetime
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 
@@ -86,7 +104,7 @@ BUDGET_STEP = 10_000
 # ----------------------------------------------------------------------------- cells
 
 
-def spcp_steps(run: RunRecord) -> dict[int, int]:
+def spcp_steps(run: RunRecord, budget_step: int = BUDGET_STEP) -> dict[int, int]:
     """Budget B -> step of the candidate the run selects among those at steps <= B."""
     from sumo_ayss.training.selection import select_spcp
 
@@ -94,7 +112,7 @@ def spcp_steps(run: RunRecord) -> dict[int, int]:
     rows = read_eval_rows(run.folder.eval_table)[0]
     last = int(max(r["step"] for r in rows))
     out = {}
-    for budget in range(BUDGET_STEP, last + 1, BUDGET_STEP):
+    for budget in range(budget_step, last + 1, budget_step):
         prefix = [r for r in rows if r["step"] <= budget]
         out[budget] = select_spcp(prefix, criterion).step
     return out
@@ -114,8 +132,9 @@ def _done_cells(path: Path) -> set[tuple[str, str, int, int]]:
         }
 
 
-def cells(out: Path, studies: Sequence[Path]) -> None:
-    """Roll out every (VUT, candidate SPCP) cell not yet in ``OUT/<case>/cells.csv``."""
+def cells(out: Path, studies: Sequence[Path], budget_step: int = BUDGET_STEP) -> None:
+    """Roll out every (VUT, candidate SPCP) cell not yet in ``OUT/<case>/cells.csv``
+    (budgets every ``budget_step`` transitions)."""
     from sumo_ayss.agents.weights import load_greedy_policy
     from sumo_ayss.envs import make_env
     from sumo_ayss.envs.odd import sample_initial_conditions
@@ -143,7 +162,7 @@ def cells(out: Path, studies: Sequence[Path]) -> None:
         }
         todo = []
         for r in runs:
-            steps = spcp_steps(r)
+            steps = spcp_steps(r, budget_step)
             meta["runs"][f"{r.experiment.env.vut}/{r.config_seed}"] = {
                 "run_dir": portable_path(r.path),
                 "spcp_by_budget": {str(b): s for b, s in steps.items()},
@@ -155,6 +174,8 @@ def cells(out: Path, studies: Sequence[Path]) -> None:
                     for v in envs
                     if (v, r.experiment.env.vut, r.config_seed, step) not in done
                 ]
+        # the smallest budgets first: an interrupted run leaves whole budgets behind it
+        todo.sort(key=lambda t: (t[2], t[1].experiment.env.vut, t[1].config_seed, t[0]))
         atomic_write_text(folder / "cells.json", json.dumps(meta, indent=2) + "\n")
         print(f"{case}: {len(done)} cells done, {len(todo)} to run", flush=True)
         new = not path.is_file()
@@ -248,16 +269,44 @@ def _sec_per_10k(folder: RunFolder) -> float:
 # ----------------------------------------------------------------------------- curve
 
 
+RATE_FROM: Path | None = None
+"""``--rate-from``: a curve folder whose ``<case>/cells.json`` gives the seconds per 10k
+transitions of the CPU model instead of this study's ``job.log`` (whose wall-clock gaps
+measure the machine's load as much as the job when other work shares the cores)."""
+
+
+def _has_cells(folder: Path) -> bool:
+    return (folder / "cells.csv").is_file() or (folder / "cells.csv.gz").is_file()
+
+
+def _open_cells(folder: Path) -> IO[str]:
+    """``cells.csv``, or the committed ``cells.csv.gz`` when it is absent (``gunzip -k`` it
+    before ``cells`` appends to it)."""
+    if (folder / "cells.csv").is_file():
+        return (folder / "cells.csv").open()
+    return gzip.open(folder / "cells.csv.gz", "rt")
+
+
+def _read_meta(folder: Path) -> dict:
+    meta = json.loads((folder / "cells.json").read_text())
+    if RATE_FROM is not None:
+        ref = json.loads((RATE_FROM / folder.name / "cells.json").read_text())["runs"]
+        rate = float(np.nanmedian([r["sec_per_10k"] for r in ref.values()]))
+        for r in meta["runs"].values():
+            r["sec_per_10k"] = rate
+    return meta
+
+
 def _load_cells(folder: Path) -> tuple[dict, dict, float]:
     """(vut, opp_vut, opp_seed, step) -> (harm, collided) arrays; meta; CPU-s per episode."""
-    meta = json.loads((folder / "cells.json").read_text())
+    meta = _read_meta(folder)
     first = read_run(PROJECT_ROOT / next(iter(meta["runs"].values()))["run_dir"])
     scale = harm_scale_of(first)
     if scale is None:
         sys.exit(f"{first.path}: no harm scale ({'; '.join(first.problems)})")
     data: dict = defaultdict(list)
     cpu: dict = {}
-    with (folder / "cells.csv").open() as f:
+    with _open_cells(folder) as f:
         for r in csv.DictReader(f):
             key = (r["vut"], r["opponent_vut"], int(r["opponent_seed"]), int(r["opponent_step"]))
             data[key].append((int(r["scenario"]), float(r["near_miss_pay"]), int(r["collided"])))
@@ -273,9 +322,11 @@ def _load_cells(folder: Path) -> tuple[dict, dict, float]:
     return cells_out, meta, per_episode
 
 
-def curve(out: Path, expected: Sequence[str] | None, max_subsets: int) -> None:
+def curve(
+    out: Path, expected: Sequence[str] | None, max_subsets: int, max_budget: int | None = None
+) -> None:
     summary = []
-    for folder in sorted(p for p in out.iterdir() if (p / "cells.csv").is_file()):
+    for folder in sorted(p for p in out.iterdir() if _has_cells(p)):
         case = folder.name
         data, meta, cpu_episode = _load_cells(folder)
         runs = meta["runs"]
@@ -286,13 +337,14 @@ def curve(out: Path, expected: Sequence[str] | None, max_subsets: int) -> None:
         }
         seeds = seeds_of[vuts[0]]
         budgets = sorted({int(b) for r in runs.values() for b in r["spcp_by_budget"]})
+        budgets = [b for b in budgets if max_budget is None or b <= max_budget]
         sec10k = float(np.nanmedian([r["sec_per_10k"] for r in runs.values()]))
         n_max = meta["n"]
         ns = [x for x in (50, 100, 200) if x <= n_max] or [n_max]
         rows = []
         for budget in budgets:
             for s_count in range(2, len(seeds) + 1):
-                subsets = list(itertools.combinations(seeds, s_count))[:max_subsets]
+                subsets = _subsets(seeds, s_count, max_subsets)
                 for n in ns:
                     cpu = _protocol_cpu(len(vuts), s_count, budget, n, sec10k, cpu_episode)
                     results = []
@@ -325,6 +377,9 @@ def curve(out: Path, expected: Sequence[str] | None, max_subsets: int) -> None:
                             ),
                             "mean_tau": round(float(np.mean([r["tau"] for r in results])), 3),
                             "median_ends_p": float(np.median([r["ends_p"] for r in results])),
+                            "median_ends_p_holm": float(
+                                np.median([r["ends_p_holm"] for r in results])
+                            ),
                             "mean_sig_adjacent": round(
                                 float(np.mean([r["significant_adjacent"] for r in results])), 2
                             ),
@@ -340,22 +395,41 @@ def curve(out: Path, expected: Sequence[str] | None, max_subsets: int) -> None:
     print(f"wrote {out / 'summary.csv'}")
 
 
+def _subsets(seeds: Sequence[int], size: int, most: int) -> list[tuple[int, ...]]:
+    """Every ``size``-subset of ``seeds``, or ``most`` of them drawn at random (seeded, the
+    same every run) when there are more: a fair sample, not the lexicographically first."""
+    every = list(itertools.combinations(seeds, size))
+    if len(every) <= most:
+        return every
+    rng = np.random.default_rng(size)
+    return [every[i] for i in sorted(rng.choice(len(every), most, replace=False))]
+
+
 def _expected(meta: dict) -> list[str]:
     study = StudyFolder(PROJECT_ROOT / meta["studies"][0])
     return list(read_order_check(study.order_check_json).expected)
 
 
+EPISODE_S: float | None = None
+"""``--episode-ms`` / 1000: the CPU model's seconds per episode instead of the cells' own
+(whose CPU time grows with the machine's load)."""
+
+
 def _protocol_cpu(v: int, s: int, budget: int, n: int, sec10k: float, cpu_episode: float) -> float:
+    cpu_episode = cpu_episode if EPISODE_S is None else EPISODE_S
     train = v * s * sec10k * budget / BUDGET_STEP
     episodes = v * s * n + v * v * s * n
     return train + episodes * cpu_episode
 
 
 def _rank(data, runs, vuts, subset, budget, n, order) -> dict:
+    """The cross-play ranking of ``subset``'s opponents at ``budget`` (one budget for every
+    run, or a mapping ``"vut/seed"`` -> budget: each run's own, e.g. where it stopped)."""
     cols: dict[str, list] = {k: [] for k in ("vut", "ov", "os", "harm", "crash")}
     for opp in vuts:
         for s in subset:
-            step = runs[f"{opp}/{s}"]["spcp_by_budget"].get(str(budget))
+            b = budget[f"{opp}/{s}"] if isinstance(budget, dict) else budget
+            step = runs[f"{opp}/{s}"]["spcp_by_budget"].get(str(b))
             if step is None:
                 step = max(runs[f"{opp}/{s}"]["spcp_by_budget"].values())
             for v in vuts:
@@ -372,8 +446,11 @@ def _rank(data, runs, vuts, subset, budget, n, order) -> dict:
     return {
         "order": " > ".join(got),
         "tau": kendall_tau(got, order),
+        # ``significant``: the family-adjusted p (Holm over the adjacent pairs, the ends
+        # claimed through the chain between them), as the product decides it
         "ends_significant": bool(ends.significant and ends.name_a == order[0]),
         "ends_p": ends.p,
+        "ends_p_holm": ends.p_decision,
         "significant_adjacent": sum(bool(r.significant_vs_next) for r in ranked[:-1]),
     }
 
@@ -386,6 +463,190 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
     w.writeheader()
     w.writerows(rows)
     atomic_write_text(path, buf.getvalue())
+
+
+# ----------------------------------------------------------------------------- frontier
+
+
+def frontier(out: Path, n: int) -> None:
+    """The cheapest protocols (budget, seeds per VUT) whose share of seed subsets with τ = 1
+    and Holm-significant ends reaches 100 % and 95 %, per case and for both cases of the
+    ladder at once (one protocol for both; points with at least 8 seed subsets), from
+    ``OUT/summary.csv`` at ``n`` scenarios;
+    CPU-seconds also as a share of the paper protocol's (3 seeds × 100k, same model)."""
+    with (out / "summary.csv").open() as f:
+        rows = [r for r in csv.DictReader(f) if int(r["n"]) == n]
+    meta = {p.name: _load_meta(p) for p in out.iterdir() if (p / "cells.json").is_file()}
+    paper = {case: _paper_cpu(m, n) for case, m in meta.items()}
+    points: dict[tuple[int, int], dict[str, dict]] = defaultdict(dict)
+    for r in rows:
+        points[(int(r["budget"]), int(r["seeds_per_vut"]))][r["case"]] = r
+    cases = sorted({r["case"] for r in rows})
+    table = []
+    for (budget, seeds), by_case in sorted(points.items()):
+        if set(by_case) != set(cases):
+            continue
+        cpu = sum(float(by_case[c]["cpu_s"]) for c in cases)
+        table.append(
+            {
+                "budget": budget,
+                "seeds_per_vut": seeds,
+                **{f"share_{c}": float(by_case[c]["share_both"]) for c in cases},
+                **{f"subsets_{c}": int(by_case[c]["subsets"]) for c in cases},
+                "share_min": min(float(by_case[c]["share_both"]) for c in cases),
+                "cpu_s": round(cpu),
+                "of_paper": round(cpu / sum(paper.values()), 3),
+            }
+        )
+    _write_csv(out / "frontier.csv", table)
+    for level in (1.0, 0.95):
+        # a share over a handful of subsets (all 8 of 8 seeds is one) says little
+        ok = [
+            t
+            for t in table
+            if t["share_min"] >= level and min(t[f"subsets_{c}"] for c in cases) >= 8
+        ]
+        best = min(ok, key=lambda t: t["cpu_s"]) if ok else None
+        print(f"cheapest point with >= {level:.0%} in every case: {best}")
+    print(f"paper protocol (model): { ({c: round(v) for c, v in paper.items()}) } CPU-s")
+    print(f"wrote {out / 'frontier.csv'}")
+
+
+def _load_meta(folder: Path) -> dict:
+    meta = _read_meta(folder)
+    with _open_cells(folder) as f:
+        cpu = {}
+        for r in csv.DictReader(f):
+            cpu[(r["vut"], r["opponent_vut"], r["opponent_seed"], r["opponent_step"])] = float(
+                r["cell_cpu_s"]
+            )
+    meta["cpu_episode"] = float(np.median([c / meta["n"] for c in cpu.values()]))
+    return meta
+
+
+def _paper_cpu(meta: dict, n: int) -> float:
+    runs = meta["runs"]
+    vuts = {k.split("/")[0] for k in runs}
+    sec10k = float(np.nanmedian([r["sec_per_10k"] for r in runs.values()]))
+    return _protocol_cpu(len(vuts), 3, 100_000, n, sec10k, meta["cpu_episode"])
+
+
+def holm_bound(outs: Sequence[Path], dest: Path, n: int) -> None:
+    """From ``curve.csv`` files written before the ranking used Holm (raw ends significance
+    and the count of raw-significant adjacent pairs, no adjacent p): per ladder, case,
+    budget and seeds per VUT, the share of subsets with τ = 1 and raw-significant ends, and
+    an **upper bound** on the share with Holm-significant ends (those need every adjacent
+    pair significant on its own too: τ = 1 and all adjacent pairs raw-significant). Writes
+    ``dest``."""
+    table = []
+    for out in outs:
+        for path in sorted(out.glob("*/curve.csv")):
+            groups: dict[tuple[int, int], list[dict]] = defaultdict(list)
+            with path.open() as f:
+                for r in csv.DictReader(f):
+                    if int(r["n"]) == n:
+                        groups[(int(r["budget"]), int(r["seeds_per_vut"]))].append(r)
+            for (budget, seeds), rows in sorted(groups.items()):
+                k = len(rows[0]["order"].split(" > "))
+                raw = [float(r["tau"]) == 1.0 and r["ends_significant"] == "True" for r in rows]
+                bound = [
+                    float(r["tau"]) == 1.0 and int(r["significant_adjacent"]) == k - 1 for r in rows
+                ]
+                table.append(
+                    {
+                        "ladder": out.name,
+                        "case": path.parent.name,
+                        "budget": budget,
+                        "seeds_per_vut": seeds,
+                        "subsets": len(rows),
+                        "share_both_raw": round(float(np.mean(raw)), 3),
+                        "share_both_holm_at_most": round(float(np.mean(bound)), 3),
+                        "cpu_s": int(rows[0]["cpu_s"]),
+                    }
+                )
+    _write_csv(dest, table)
+    print(f"wrote {dest}")
+
+
+# ----------------------------------------------------------------------------- early stop
+
+
+def early_stop(
+    out: Path,
+    expected: Sequence[str] | None,
+    max_subsets: int,
+    rules: Sequence[tuple[int, float]],
+    n: int,
+    max_budget: int | None = None,
+) -> None:
+    """The verdict with every run stopped by the early-stopping rule
+    (:func:`sumo_ayss.analysis.early_stop.stop_index` on the run's ``eval.csv``), each
+    ``(patience, margin_se)`` of ``rules``, against every run trained to its last candidate:
+    per case and seeds per VUT, the share of seed subsets with τ = 1 and Holm-significant
+    ends, the transitions trained and the CPU-seconds (model). ``OUT/early_stop.csv``."""
+    from sumo_ayss.analysis.early_stop import evaluation_se, stop_index
+    from sumo_ayss.training.selection import CRITERIA
+
+    table = []
+    for folder in sorted(p for p in out.iterdir() if _has_cells(p)):
+        case = folder.name
+        data, meta, cpu_episode = _load_cells(folder)
+        runs = meta["runs"]
+        vuts = sorted({k.split("/")[0] for k in runs})
+        order = list(expected) if expected else _expected(meta)
+        seeds = sorted(int(k.split("/")[1]) for k in runs if k.startswith(f"{vuts[0]}/"))
+        sec10k = float(np.nanmedian([r["sec_per_10k"] for r in runs.values()]))
+        cap = max(int(b) for r in runs.values() for b in r["spcp_by_budget"])
+        cap = cap if max_budget is None else min(cap, max_budget)
+        curves = {}
+        for key, r in runs.items():
+            run = read_run(PROJECT_ROOT / r["run_dir"])
+            score = CRITERIA[run.experiment.train.selection]
+            rows = read_eval_rows(run.folder.eval_table)[0]
+            curves[key] = (
+                [int(x["step"]) for x in rows],
+                [score(x) for x in rows],
+                [evaluation_se(x) for x in rows],
+            )
+        for patience, margin in [(0, 0.0), *rules]:
+            stop_at = {}
+            for key, (steps, scores, ses) in curves.items():
+                j = None if patience == 0 else stop_index(scores, ses, patience, margin)
+                stop_at[key] = cap if j is None else min(steps[j], cap)
+            for s_count in range(2, len(seeds) + 1):
+                results, trained = [], []
+                for subset in _subsets(seeds, s_count, max_subsets):
+                    results.append(_rank(data, runs, vuts, subset, stop_at, n, order))
+                    trained.append(
+                        float(np.mean([stop_at[f"{v}/{s}"] for v in vuts for s in subset]))
+                    )
+                mean_budget = float(np.mean(trained))
+                table.append(
+                    {
+                        "case": case,
+                        "patience": patience or "off",
+                        "margin_se": margin if patience else "",
+                        "seeds_per_vut": s_count,
+                        "subsets": len(results),
+                        "share_tau1": round(float(np.mean([r["tau"] == 1 for r in results])), 3),
+                        "share_both": round(
+                            float(
+                                np.mean([r["tau"] == 1 and r["ends_significant"] for r in results])
+                            ),
+                            3,
+                        ),
+                        "median_ends_p_holm": float(np.median([r["ends_p_holm"] for r in results])),
+                        "runs_stopped": sum(v < cap for v in stop_at.values()),
+                        "runs": len(stop_at),
+                        "mean_transitions": round(mean_budget),
+                        "cpu_s": round(
+                            _protocol_cpu(len(vuts), s_count, mean_budget, n, sec10k, cpu_episode)
+                        ),
+                    }
+                )
+        print(f"{case}: early-stop verdicts for {len(rules)} rules")
+    _write_csv(out / "early_stop.csv", table)
+    print(f"wrote {out / 'early_stop.csv'}")
 
 
 def figure(outs: Sequence[Path], dest: Path, seeds: Sequence[int], n: int) -> None:
@@ -451,22 +712,75 @@ def main(argv: Sequence[str] | None = None) -> None:
     c = sub.add_parser("cells")
     c.add_argument("out", type=Path)
     c.add_argument("studies", type=Path, nargs="+")
+    c.add_argument("--budget-step", type=int, default=BUDGET_STEP)
     k = sub.add_parser("curve")
     k.add_argument("out", type=Path)
     k.add_argument("--expected", nargs="+", default=None)
     k.add_argument("--max-subsets", type=int, default=20)
+    fr = sub.add_parser("frontier")
+    fr.add_argument("out", type=Path)
+    fr.add_argument("--n", type=int, default=200)
+    hb = sub.add_parser("holm-bound")
+    hb.add_argument("dest", type=Path)
+    hb.add_argument("outs", type=Path, nargs="+")
+    hb.add_argument("--n", type=int, default=200)
+    es = sub.add_parser("early-stop")
+    es.add_argument("out", type=Path)
+    es.add_argument("--expected", nargs="+", default=None)
+    es.add_argument("--max-subsets", type=int, default=20)
+    es.add_argument("--n", type=int, default=200)
+    es.add_argument(
+        "--rules",
+        nargs="+",
+        default=["1:1", "2:0", "2:1", "2:2", "3:1"],
+        help="patience:margin_se pairs",
+    )
     g = sub.add_parser("figure")
     g.add_argument("dest", type=Path)
     g.add_argument("outs", type=Path, nargs="+")
     g.add_argument("--seeds", type=int, nargs="+", default=[3, 4])
     g.add_argument("--n", type=int, default=200)
+    for sp in (k, es):
+        sp.add_argument(
+            "--max-budget",
+            type=int,
+            default=None,
+            help="only budgets up to this (cells of larger ones may be missing); early-stop: "
+            "the runs' cap",
+        )
+    for sp in (k, fr, es):
+        sp.add_argument(
+            "--episode-ms",
+            type=float,
+            default=None,
+            help="CPU milliseconds per episode of the CPU model (default: the cells' own)",
+        )
+        sp.add_argument(
+            "--rate-from",
+            type=Path,
+            default=None,
+            help="a curve folder whose <case>/cells.json gives the seconds per 10k "
+            "transitions"
+            " of the CPU model (default: this study's job.log)",
+        )
     a = p.parse_args(argv)
+    global RATE_FROM, EPISODE_S
+    RATE_FROM = getattr(a, "rate_from", None)
+    ms = getattr(a, "episode_ms", None)
+    EPISODE_S = None if ms is None else ms / 1000
     if a.cmd == "figure":
         figure(a.outs, a.dest, a.seeds, a.n)
     elif a.cmd == "cells":
-        cells(a.out, a.studies)
+        cells(a.out, a.studies, a.budget_step)
+    elif a.cmd == "holm-bound":
+        holm_bound(a.outs, a.dest, a.n)
+    elif a.cmd == "frontier":
+        frontier(a.out, a.n)
+    elif a.cmd == "early-stop":
+        rules = [(int(r.split(":")[0]), float(r.split(":")[1])) for r in a.rules]
+        early_stop(a.out, a.expected, a.max_subsets, rules, a.n, a.max_budget)
     else:
-        curve(a.out, a.expected, a.max_subsets)
+        curve(a.out, a.expected, a.max_subsets, a.max_budget)
 
 
 if __name__ == "__main__":

@@ -32,6 +32,8 @@ Pipeline YAML (every key optional)::
     budget: verdict             # a named budget: verdict (default) | paper | null (config.budget)
     total_timesteps: null       # override the budget's / every experiment's train.total_timesteps
     eval_every: null            # override the budget's / every experiment's train.eval_every
+    early_stop_patience: null   # every experiment's train.early_stop_patience (null: its own, off)
+    early_stop_margin_se: null  # every experiment's train.early_stop_margin_se
     evaluate: {n_outcome: 200, n_ayss: 100000}  # n_ayss: shorthand for ayss.n_samples
     #   ayss: {h_m: [0, 5], seed: 4242, ...}   # Monte Carlo (sumo_ayss.config.AyssConfig)
     vuts: {}                    # extra VUTs (name: vehicle type) added to every experiment
@@ -67,7 +69,7 @@ from sumo_ayss.grid.plan import plan_jobs, plan_seed
 from sumo_ayss.grid.progress import JobStatus
 from sumo_ayss.modes import analyse_cases, check_mode, get_mode
 from sumo_ayss.run_folder import RunRecord, StudyFolder, case_runs, load_runs, write_pipeline_json
-from sumo_ayss.util.errors import AyssError
+from sumo_ayss.util.errors import AyssError, DiskFullError
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
@@ -317,6 +319,8 @@ def run_crossplay_stage(
                 reference=cfg.evaluate.reference,
                 references=cfg.evaluate.reference_rows,
             )
+        except DiskFullError:
+            raise
         except AyssError as e:  # never fatal: the report says the table is missing
             logger.warning("cross-play of %s failed: %s", case, e)
             continue
@@ -338,7 +342,7 @@ def write_discriminability(cfg: PipelineConfig) -> None:
     if len(cfg.grid.vuts) < 2:
         return
     from sumo_ayss import discriminability
-    from sumo_ayss.util.errors import AyssError
+    from sumo_ayss.util.errors import AyssError, DiskFullError
 
     for case in cfg.grid.cases:
         logger.info(
@@ -350,6 +354,8 @@ def write_discriminability(cfg: PipelineConfig) -> None:
         try:
             env = discriminability.pipeline_env(cfg, case)
             discriminability.ensure(env, cfg.grid.vuts, StudyFolder(cfg.out).case(case).path)
+        except DiskFullError:
+            raise
         except (AyssError, ImportError, OSError) as e:  # never fatal: the report says so
             logger.warning("discriminability of %s not computed: %s", case, e)
 
@@ -381,6 +387,14 @@ def add_config_flags(parser: argparse.ArgumentParser) -> None:
     )
     group.add_argument("--n-ayss", type=int, default=None, help="AYSS Monte Carlo draws per SPCP")
     group.add_argument(
+        "--early-stop-patience",
+        type=int,
+        default=None,
+        help="stop a run once this many candidates in a row have not beaten the best before "
+        "them by more than early_stop_margin_se standard errors (train.early_stop_patience; "
+        "default: off)",
+    )
+    group.add_argument(
         "--max-seeds",
         type=int,
         default=None,
@@ -403,6 +417,7 @@ def config_from_args(args: argparse.Namespace) -> PipelineConfig:
         n_outcome=args.n_outcome,
         n_ayss=args.n_ayss,
         max_seeds=args.max_seeds,
+        early_stop_patience=args.early_stop_patience,
     )
     check_mode(cfg.report.mode)
     return cfg

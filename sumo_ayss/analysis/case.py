@@ -374,7 +374,7 @@ def _crossplay(out: CaseAnalysis[R], options: CaseOptions, found: CrossplayInput
     out.crossplay, out.crossplay_path = m, found.path
     out.crossplay_diagonal = found.diagonal
     out.outcomes[CROSSPLAY_MODE] = vut_outcomes(
-        {v: (*m.crashes(v), m.vut_mobility(v)) for v in m.vuts}, options.level
+        {v: (*m.crashes(v), m.vut_mobility(v)) for v in m.vuts}, options.level, m.hazards
     )
     out.crossplay_rows, out.crossplay_pairs = rank_crossplay(
         m, blocks=options.crossplay_blocks, level=options.level, alpha=options.welch_alpha

@@ -40,6 +40,7 @@ import numpy as np
 import numpy.typing as npt
 
 from sumo_ayss.analysis.harm import HARM_RANGE
+from sumo_ayss.analysis.hazards import vut_hazards
 from sumo_ayss.analysis.seeds import SeedComparison, SeedRankRow, SeedScores, rank_seeds
 from sumo_ayss.util.errors import ConfigError
 
@@ -88,6 +89,8 @@ class CrossplayMatrix:
     mobility: npt.NDArray[np.float64]
     preventable: npt.NDArray[np.int64] | None = None
     labelled: npt.NDArray[np.int64] | None = None
+    hazards: dict[str, dict[str, float]] | None = None
+    """Per VUT, the hazards it caused (:func:`~.hazards.vut_hazards`); None: not recorded."""
 
     def preventable_crashes(self, vut: str) -> tuple[int, int]:
         """``(preventable, labelled)`` collisions of ``vut`` against the whole pool;
@@ -145,6 +148,7 @@ def crossplay_matrix(
     episode_return: npt.ArrayLike | None = None,
     mobility: npt.ArrayLike | None = None,
     preventable: npt.ArrayLike | None = None,
+    hazards: dict[str, npt.NDArray[np.float64]] | None = None,
 ) -> CrossplayMatrix:
     """Reduces the cross-play table's columns (one entry per episode) to the matrix.
 
@@ -156,6 +160,7 @@ def crossplay_matrix(
         mobility: Each episode's VUT mean speed [m/s] (NaN: not recorded), or None.
         preventable: Each episode's crash label (1 preventable, 0 unpreventable, NaN no
             crash or not labelled), or None.
+        hazards: The hazard columns by name (:data:`~.hazards.VUT_HAZARD_COLUMNS`), or None.
 
     Raises:
         ConfigError: If the lengths differ, a harm or return is not finite, or the design is
@@ -215,6 +220,7 @@ def crossplay_matrix(
         mobility=sums["mob"] / counts,
         preventable=None if preventable is None else sums["prev"].astype(np.int64),
         labelled=None if preventable is None else sums["lab"].astype(np.int64),
+        hazards=None if hazards is None else vut_hazards(np.asarray(vut), hazards),
     )
 
 

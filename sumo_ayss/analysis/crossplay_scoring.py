@@ -19,6 +19,7 @@ from sumo_ayss.analysis.harm import (
     episode_harm,
     harm_scale_of,
 )
+from sumo_ayss.analysis.hazards import VUT_HAZARD_COLUMNS, harm_crash
 from sumo_ayss.util.errors import ConfigError, TableError
 
 __all__ = ["CrossplayTablesLike", "case_matrix", "crossplay_input", "score_crossplay"]
@@ -61,15 +62,18 @@ def score_crossplay(columns: Mapping[str, Any], scale: HarmScale) -> CrossplayMa
     """
     c = columns
     pay = scale.near_miss_pay(c["near_miss_pay"], c["episode_return"], c["collided"])
+    # A rear-end the VUT caused by braking for nothing counts as a crash (issue 33).
+    crash = harm_crash(c["collided"], c["rear_end_unjustified"])
     return crossplay_matrix(
         c["vut"],
         c["opponent_vut"],
         c["opponent_seed"],
-        episode_harm(pay, c["collided"], scale.max_episode_pay),
+        episode_harm(pay, crash, scale.max_episode_pay),
         c["collided"],
         episode_return=c["episode_return"],
         mobility=c["vut_mean_speed_mps"],
         preventable=c["crash_preventable"],
+        hazards={name: c[name] for name in VUT_HAZARD_COLUMNS},
     )
 
 

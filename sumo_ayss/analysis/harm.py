@@ -42,6 +42,7 @@ from typing import Any, Protocol
 import numpy as np
 import numpy.typing as npt
 
+from sumo_ayss.analysis.hazards import overbraking_flags
 from sumo_ayss.analysis.stats import wilson_interval
 from sumo_ayss.util.errors import ConfigError
 
@@ -191,7 +192,13 @@ class VutOutcome:
         crash_hi: Upper end, in [0, 1].
         mobility: Mean VUT speed over the episodes [m/s]; NaN: not recorded.
         timid: Mobility below :data:`MOBILITY_FLOOR` × the median VUT's
-            (:func:`mobility_flags`): it may be "safe" by standing still.
+            (:func:`mobility_flags`): it may be "safe" by standing still. It misses a VUT
+            that brakes for nothing in car-following, where the leader sets the pace:
+            ``overbraking`` catches that one.
+        hazards: The hazards it caused, means over the same episodes
+            (:func:`~sumo_ayss.analysis.hazards.vut_hazards`); None: not recorded.
+        overbraking: It braked for nothing far more than the others
+            (:func:`~sumo_ayss.analysis.hazards.overbraking_flags`).
     """
 
     crashes: int
@@ -200,6 +207,8 @@ class VutOutcome:
     crash_hi: float
     mobility: float
     timid: bool
+    hazards: Mapping[str, float] | None = None
+    overbraking: bool = False
 
     @property
     def crash_rate(self) -> float:
@@ -207,20 +216,26 @@ class VutOutcome:
 
 
 def vut_outcomes(
-    counts: dict[str, tuple[int, int, float]], level: float = 0.95
+    counts: dict[str, tuple[int, int, float]],
+    level: float = 0.95,
+    hazards: Mapping[str, Mapping[str, float]] | None = None,
 ) -> dict[str, VutOutcome]:
     """Per VUT ``(crashes, episodes, mobility)`` -> its :class:`VutOutcome`.
 
-    The crash rate's interval is Wilson's over the episodes pooled: it stays inside
-    [0, 1] and is informative at 0 crashes, but treats the episodes as independent, which
-    episodes of one opponent are not (it is a description beside the score; the verdict's
-    test is the score's, over training-seed blocks).
+    ``hazards``: per VUT, the hazards it caused (cross-play's); their unjustified braking
+    sets the OVER-BRAKING flag. The crash rate's interval is Wilson's over the episodes
+    pooled: it stays inside [0, 1] and is informative at 0 crashes, but treats the episodes
+    as independent, which episodes of one opponent are not (it is a description beside the
+    score; the verdict's test is the score's, over training-seed blocks).
     """
     flags = mobility_flags({v: mob for v, (_c, _n, mob) in counts.items()})
+    dv = {v: (hazards or {}).get(v, {}).get("unjustified_dv_mps", math.nan) for v in counts}
+    over = overbraking_flags(dv)
     out = {}
     for vut, (crashes, n, mob) in counts.items():
         lo, hi = wilson_interval(crashes, n, level) if n else (math.nan, math.nan)
-        out[vut] = VutOutcome(crashes, n, lo, hi, mob, flags[vut])
+        mine = None if hazards is None else hazards.get(vut)
+        out[vut] = VutOutcome(crashes, n, lo, hi, mob, flags[vut], mine, over[vut])
     return out
 
 
@@ -279,9 +294,12 @@ def episode_stats(columns: Mapping[str, Any], scale: HarmScale) -> EpisodeStats:
     Raises:
         ConfigError: If the table holds no episode or a pay does not fit the scale.
     """
+    from sumo_ayss.analysis.hazards import harm_crash
+
     c = columns
     pay = scale.near_miss_pay(c["near_miss_pay"], c["episode_return"], c["collided"])
-    harm = episode_harm(pay, c["collided"], scale.max_episode_pay)
+    crash = harm_crash(c["collided"], c["rear_end_unjustified"])  # issue 33
+    harm = episode_harm(pay, crash, scale.max_episode_pay)
     return EpisodeStats.of(harm, c["collided"], c["vut_mean_speed_mps"])
 
 

@@ -49,6 +49,7 @@ from sumo_ayss.config.experiment import (
     experiment_from_dict,
     load_experiment,
 )
+from sumo_ayss.config.follower import FOLLOWER_TYPE, FollowerConfig
 from sumo_ayss.config.mapping import build, env_config_from_mapping, to_dict
 from sumo_ayss.config.pipeline import (
     EvaluateConfig,
@@ -62,6 +63,7 @@ from sumo_ayss.util.validation import SEED_MAX, check_out_dir, check_seed, check
 
 __all__ = [
     "DEFAULT_AYSS_SEED",
+    "FOLLOWER_TYPE",
     "MANAGED_SUMO_OPTIONS",
     "PROJECT_ROOT",
     "SEED_MAX",
@@ -72,6 +74,7 @@ __all__ = [
     "EnvConfig",
     "EvaluateConfig",
     "ExperimentConfig",
+    "FollowerConfig",
     "GridConfig",
     "OddConfig",
     "PipelineConfig",

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import ClassVar, Literal
 
 from sumo_ayss.cases import DEFAULT_CASE, ROAD_EDGE, case_names, get_case
+from sumo_ayss.config.follower import FollowerConfig
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.frozen import FrozenMap
 from sumo_ayss.util.validation import check_choice, check_range, check_sumo_network, require
@@ -286,6 +287,9 @@ class EnvConfig:
     reward: RewardConfig = field(default_factory=RewardConfig)
     actuator: ActuatorConfig = field(default_factory=ActuatorConfig)
     sim: SimConfig = field(default_factory=SimConfig)
+    follower: FollowerConfig = field(default_factory=FollowerConfig)
+    """A SUMO-driven follower behind the VUT (off by default: :mod:`~sumo_ayss.config.
+    follower`)."""
 
     def __post_init__(self) -> None:
         s = self.SECTION

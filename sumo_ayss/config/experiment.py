@@ -20,7 +20,7 @@ from sumo_ayss.config.env import EnvConfig
 from sumo_ayss.config.mapping import build, to_dict
 from sumo_ayss.config.yaml_io import read_yaml
 from sumo_ayss.training.selection import CRITERIA
-from sumo_ayss.util.validation import check_choice, check_seed, require
+from sumo_ayss.util.validation import check_choice, check_int, check_number, check_seed, require
 
 
 @dataclass(frozen=True)
@@ -56,6 +56,14 @@ class TrainConfig:
     ``gradient_steps`` to keep ``agent.update_to_data_ratio`` gradient steps per transition.
     Candidates are then evaluated on all pairs at once, right at ``eval_every``; the pairs'
     running episodes are cut there (stored as time-limit truncations) and restarted."""
+    early_stop_patience: int | None = None
+    """Stop the run once this many consecutive candidates have not beaten the best candidate
+    before them by more than ``early_stop_margin_se`` standard errors of its evaluation mean
+    (:mod:`sumo_ayss.training.early_stop`); ``total_timesteps`` is then a cap. None (the
+    default): train to ``total_timesteps``."""
+    early_stop_margin_se: float = 1.0
+    """The improvement that counts for ``early_stop_patience``, in standard errors of the
+    best earlier candidate's mean evaluation return (``std_return / sqrt(n_episodes)``)."""
 
     def __post_init__(self) -> None:
         s = self.SECTION
@@ -80,6 +88,9 @@ class TrainConfig:
             f"{s}.device must be 'cpu', 'cuda' or 'cuda:<index>', got {self.device!r}",
         )
         check_choice(f"{s}.selection", self.selection, sorted(CRITERIA))
+        # the rule itself: sumo_ayss.analysis.early_stop (not imported here: it needs scipy)
+        check_int(f"{s}.early_stop_patience", self.early_stop_patience, 1, none_ok=True)
+        check_number(f"{s}.early_stop_margin_se", self.early_stop_margin_se, 0.0)
 
 
 @dataclass(frozen=True)

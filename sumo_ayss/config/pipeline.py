@@ -18,7 +18,14 @@ from sumo_ayss.config.mapping import build
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.config.yaml_io import read_yaml
 from sumo_ayss.util.frozen import FrozenMap
-from sumo_ayss.util.validation import check_choice, check_seed, require, suggest
+from sumo_ayss.util.validation import (
+    check_choice,
+    check_int,
+    check_number,
+    check_seed,
+    require,
+    suggest,
+)
 from sumo_ayss.vuts.catalog import VehicleType
 from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE, REFERENCE_VUTS
 
@@ -112,6 +119,11 @@ class PipelineConfig:
     """Transitions per run for every experiment; None: the budget's (or the experiment's)."""
     eval_every: int | None = None
     """Transitions between SPCP candidates; None: the budget's (or the experiment's)."""
+    early_stop_patience: int | None = None
+    """Every experiment's ``train.early_stop_patience`` (stop a run once its candidates stop
+    moving, :mod:`sumo_ayss.analysis.early_stop`); None: the experiment's (off by default)."""
+    early_stop_margin_se: float | None = None
+    """Every experiment's ``train.early_stop_margin_se``; None: the experiment's."""
     max_seeds: int | None = None
     """Adaptive seeding: a case whose cross-play ranking has not settled after ``grid.seeds``
     gets one more seed per VUT at a time (the next integer after the last seed), up to this
@@ -129,6 +141,10 @@ class PipelineConfig:
     two ends differ significantly. Empty: no known order."""
     workers: int = 0
     retries: int = 1
+    follower: bool | None = None
+    """A follower behind the VUT in every case's evaluation episodes (true) or in none
+    (false; the paper's protocol); None: as each experiment's ``env.follower.enabled``
+    says (the shipped ``configs/<case>.yaml``: on)."""
 
     def __post_init__(self) -> None:
         if self.budget is not None:
@@ -176,6 +192,9 @@ class PipelineConfig:
                 f"({self.total_timesteps}): a run needs at least one SPCP candidate (a "
                 "smaller total_timesteps than the budget's needs a smaller eval_every too)",
             )
+        check_int("early_stop_patience", self.early_stop_patience, 1, none_ok=True)
+        if self.early_stop_margin_se is not None:
+            check_number("early_stop_margin_se", self.early_stop_margin_se, 0.0)
         require(self.workers >= 0, f"workers must be >= 0, got {self.workers}")
         require(self.retries >= 0, f"retries must be >= 0, got {self.retries}")
         if self.expected_order:

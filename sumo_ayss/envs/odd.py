@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from sumo_ayss.config import OddConfig
+from sumo_ayss.config.follower import FollowerConfig
 
 
 @dataclass(frozen=True)
@@ -18,11 +21,16 @@ class InitialCondition:
         vut_speed_mps: VUT speed [m/s].
         gap_m: longitudinal gap, POV rear bumper minus VUT front bumper [m]. In cut-in the
             POV starts in the adjacent lane, so a negative gap (side by side) is possible.
+        follower_gap_m: The follower's gap, VUT rear bumper minus follower front bumper [m]
+            (> 0); None: no follower (:func:`with_followers` draws it).
+        follower_speed_mps: The follower's speed [m/s]; None without a follower.
     """
 
     pov_speed_mps: float
     vut_speed_mps: float
     gap_m: float
+    follower_gap_m: float | None = None
+    follower_speed_mps: float | None = None
 
     def as_tuple(self) -> tuple[float, float, float]:
         return (self.pov_speed_mps, self.vut_speed_mps, self.gap_m)
@@ -44,3 +52,45 @@ def sample_initial_conditions(odd: OddConfig, n: int, seed: int) -> list[Initial
     """``n`` initial conditions from a seed: the fixed scenario set shared by every VUT."""
     rng = np.random.default_rng(seed)
     return [sample_initial_condition(odd, rng) for _ in range(n)]
+
+
+#: Tag of the follower's random stream, so that its draws never shift the scenario set's.
+FOLLOWER_STREAM = 33
+
+
+def with_followers(
+    scenarios: Sequence[InitialCondition], follower: FollowerConfig, seed: int
+) -> list[InitialCondition]:
+    """``scenarios`` with a follower start each (``follower.enabled``; else unchanged).
+
+    The follower drives at the VUT's initial speed at a time headway drawn uniformly from
+    ``follower.time_headway_s`` (at least its ``minGap``, 2.5 m by default, behind a VUT
+    at rest), one draw per scenario in order from a stream of its own
+    (``[FOLLOWER_STREAM, seed]``): the VUT-POV part of every scenario is the set's as
+    without a follower, and scenario ``i`` has the same follower for every VUT.
+    """
+    if not follower.enabled:
+        return list(scenarios)
+    floor = float(follower.vtype.params.get("minGap", 2.5))  # a VUT at rest: standstill gap
+    rng = np.random.default_rng([FOLLOWER_STREAM, seed])
+    u = rng.random(len(scenarios)).tolist()
+    lo, hi = follower.time_headway_s
+    return [
+        dataclasses.replace(
+            ic,
+            follower_gap_m=max((lo + (hi - lo) * u_i) * ic.vut_speed_mps, floor),
+            follower_speed_mps=ic.vut_speed_mps,
+        )
+        for ic, u_i in zip(scenarios, u, strict=True)
+    ]
+
+
+def with_follower_at(
+    ic: InitialCondition, follower: FollowerConfig, seed: int, index: int
+) -> InitialCondition:
+    """Scenario ``index`` of a set of ``seed`` with its follower start, as
+    :func:`with_followers` gives it (a replay of one row); ``ic`` unchanged when the
+    follower is off."""
+    if not follower.enabled:
+        return ic
+    return with_followers([ic] * (index + 1), follower, seed)[index]

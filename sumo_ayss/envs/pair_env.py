@@ -25,6 +25,12 @@ import numpy.typing as npt
 from gymnasium import spaces
 
 from sumo_ayss.config import EnvConfig
+from sumo_ayss.envs.follower import (
+    check_follower_start,
+    follower_info,
+    follower_wanted,
+    place_follower,
+)
 from sumo_ayss.envs.odd import InitialCondition, sample_initial_condition
 from sumo_ayss.envs.rewards import total_reward
 from sumo_ayss.laws import VehicleLaws, build_laws
@@ -55,6 +61,8 @@ def session_vtypes(cfg: EnvConfig) -> dict[str, VehicleType]:
     """The vehicle types a simulation of ``cfg`` loads: ``vut_<name>`` per catalog VUT, ``pov``."""
     vtypes = {f"vut_{name}": vt for name, vt in cfg.vuts.items()}
     vtypes["pov"] = cfg.pov
+    if cfg.follower.enabled:
+        vtypes["follower"] = cfg.follower.sumo_type
     return vtypes
 
 
@@ -192,7 +200,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             raise self._step_error()
         ic = self.begin_reset(seed, options)
         pair = self._ensure_sim()
-        pair.add()
+        pair.add(follower=follower_wanted(self.config, ic))
         pair.session.step()  # inserts the fresh vehicles (they do not move in this step)
         values, info = self.start_episode(ic)
         return np.array(values, dtype=np.float32), info
@@ -300,6 +308,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
                     f"reset options['initial_condition'].{name} must be a finite number in "
                     f"[{low:g}, {high:g}], got {value!r}"
                 )
+        check_follower_start(ic)
 
     def start_episode(self, ic: InitialCondition) -> tuple[tuple[float, ...], dict[str, Any]]:
         """Place the pair's fresh vehicles at ``ic``: the reset's observation values and info.
@@ -308,7 +317,10 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         """
         pair = self._pair
         assert pair is not None
-        pair.place(self._placement(ic))
+        placement = self._placement(ic)
+        pair.place(placement)
+        if pair.follower is not None:
+            place_follower(pair, placement, ic, self.config)
         self._vut_law.start(pair, ic.vut_speed_mps)
         self._pov_law.start(pair, ic.pov_speed_mps)
         self.initial_condition = ic
@@ -322,6 +334,8 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             "initial_condition": ic,
             **self._positions_info(k),
         }
+        if pair.follower is not None:  # no acceleration yet (SUMO's is the placement's)
+            info.update(follower_info(pair.follower), follower_accel_mps2=math.nan)
         return self._observation_values(k), info
 
     def begin_decision(self, action: SupportsInt) -> None:
@@ -378,6 +392,8 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             **self._positions_info(k),
             **extra,
         }
+        if pair.follower is not None:
+            info.update(follower_info(pair.follower))
         return self._observation_values(k), reward, terminated, truncated, info
 
     @staticmethod
@@ -449,7 +465,13 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         self._session = session
         # An env dropped without close() must not hold the process's one simulation forever.
         self._finalizer = weakref.finalize(self, session.close)
-        self._pair = VehiclePair(session, vut_type=f"vut_{cfg.vut}", pov_type="pov", edge=ROAD_EDGE)
+        self._pair = VehiclePair(
+            session,
+            vut_type=f"vut_{cfg.vut}",
+            pov_type="pov",
+            edge=ROAD_EDGE,
+            follower_type="follower" if cfg.follower.enabled else None,
+        )
         return self._pair
 
     @staticmethod

@@ -24,7 +24,7 @@ from sumo_ayss.run_folder import (
     run_dir_for,
     write_progress,
 )
-from sumo_ayss.util.errors import ControllerError
+from sumo_ayss.util.errors import ControllerError, DiskFullError
 from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
 
 logger = logging.getLogger("sumo_ayss.pipeline")
@@ -32,8 +32,9 @@ logger = logging.getLogger("sumo_ayss.pipeline")
 #: Failures a retry would repeat, so the schedulers do not retry them: a user controller
 #: that raised or returned no number does so again on the same seed and path (the retry
 #: resumes from the last candidate and drives the same episodes); a retry only delayed the
-#: pipeline's exit by the time to get there again (18-40 s in issue 23).
-NOT_RETRIED: tuple[type[BaseException], ...] = (ControllerError,)
+#: pipeline's exit by the time to get there again (18-40 s in issue 23). A full disk stops
+#: the whole grid (every other job would meet it too).
+NOT_RETRIED: tuple[type[BaseException], ...] = (ControllerError, DiskFullError)
 
 
 @dataclass(frozen=True)
@@ -76,6 +77,14 @@ class JobSpec:
     def folder(self) -> RunFolder:
         """The job's run folder."""
         return RunFolder(self.run_dir)
+
+
+def is_finished(spec: JobSpec) -> bool:
+    """Whether the job's run folder holds its finished training and evaluation (same inputs)."""
+    folder = spec.folder
+    return is_done(TrainStage(folder, spec.experiment, spec.seed)) and is_done(
+        EvaluateStage(folder, spec.n_outcome, spec.ayss)
+    )
 
 
 def run_job(spec: JobSpec) -> dict[str, Any]:

@@ -20,6 +20,7 @@ from typing import Any
 
 from sumo_ayss.grid.jobs import NOT_RETRIED, JobSpec, run_job
 from sumo_ayss.grid.progress import GridProgress, JobStatus
+from sumo_ayss.util.errors import DiskFullError
 
 logger = logging.getLogger("sumo_ayss.pipeline")
 
@@ -123,6 +124,10 @@ def run_grid_local(
                 s = pending.pop(fut)
                 try:
                     result = fut.result()
+                except DiskFullError as e:  # every other job would meet it: stop the grid
+                    s.state, s.error = "failed", str(e)
+                    logger.error(progress.line(s, f"FAILED: {e}"))
+                    raise
                 except Exception as e:  # a job's failure is data here
                     s.error = "".join(traceback.format_exception_only(e)).strip()
                     s.stage = ""
@@ -140,7 +145,7 @@ def run_grid_local(
             if display is not None:
                 display.update(progress.table())
             time.sleep(0.2)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, DiskFullError) as e:
         for s in queue:
             s.state = "cancelled"
         for fut, s in pending.items():
@@ -148,8 +153,9 @@ def run_grid_local(
             s.state = "interrupted"
         _stop_workers(pool)
         logger.warning(
-            "interrupted: %d running job(s) stopped, %d queued job(s) cancelled; rerun the "
+            "%s: %d running job(s) stopped, %d queued job(s) cancelled; rerun the "
             "same command to resume",
+            "interrupted" if isinstance(e, KeyboardInterrupt) else "the disk is full",
             len(pending),
             len(queue),
         )

@@ -13,7 +13,7 @@ from sumo_ayss.config import ExperimentConfig, PipelineConfig, load_experiment
 from sumo_ayss.grid.jobs import JobSpec
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.validation import suggest
-from sumo_ayss.vuts.reference_types import REFERENCE_VUTS
+from sumo_ayss.vuts.reference_types import OVERBRAKER_VUT, REFERENCE_VUTS
 
 __all__ = ["case_experiment", "plan_jobs", "plan_seed"]
 
@@ -67,14 +67,22 @@ def case_experiment(cfg: PipelineConfig, case: str) -> ExperimentConfig:
         overrides["total_timesteps"] = cfg.total_timesteps
     if cfg.eval_every is not None:
         overrides["eval_every"] = cfg.eval_every
+    if cfg.early_stop_patience is not None:
+        overrides["early_stop_patience"] = cfg.early_stop_patience
+    if cfg.early_stop_margin_se is not None:
+        overrides["early_stop_margin_se"] = cfg.early_stop_margin_se
     exp = dataclasses.replace(exp, train=dataclasses.replace(exp.train, **overrides))
+    if cfg.follower is not None:
+        follower = dataclasses.replace(exp.env.follower, enabled=cfg.follower)
+        exp = dataclasses.replace(exp, env=dataclasses.replace(exp.env, follower=follower))
     if cfg.vuts:
         exp = dataclasses.replace(
             exp, env=dataclasses.replace(exp.env, vuts={**exp.env.vuts, **cfg.vuts})
         )
-    refs = {v: REFERENCE_VUTS[v] for v in cfg.grid.vuts if v in REFERENCE_VUTS}
+    named = {**REFERENCE_VUTS, "overbraker": OVERBRAKER_VUT}
+    refs = {v: named[v] for v in cfg.grid.vuts if v in named}
     refs = {v: vt for v, vt in refs.items() if v not in exp.env.vuts}
-    if refs:  # a reference driver named in the grid is a built-in VUT of every case
+    if refs:  # a reference driver (or the over-braker) named in the grid: a built-in VUT
         exp = dataclasses.replace(
             exp, env=dataclasses.replace(exp.env, vuts={**exp.env.vuts, **refs})
         )

@@ -70,7 +70,7 @@ class ExportResult:
 
 
 def _vehicle_name(vtype: str) -> str:
-    return "pov" if vtype == "pov" else "vut"
+    return vtype if vtype in ("pov", "follower") else "vut"
 
 
 def _rename(points: Sequence[export.FcdPoint], time_of: dict[float, float]) -> list[Any]:
@@ -124,7 +124,7 @@ def _export(
 ) -> Any:
     env_cfg = run.experiment.env  # raises first if the folder is not a run folder
     row = read_row(run.folder, kind, index)
-    ic = initial_condition(kind, row)
+    ic = initial_condition(kind, row, run)
     pol = policy if policy is not None else load_policy(run)
     limit = decisions if decisions is not None else (1 if kind == "ayss" else None)
     out.mkdir(parents=True, exist_ok=True)
@@ -144,7 +144,10 @@ def _export(
     net_src = env_cfg.network if env_cfg.network is not None else network_path(env_cfg.case)
     atomic_copy(net_src, out / NET_FILE)
     vt = env_cfg.vut_type
-    atomic_write_text(out / VTYPES_FILE, vtypes_xml({f"vut_{env_cfg.vut}": vt, "pov": env_cfg.pov}))
+    types = {f"vut_{env_cfg.vut}": vt, "pov": env_cfg.pov}
+    if env_cfg.follower.enabled:  # issue 33: the follower behind the VUT
+        types["follower"] = env_cfg.follower.sumo_type
+    atomic_write_text(out / VTYPES_FILE, vtypes_xml(types))
     comment = (
         f"{kind} row {index} of {run.path}; t = 0 inserts the vehicles, the scenario "
         f"(tau = 0) starts at t = {dt:g} s"

@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Any, Literal
 
 from sumo_ayss.envs import make_env
-from sumo_ayss.envs.odd import InitialCondition
+from sumo_ayss.envs.odd import InitialCondition, with_follower_at
 from sumo_ayss.run_folder import AYSS_SCHEMA, OUTCOME_SCHEMA, RunFolder, RunRecord, read_table
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.util.errors import CheckpointError, ConfigError
@@ -63,12 +63,22 @@ def read_row(folder: RunFolder, kind: Kind, index: int) -> dict[str, Any]:
     return dict(list(table.rows())[index])
 
 
-def initial_condition(kind: Kind, row: dict[str, Any]) -> InitialCondition:
+def initial_condition(
+    kind: Kind, row: dict[str, Any], run: RunRecord | None = None
+) -> InitialCondition:
     """The scenario's initial state: the sampled observation of an AYSS row, the episode
-    start of an outcome row."""
+    start of an outcome row; an outcome row of a ``run`` with a follower (issue 33) gets the
+    follower its episode had (scenario index and seed of the outcome stage)."""
     if kind == "ayss":
         return InitialCondition(row["v_pov_mps"], row["v_vut_mps"], row["h_m"])
-    return InitialCondition(row["v_pov0_mps"], row["v_vut0_mps"], row["gap0_m"])
+    ic = InitialCondition(row["v_pov0_mps"], row["v_vut0_mps"], row["gap0_m"])
+    if run is None or not run.experiment.env.follower.enabled:
+        return ic
+    from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
+
+    rec = run.outcome_record
+    seed = int(rec.settings.get("seed", DEFAULT_OUTCOME_SEED)) if rec else DEFAULT_OUTCOME_SEED
+    return with_follower_at(ic, run.experiment.env.follower, seed, int(row["scenario"]))
 
 
 def load_policy(run: RunRecord) -> Policy:

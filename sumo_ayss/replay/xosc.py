@@ -41,7 +41,7 @@ from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.replay.source import initial_condition, load_policy, read_row, select_row
 from sumo_ayss.run_folder import read_run
 from sumo_ayss.scenarios.rollout import Policy
-from sumo_ayss.scenarios.trajectory import body_width_m, trajectory_from_infos
+from sumo_ayss.scenarios.trajectory import body_width_m, follower_of, trajectory_from_infos
 from sumo_ayss.sim.network import network_path
 from sumo_ayss.util.atomic import atomic_write_text, atomic_write_with
 from sumo_ayss.util.errors import ConfigError, SimulationError
@@ -164,7 +164,13 @@ def _vehicle(name: str, length_m: float, width_m: float, max_speed_mps: float) -
 
 
 def _xosc(
-    tr: Any, road: _Road, y_vut: np.ndarray, y_pov: np.ndarray, path: Path, description: str
+    tr: Any,
+    road: _Road,
+    y_vut: np.ndarray,
+    y_pov: np.ndarray,
+    path: Path,
+    description: str,
+    follower: tuple[np.ndarray, np.ndarray, float, float] | None = None,
 ) -> None:
     from scenariogeneration import xosc
 
@@ -183,8 +189,13 @@ def _xosc(
         "ego": (tr.vut_x_m, y_vut, tr.vut_speed_mps, tr.vut_length_m, tr.vut_width_m),
         "pov": (tr.pov_x_m, y_pov, tr.pov_speed_mps, tr.pov_length_m, tr.pov_width_m),
     }
-    times = [float(t) for t in tr.time_s]
+    if follower is not None:  # issue 33: in the VUT's lane; its samples until a rear-end
+        fx, fv, f_len, f_wid = follower
+        alive = int(np.isfinite(fx).sum())
+        bodies["follower"] = (fx[:alive], y_vut[:alive], fv[:alive], f_len, f_wid)
+    all_times = [float(t) for t in tr.time_s]
     for name, (x_front, y, speed, length, width) in bodies.items():
+        times = all_times[: len(x_front)]
         entities.add_scenario_object(name, _vehicle(name, length, width, 50.0))
         # the rear axle: OVERHANG_M in front of the rear bumper; coordinates from the road
         xs = np.asarray(x_front) - length + OVERHANG_M  # lane positions: x from the road start
@@ -272,7 +283,7 @@ def export_xosc(
         run = read_run(run_dir)
         env_cfg: EnvConfig = run.experiment.env  # raises first if not a run folder
         row = read_row(run.folder, kind, index)
-        ic = initial_condition(kind, row)
+        ic = initial_condition(kind, row, run)
         pol = policy if policy is not None else load_policy(run)
         limit = decisions if decisions is not None else (1 if kind == "ayss" else None)
         reset_info, infos, actions, rewards = _record(env_cfg, run.config_seed, ic, pol, limit)
@@ -287,7 +298,13 @@ def export_xosc(
     out.mkdir(parents=True, exist_ok=True)
     _xodr(road, out / XODR_FILE)
     description = f"{kind} row {index} of {portable_path(run.path)} ({env_cfg.case}, {env_cfg.vut})"
-    _xosc(tr, road, y_vut, y_pov, out / XOSC_FILE, description)
+    track = follower_of(reset_info, infos)
+    fol = None
+    if track is not None:
+        f_type = env_cfg.follower.sumo_type
+        f_len = float(f_type.params.get("length", 5.0))
+        fol = (track.x_m, track.speed_mps, f_len, body_width_m(f_type))
+    _xosc(tr, road, y_vut, y_pov, out / XOSC_FILE, description, fol)
     collided = bool(infos[-1]["collision"])
     reproduced: dict[str, bool]
     if kind == "ayss":

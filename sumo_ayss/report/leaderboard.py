@@ -34,7 +34,12 @@ from sumo_ayss.modes import (
 )
 from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p, rank_labels
 from sumo_ayss.report.blocks import Table
-from sumo_ayss.report.sections.common import crash_cell, mobility_cell
+from sumo_ayss.report.sections.common import (
+    crash_cell,
+    hazards_cell,
+    mobility_cell,
+    unjustified_cell,
+)
 from sumo_ayss.report.sections.reference import preventable_text
 from sumo_ayss.run_folder import RunRecord
 
@@ -65,6 +70,9 @@ class LeaderRow:
             the Wilson interval of their rate, or "—" (no labels, or not cross-play).
         vs_human: The verdict against the careful human (cross-play's reference row), e.g.
             ``"less safe (Holm p = 0.025)"``, or "—".
+        hazards: The hazards it caused to the follower behind it (rear-ends, the share it
+            caused by braking for nothing, the follower's braking), or "—" (no follower).
+        unjustified: Its unjustified hard braking, OVER-BRAKING flagged, or "—".
     """
 
     rank: str
@@ -75,6 +83,8 @@ class LeaderRow:
     mobility: str
     preventable: str = "—"
     vs_human: str = "—"
+    hazards: str = "—"
+    unjustified: str = "—"
 
 
 @dataclass(frozen=True)
@@ -103,6 +113,8 @@ COLUMNS: tuple[LeaderColumn, ...] = (
     LeaderColumn("mean speed", True, lambda r: r.mobility),
     LeaderColumn("preventable crashes", True, lambda r: r.preventable, optional=True),
     LeaderColumn("vs the careful human", False, lambda r: r.vs_human, optional=True),
+    LeaderColumn("hazards caused", False, lambda r: r.hazards, optional=True),
+    LeaderColumn("unjustified braking", False, lambda r: r.unjustified, optional=True),
 )
 """The leaderboard's columns, in order."""
 
@@ -147,6 +159,8 @@ def leaderboard_rows(a: CaseAnalysis[RunRecord]) -> list[LeaderRow]:
             crash_cell(outcomes.get(s.vut)),
             mobility_cell(outcomes.get(s.vut)),
             *_human_cells(against.get(s.vut)),
+            hazards_cell(outcomes.get(s.vut)),
+            unjustified_cell(outcomes.get(s.vut)),
         )
         for label, s in zip(labels, standings, strict=True)
     ]
@@ -190,9 +204,33 @@ def leaderboard_table(a: CaseAnalysis[RunRecord], level: float) -> Table | None:
             " Preventable crashes: those R157's careful human avoided when replaying them "
             "(section k); vs the careful human: the VUT's harm against the careful human's "
             "under the same opponents (paired, Holm over the VUTs)."
-            if len(columns) > len(COLUMNS) - 2
+            if any(c.header == "vs the careful human" for c in columns)
             else ""
-        ),
+        )
+        + (
+            " Hazards caused: the follower behind the VUT (SUMO's EIDM, 1 s reaction): share "
+            "of episodes it ran into the VUT, the share the VUT caused by braking for nothing "
+            "(counted in the harm score as a crash), the follower's mean largest braking. "
+            "Unjustified braking: episodes where the VUT braked harder than 3.4 m/s² while "
+            "nothing ahead was critical, and the speed it shed so per episode; OVER-BRAKING: "
+            "more than 1.5 × the median VUT's (docs/ranking.md)."
+            if any(c.header == "hazards caused" for c in columns)
+            else ""
+        )
+        + _flagged_first(rows),
+    )
+
+
+def _flagged_first(rows: Sequence[LeaderRow]) -> str:
+    """A sentence when the VUT ranked first is flagged OVER-BRAKING, else ""."""
+    first = [r for r in rows if r.rank.split("–")[0] == "1" and "OVER-BRAKING" in r.unjustified]
+    if not first:
+        return ""
+    names = ", ".join(r.vut for r in first)
+    where = "shares the first rank" if any("–" in r.rank for r in first) else "ranks first"
+    return (
+        f" {names} {where} but is flagged OVER-BRAKING: its low harm comes with braking "
+        "for nothing, a hazard to the traffic behind it."
     )
 
 
@@ -225,6 +263,8 @@ def leaderboard_text(analyses: Sequence[CaseAnalysis[RunRecord]], width: int = 8
                 if r.vs_human != "—"
                 else ""
             )
+            if r.unjustified != "—":
+                human += f"   hazards: {r.hazards}   unjustified braking: {r.unjustified}"
             lines += textwrap.wrap(
                 f"{r.rank:>{rank_w}}. {r.vut:<{name_w}}  {r.score}   crashes {r.crash_rate}   "
                 f"speed {r.mobility}{human}",

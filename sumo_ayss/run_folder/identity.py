@@ -7,7 +7,7 @@ never enter its simulation's dynamics, and the VUT's *name* is a label: a study 
 drops, redefines or renames another VUT, or renames this one without changing it, asks for
 the same run. :func:`run_identity` is that view of an experiment, as flat dotted fields:
 
-* ``env.vut`` and ``env.vuts`` are left out;
+* ``env.vut`` and ``env.vuts`` are left out, and ``env.follower`` (evaluation only);
 * the run's own VUT's definition (model, parameters, controller; its ``description`` is
   display only) enters under :data:`OWN_VUT` (``env.vuts[env.vut].params.minGap``);
 * display options (:data:`DISPLAY_FIELDS`, e.g. the progress bar) are left out.
@@ -84,6 +84,9 @@ def run_identity(cfg: ExperimentConfig, seed: int) -> dict[str, Any]:
     env = data["env"]
     env.pop("vut")
     env.pop("vuts")
+    # The follower behind the VUT is in the evaluation episodes only (it never changes a
+    # training episode: sumo_ayss.envs.follower), and run folders before it have none.
+    env.pop("follower", None)
     flat = flat_config(data)
     flat.update(flat_config(vut_definition(cfg.env.vut_type), f"{OWN_VUT}."))
     return {"seed": seed, **{k: v for k, v in flat.items() if k not in DISPLAY_FIELDS}}

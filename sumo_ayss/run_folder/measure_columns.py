@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from sumo_ayss.run_folder.table import Column
 
-__all__ = ["EPISODE_MEASURE_COLUMNS"]
+__all__ = ["EPISODE_HAZARD_COLUMNS", "EPISODE_MEASURE_COLUMNS"]
 
 
 def _measure(name: str, unit: str, meaning: str, allow_inf: bool = False) -> Column:
@@ -91,5 +91,55 @@ EPISODE_MEASURE_COLUMNS: tuple[Column, ...] = (
         "m/s",
         "cut-in: VUT speed minus POV speed at the R157 lane intrusion (> 0 closing in; NaN: "
         "no such intrusion)",
+    ),
+)
+
+
+#: What the VUT did to the traffic behind it (issue 33; :mod:`sumo_ayss.analysis.hazards`):
+#: NaN in files written before these columns, and the follower's without a follower.
+EPISODE_HAZARD_COLUMNS: tuple[Column, ...] = (
+    _measure(
+        "follower_min_ttc_s",
+        "s",
+        "the follower's minimum TTC on the VUT (inf = never closing in; NaN: no follower)",
+        allow_inf=True,
+    ),
+    _measure(
+        "follower_min_thw_s",
+        "s",
+        "the follower's minimum time headway to the VUT (NaN: no follower)",
+        allow_inf=True,
+    ),
+    _measure(
+        "follower_max_braking_mps2",
+        "m/s²",
+        "the follower's largest deceleration, > 0 = braking (NaN: no follower)",
+    ),
+    _measure(
+        "follower_max_drac_mps2",
+        "m/s²",
+        "the follower's largest deceleration rate to avoid the VUT (NaN: no follower)",
+    ),
+    _measure("rear_end", "-", "1 if the follower ran into the VUT, else 0 (NaN: no follower)"),
+    _measure(
+        "unjustified_braking",
+        "-",
+        "1 if the VUT braked harder than 3.4 m/s² while nothing ahead was critical, else 0",
+    ),
+    _measure(
+        "unjustified_braking_max_mps2",
+        "m/s²",
+        "the VUT's hardest unjustified braking (0: none)",
+    ),
+    _measure(
+        "unjustified_dv_mps",
+        "m/s",
+        "speed the VUT shed in unjustified hard braking, the sum of braking × decision period",
+    ),
+    _measure(
+        "rear_end_unjustified",
+        "-",
+        "1 if a rear-end followed the VUT's unjustified braking within 3 s, else 0 (NaN: no "
+        "follower)",
     ),
 )

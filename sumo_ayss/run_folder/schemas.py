@@ -17,7 +17,7 @@ Written and read with :func:`~sumo_ayss.run_folder.table.write_table` /
 from __future__ import annotations
 
 from sumo_ayss.cases import CAR_FOLLOWING, CUT_IN, indicator_columns
-from sumo_ayss.run_folder.measure_columns import EPISODE_MEASURE_COLUMNS
+from sumo_ayss.run_folder.measure_columns import EPISODE_HAZARD_COLUMNS, EPISODE_MEASURE_COLUMNS
 from sumo_ayss.run_folder.table import Column, TableSchema
 
 __all__ = [
@@ -97,6 +97,7 @@ OUTCOME_SCHEMA = TableSchema(
         *EPISODE_HARM_COLUMNS,
         *EPISODE_MEASURE_COLUMNS,
         *EPISODE_LABEL_COLUMNS,
+        *EPISODE_HAZARD_COLUMNS,
     ),
 )
 
@@ -191,5 +192,6 @@ CROSSPLAY_SCHEMA = TableSchema(
         *EPISODE_HARM_COLUMNS,
         *EPISODE_MEASURE_COLUMNS,
         *EPISODE_LABEL_COLUMNS,
+        *EPISODE_HAZARD_COLUMNS,
     ),
 )

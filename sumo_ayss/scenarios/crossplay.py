@@ -39,9 +39,10 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from sumo_ayss.analysis.hazards import HAZARD_NAMES
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.config import EnvConfig
-from sumo_ayss.envs.odd import sample_initial_conditions
+from sumo_ayss.envs.odd import sample_initial_conditions, with_followers
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, DiagonalCheck, Table, table_from_rows
 from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
@@ -147,7 +148,7 @@ def run_crossplay(
     # SUMO): its greedy policy depends on the spaces only, the same for every VUT of the pool.
     policies: dict[int, Policy] = {}
     for vut, cfg in envs.items():
-        scenarios = sample_initial_conditions(cfg.odd, n, seed)
+        scenarios = with_followers(sample_initial_conditions(cfg.odd, n, seed), cfg.follower, seed)
         for k, opp in enumerate(opponents):
             key = (vut, repr(cfg), opp.vut, opp.seed, opp.identity, n, seed, reference)
             kept = cells.load(key) if cells is not None and opp.identity else None
@@ -192,6 +193,7 @@ def run_crossplay(
                         "vut_mean_speed_mps": e.vut_mean_speed_mps,
                         **e.measure_row(),
                         "crash_preventable": float(labels[j]),
+                        **e.hazard_row(),
                     }
                 )
             if cells is not None and opp.identity:
@@ -216,6 +218,7 @@ DIAGONAL_COLUMNS = (
     "vut_mean_speed_mps",
     *MEASURE_NAMES,
     "crash_preventable",
+    *HAZARD_NAMES,
 )
 
 

@@ -34,7 +34,7 @@ from tqdm import tqdm
 
 from sumo_ayss.analysis.stats import mean_ci, wilson_interval
 from sumo_ayss.cases import get_case
-from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
+from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions, with_followers
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.run_folder import OUTCOME_SCHEMA, Table
 from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, measure_columns, run_episode
@@ -254,7 +254,8 @@ def run_outcome(
         raise ConfigError(f"n: expected an integer >= 1, got {n!r}")
     base = env.unwrapped
     assert isinstance(base, PairEnv)
-    scenarios = sample_initial_conditions(base.config.odd, n, seed)
+    cfg = base.config
+    scenarios = with_followers(sample_initial_conditions(cfg.odd, n, seed), cfg.follower, seed)
     t0 = time.perf_counter()
     bar = tqdm(scenarios, desc="outcome", unit="ep", disable=not progress, leave=False)
     episodes = [run_episode(base, policy, ic) for ic in bar]

@@ -16,10 +16,11 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from sumo_ayss.analysis.hazards import HAZARD_NAMES, HazardMeasures
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES, EpisodeMeasures
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.scenarios.trajectory import measures_of
+from sumo_ayss.scenarios.trajectory import hazards_of, measures_of
 
 Policy = Callable[[npt.NDArray[np.float32]], npt.NDArray[np.integer]]
 
@@ -43,6 +44,8 @@ class EpisodeResult:
         actions: The POV's actions, in order (:func:`run_episode` records them; empty
             where not recorded): what a counterfactual replays open loop
             (:mod:`sumo_ayss.scenarios.preventability`).
+        hazards: What the VUT did to the traffic behind it (:mod:`sumo_ayss.analysis.
+            hazards`; ``None`` where not recorded).
     """
 
     episode_return: float
@@ -55,12 +58,19 @@ class EpisodeResult:
     # Not part of equality: the same episode tabulated from a vec env has no trajectory.
     measures: EpisodeMeasures | None = field(default=None, compare=False)
     actions: tuple[int, ...] = field(default=(), compare=False)
+    hazards: HazardMeasures | None = field(default=None, compare=False)
 
     def measure_row(self) -> dict[str, float]:
         """The measures as table columns (NaN throughout when not recorded)."""
         if self.measures is None:
             return dict.fromkeys(MEASURE_NAMES, math.nan)
         return self.measures.as_row()
+
+    def hazard_row(self) -> dict[str, float]:
+        """The hazards as table columns (NaN throughout when not recorded)."""
+        if self.hazards is None:
+            return dict.fromkeys(HAZARD_NAMES, math.nan)
+        return self.hazards.as_row()
 
 
 @dataclass(frozen=True)
@@ -102,7 +112,8 @@ def run_episode(env: PairEnv, policy: Policy, ic: InitialCondition) -> EpisodeRe
             break
     result = episode_result(rewards, infos)
     measures = measures_of(base.config, reset_info, infos)
-    return dataclasses.replace(result, measures=measures, actions=tuple(actions))
+    hazards = hazards_of(base.config, reset_info, infos)
+    return dataclasses.replace(result, measures=measures, actions=tuple(actions), hazards=hazards)
 
 
 def episode_result(rewards: Sequence[float], infos: Sequence[Mapping[str, Any]]) -> EpisodeResult:
@@ -132,9 +143,10 @@ def episode_result(rewards: Sequence[float], infos: Sequence[Mapping[str, Any]])
 
 
 def measure_columns(episodes: Sequence[EpisodeResult]) -> dict[str, list[float]]:
-    """The measure columns of a table of ``episodes``: column name -> one value each."""
-    rows = [e.measure_row() for e in episodes]
-    return {name: [r[name] for r in rows] for name in MEASURE_NAMES}
+    """The measure and hazard columns of a table of ``episodes``: column name -> one value
+    each."""
+    rows = [{**e.measure_row(), **e.hazard_row()} for e in episodes]
+    return {name: [r[name] for r in rows] for name in (*MEASURE_NAMES, *HAZARD_NAMES)}
 
 
 def run_episodes(

@@ -27,11 +27,19 @@ from typing import Any
 
 import numpy as np
 
+from sumo_ayss.analysis.hazards import FollowerTrack, HazardMeasures, episode_hazards
 from sumo_ayss.analysis.safety_measures import EpisodeMeasures, PairTrajectory, episode_measures
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.vuts.catalog import VehicleType
 
-__all__ = ["SUMO_DEFAULT_WIDTH_M", "body_width_m", "measures_of", "trajectory_from_infos"]
+__all__ = [
+    "SUMO_DEFAULT_WIDTH_M",
+    "body_width_m",
+    "follower_of",
+    "hazards_of",
+    "measures_of",
+    "trajectory_from_infos",
+]
 
 #: SUMO's default vType width [m] (passenger class), used when a type gives none.
 SUMO_DEFAULT_WIDTH_M = 1.8
@@ -86,3 +94,26 @@ def measures_of(
     """The safety measures of one episode (:func:`trajectory_from_infos`, then
     :func:`~sumo_ayss.analysis.safety_measures.episode_measures`)."""
     return episode_measures(trajectory_from_infos(config, reset_info, infos))
+
+
+def follower_of(
+    reset_info: Mapping[str, Any], infos: Sequence[Mapping[str, Any]]
+) -> FollowerTrack | None:
+    """The follower's samples of one episode, or None when it had none."""
+    if "follower_pos_m" not in reset_info:
+        return None
+    samples = [reset_info, *infos]
+    return FollowerTrack(
+        x_m=np.array([float(s["follower_pos_m"]) for s in samples]),
+        speed_mps=np.array([float(s["follower_speed_mps"]) for s in samples]),
+        rear_end=bool(samples[-1]["rear_end"]),
+    )
+
+
+def hazards_of(
+    config: EnvConfig, reset_info: Mapping[str, Any], infos: Sequence[Mapping[str, Any]]
+) -> HazardMeasures:
+    """The hazards the VUT caused in one episode
+    (:func:`~sumo_ayss.analysis.hazards.episode_hazards`)."""
+    tr = trajectory_from_infos(config, reset_info, infos)
+    return episode_hazards(tr, follower_of(reset_info, infos))

@@ -22,6 +22,7 @@ from typing import NamedTuple
 import libsumo
 from libsumo import _libsumo
 
+from sumo_ayss.sim.follower import VUT_INSERT_POS_WITH_FOLLOWER_M, Follower
 from sumo_ayss.sim.session import SUMO_ERRORS, SumoSession
 from sumo_ayss.util.errors import SimulationError
 
@@ -79,6 +80,8 @@ class VehiclePair:
         pov_type: vType id of the POV.
         edge: road edge id.
         prefix: vehicle-id prefix, unique per pair in the simulation.
+        follower_type: vType id of a follower behind the VUT (:mod:`sumo_ayss.sim.
+            follower`), for the episodes that ask for one; None: never a follower.
     """
 
     def __init__(
@@ -88,6 +91,7 @@ class VehiclePair:
         pov_type: str,
         edge: str = "road",
         prefix: str = "p0",
+        follower_type: str | None = None,
     ) -> None:
         self.session = session
         self.vut_type = vut_type
@@ -98,22 +102,34 @@ class VehiclePair:
         self.episode = 0
         self.vut = ""
         self.pov = ""
+        self._follower_type = follower_type
+        #: This episode's follower, or None (no follower in this episode).
+        self.follower: Follower | None = None
 
     # ------------------------------------------------------------------ episode set-up
 
-    def add(self) -> None:
-        """Remove the last episode's vehicles and add fresh ones (inserted by the next step)."""
+    def add(self, follower: bool = False) -> None:
+        """Remove the last episode's vehicles and add fresh ones (inserted by the next step);
+        ``follower``: a follower behind the VUT too (the pair needs a ``follower_type``)."""
         self.session.add_route(self.route, [self.edge])
         self.remove()
         self.episode += 1
         self.vut = f"{self.prefix}.vut.{self.episode}"
         self.pov = f"{self.prefix}.pov.{self.episode}"
+        vut_pos = _INSERT_VUT_POS_M
+        if follower:
+            if self._follower_type is None:
+                raise SimulationError(f"pair {self.prefix} was built without a follower type")
+            self.follower = Follower(self._follower_type, self.prefix)
+            vut_pos = VUT_INSERT_POS_WITH_FOLLOWER_M
         add = libsumo.vehicle.add
         try:
             add(self.pov, self.route, self.pov_type, "now", "0", str(_INSERT_POV_POS_M), "0")
-            add(self.vut, self.route, self.vut_type, "now", "0", str(_INSERT_VUT_POS_M), "0")
+            add(self.vut, self.route, self.vut_type, "now", "0", str(vut_pos), "0")
         except SUMO_ERRORS as e:
             raise SimulationError(f"adding pair {self.prefix} failed: {e}") from e
+        if self.follower is not None:
+            self.follower.add(self.route, self.episode)
 
     def place(self, p: PairPlacement) -> None:
         """Put the freshly inserted vehicles exactly at ``p`` (call after one step)."""
@@ -131,6 +147,11 @@ class VehiclePair:
                 f"placing pair {self.prefix} at {p} failed ({e}); was it inserted? "
                 "(a vehicle SUMO could not insert is silently kept waiting)"
             ) from e
+
+    def place_follower(self, lane: int, pos_m: float, speed_mps: float) -> None:
+        """Put this episode's follower's front at ``pos_m`` on ``lane`` (after :meth:`place`)."""
+        assert self.follower is not None
+        self.follower.place(f"{self.edge}_{lane}", pos_m, speed_mps)
 
     def _start_vut_decisions(self) -> None:
         """The VUT's first decision is the episode's first step, then one every
@@ -159,6 +180,9 @@ class VehiclePair:
             with contextlib.suppress(*SUMO_ERRORS):  # gone already (left, or never inserted)
                 libsumo.vehicle.remove(vid)
         self.vut = self.pov = ""
+        if self.follower is not None:
+            self.follower.remove()
+            self.follower = None
 
     # ------------------------------------------------------------------ per step
 
@@ -197,8 +221,18 @@ class VehiclePair:
         libsumo.vehicle.changeLane(self.pov, lane, duration_s)
 
     def collided(self, colliding: Sequence[str]) -> bool:
-        """Whether either vehicle of the pair is in ``colliding`` (ids from the session)."""
-        return bool(colliding) and (self.vut in colliding or self.pov in colliding)
+        """Whether either vehicle of the pair is in ``colliding`` (ids from the session).
+
+        With a follower in the episode, only a collision of the VUT with the POV counts, read
+        from SUMO's collision pairs; a rear-end (the follower into the VUT) is recorded on
+        :attr:`follower` and does not end the episode (:mod:`sumo_ayss.sim.follower`).
+        """
+        if not colliding:
+            return False
+        fol = self.follower
+        if fol is not None and (fol.id in colliding or fol.gone):
+            return fol.check_collisions(self.session, self.vut, self.pov)
+        return self.vut in colliding or self.pov in colliding
 
     # ------------------------------------------------------------------ highway-env laws
 

@@ -172,6 +172,13 @@ class SumoSession:
             return ()
         return tuple(_colliding_ids())
 
+    def collision_pairs(self) -> tuple[tuple[str, str], ...]:
+        """``(collider, victim)`` of each collision of the last step (SUMO's
+        ``simulation.getCollisions``): who hit whom, where a third vehicle is near."""
+        if _n_colliding() == 0:
+            return ()
+        return tuple((c.collider, c.victim) for c in libsumo.simulation.getCollisions())
+
     def add_route(self, route_id: str, edges: Sequence[str]) -> None:
         """Add route ``route_id`` over ``edges`` unless this simulation has it already."""
         # Known routes are remembered: libsumo's getIDList costs O(routes) per call, and a

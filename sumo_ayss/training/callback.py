@@ -22,6 +22,9 @@ class Trainer(Protocol):
     next_eval: int
     collector: Collector
 
+    @property
+    def stopped(self) -> object | None: ...
+
     def save_checkpoint(self) -> None: ...
 
     def record_actions(self, actions: Any) -> None: ...
@@ -41,8 +44,9 @@ class CandidateCallback(BaseCallback):
     The collector decides (:meth:`~sumo_ayss.training.collectors.Collector.
     ready_for_candidate`). The candidate's resume checkpoint follows at the next rollout
     start (:meth:`Trainer.save_checkpoint`); the steps in between are recorded for its
-    replay. Every :data:`PROGRESS_EVERY_S` seconds it also
-    rewrites ``progress.json``.
+    replay. Once the early-stopping rule has stopped the run (:attr:`Trainer.stopped`),
+    it ends ``learn``. Every :data:`PROGRESS_EVERY_S` seconds it also rewrites
+    ``progress.json``.
     """
 
     def __init__(self, trainer: Trainer) -> None:
@@ -87,4 +91,4 @@ class CandidateCallback(BaseCallback):
             return True
         if trainer.collector.ready_for_candidate(self.locals):
             trainer.candidate(rollout=self.locals)
-        return True
+        return trainer.stopped is None  # False ends ``learn``: the early-stopping rule

@@ -84,6 +84,7 @@ from sumo_ayss.training.collectors import (
     make_collector,
 )
 from sumo_ayss.training.config_check import check_same_config
+from sumo_ayss.training.early_stop import StopDecision, rule_stops
 from sumo_ayss.training.run_metadata import write_metadata
 from sumo_ayss.training.selection import select_spcp
 from sumo_ayss.util.atomic import atomic_copy
@@ -132,6 +133,8 @@ class Trainer:
         self._pending_dir: Path | None = None
         self._anchor: dict[str, Any] = {}
         self._actions_since_anchor: list[list[int]] = []
+        #: The early-stopping rule's decision once it stopped the run (else None).
+        self.stopped: StopDecision | None = None
 
     @property
     def env(self) -> PairEnv | None:
@@ -169,7 +172,8 @@ class Trainer:
         model = self.model
         assert model is not None
         remaining = self.cfg.train.total_timesteps - model.num_timesteps
-        if remaining > 0:
+        self.check_early_stop()  # a resumed run that had already stopped stays stopped
+        if remaining > 0 and self.stopped is None:
             model.learn(
                 total_timesteps=remaining,
                 callback=CandidateCallback(self),
@@ -216,12 +220,19 @@ class Trainer:
             self.next_eval += self.cfg.train.eval_every
 
         write_eval_table(self.eval_path, self.rows)
+        self.check_early_stop()
         # The resume state is written at the next rollout start (save_checkpoint), once SB3
         # has stored this step's transitions and trained on them: from here on the actions
         # are recorded, so that a resume replays them from this episode start.
         self._anchor = env_state
         self._actions_since_anchor = []
         self._pending_dir = step_dir
+
+    def check_early_stop(self) -> None:
+        """Once the early-stopping rule (:func:`~sumo_ayss.training.early_stop.rule_stops`)
+        stops the run, :attr:`stopped` holds why (the callback then ends ``learn``)."""
+        if self.stopped is None:
+            self.stopped = rule_stops(self.cfg.train, self.rows, str(self.run_dir))
 
     def record_actions(self, actions: Any) -> None:
         """Note a step's actions (between a candidate and its checkpoint, for the replay)."""
@@ -299,6 +310,8 @@ class Trainer:
 
     def select(self) -> dict[str, Any]:
         choice = select_spcp(self.rows, self.cfg.train.selection, str(self.run_dir))
+        if self.stopped is not None:
+            choice = dataclasses.replace(choice, reason=f"{choice.reason}; {self.stopped.reason}")
         row = self.rows[choice.index]
         atomic_copy(self.run_dir / row["checkpoint"], self.folder.spcp_zip)
         record = {**dataclasses.asdict(choice), "checkpoint": row["checkpoint"], "row": row}

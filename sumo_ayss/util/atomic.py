@@ -11,12 +11,15 @@ the ones a killed process left behind.
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import shutil
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
+
+from sumo_ayss.util.errors import DiskFullError
 
 #: Suffix of every temporary file written here (``.<name>.<pid>.tmp``).
 TMP_SUFFIX = ".tmp"
@@ -34,6 +37,58 @@ def fsync_dir(folder: str | Path) -> None:
         pass
     finally:
         os.close(fd)
+
+
+#: Errors of a file system without room: no space left, quota exceeded.
+FULL_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT})
+#: A writer that hides the errno (``torch.save`` raises a ``RuntimeError``) counts as having
+#: met a full disk when less than this is free after it failed, bytes.
+NEARLY_FULL_B = 1 << 20
+
+
+def free_bytes(folder: str | Path) -> int | None:
+    """Bytes free to this user on ``folder``'s file system (None when it cannot be asked)."""
+    try:
+        st = os.statvfs(folder)
+    except OSError:
+        return None
+    return st.f_bavail * st.f_frsize
+
+
+def disk_full_error(
+    path: Path, needed: int | None, cause: BaseException, written: int = 0
+) -> DiskFullError | None:
+    """The :class:`DiskFullError` for a failed write of ``path``, or None when ``cause`` is
+    not a full file system. ``needed``: the file's size in bytes, None when unknown (then
+    ``written``, the bytes on disk when it failed, is named as a lower bound)."""
+    full = isinstance(cause, OSError) and cause.errno in FULL_ERRNOS
+    free = free_bytes(path.parent)
+    if not full and not (free is not None and free < NEARLY_FULL_B):
+        return None
+    if needed is not None:
+        size = f"{needed:,} bytes"
+    else:
+        size = f"more than {written:,} bytes" if written else "an unknown number of bytes"
+    return DiskFullError(
+        f"no space left on the file system of {path}: the file needs {size} and "
+        f"{'?' if free is None else f'{free:,}'} bytes are free there ({cause}). Every file "
+        "written before is complete; free some space (or move the output folder) and rerun "
+        "the same command to continue"
+    )
+
+
+def _measured_size(write: Callable[[Path], object], suffix: str) -> int | None:
+    """The size of what ``write`` writes, written once more into the system's temporary
+    folder (another file system, often); None when that fails too."""
+    import tempfile
+
+    try:
+        with tempfile.TemporaryDirectory(prefix="sumo_ayss_size_") as folder:
+            probe = Path(folder) / f"probe{suffix}"
+            write(probe)
+            return probe.stat().st_size
+    except Exception:
+        return None
 
 
 def _tmp_path(path: Path) -> Path:
@@ -56,6 +111,14 @@ def atomic_write_with(path: str | Path, write: Callable[[Path], object]) -> None
             os.fsync(f.fileno())
         os.replace(tmp, path)
         fsync_dir(path.parent)
+    except Exception as e:
+        written = tmp.stat().st_size if tmp.is_file() else 0
+        tmp.unlink(missing_ok=True)  # its room counts as free in the message
+        full = disk_full_error(path, None, e, written)
+        if full is not None:
+            needed = _measured_size(write, path.suffix)
+            raise (full if needed is None else disk_full_error(path, needed, e)) or full from e
+        raise
     finally:
         tmp.unlink(missing_ok=True)
 
@@ -72,6 +135,12 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
             os.fsync(f.fileno())
         os.replace(tmp, path)
         fsync_dir(path.parent)
+    except OSError as e:
+        tmp.unlink(missing_ok=True)  # its room counts as free in the message
+        full = disk_full_error(path, len(data), e)
+        if full is not None:
+            raise full from e
+        raise
     finally:
         tmp.unlink(missing_ok=True)
 

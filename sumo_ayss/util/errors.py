@@ -53,3 +53,14 @@ class ControllerError(AyssError, RuntimeError):
 
 class LockError(AyssError, RuntimeError):
     """Another live process holds the lock of an output folder (the message names its PID)."""
+
+
+class ClusterError(AyssError, RuntimeError):
+    """The Ray cluster refused the pipeline (e.g. a missing authentication token) or stopped
+    answering while jobs were queued (its head node died); the message says what to do."""
+
+
+class DiskFullError(AyssError, OSError):
+    """A file could not be written: its file system is full (or over quota). The message names
+    the file, the bytes it needed and the bytes free; what was written before stays readable
+    (atomic writes), and the same command resumes once space is freed."""

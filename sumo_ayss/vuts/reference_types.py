@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from sumo_ayss.util.frozen import FrozenMap
 from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
 
-__all__ = ["DEFAULT_REFERENCE", "REFERENCE_VUTS"]
+__all__ = ["DEFAULT_REFERENCE", "OVERBRAKER_VUT", "REFERENCE_VUTS"]
 
 
 def _reference(target: str, description: str, max_decel_mps2: float) -> VehicleType:
@@ -55,3 +55,18 @@ REFERENCE_VUTS: Mapping[str, VehicleType] = FrozenMap(
 
 #: The reference driver that labels crashes preventable or not unless configured otherwise.
 DEFAULT_REFERENCE = "cc_driver"
+
+#: Issue 33's over-braker (:class:`sumo_ayss.vuts.overbraking.OverBraker`): brakes at
+#: 6 m/s² whenever a leader is within 2 s. Its limits are its own (2 m/s² up, 6 down).
+OVERBRAKER_VUT = VehicleType(
+    model="IDM",
+    params={"length": 5.0, "width": 1.8, "minGap": 0.0},
+    description="brakes at 6 m/s² whenever a leader is within 2 s (issue 33's over-braker)",
+    controller=ControllerSpec(
+        target="sumo_ayss.vuts.overbraking:OverBraker",
+        params={},
+        max_accel_mps2=2.0,
+        max_decel_mps2=6.0,
+        max_speed_mps=40.0,
+    ),
+)

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from sumo_ayss.analysis.hazards import HAZARD_NAMES
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
@@ -40,6 +41,8 @@ def outcome_rows() -> list[dict[str, object]]:
             "vut_mean_speed_mps": 1.0 / 3.0 + i,
             **_measures(i),
             "crash_preventable": 1.0 if i == 1 else 0.0,
+            **{name: 0.5 + i for name in HAZARD_NAMES},
+            "follower_min_ttc_s": math.inf if i == 2 else 3.0,
         }
         for i in range(3)
     ]
@@ -152,7 +155,8 @@ def test_ragged_rows_bad_bools_and_missing_files_are_refused(tmp_path: Path) -> 
     write_table(path, table_from_rows(OUTCOME_SCHEMA, outcome_rows()))
     lines = path.read_text().splitlines()
     path.write_text("\n".join([*lines[:2], lines[2] + ",9", *lines[3:]]) + "\n")
-    with pytest.raises(TableError, match="row 1 has 26 cells, header has 25"):
+    n = len(OUTCOME_SCHEMA.columns)
+    with pytest.raises(TableError, match=f"row 1 has {n + 1} cells, header has {n}"):
         read_table(path, OUTCOME_SCHEMA)
     rows = [line.split(",") for line in lines]
     rows[1][OUTCOME_SCHEMA.names.index("collided")] = "2"
@@ -195,18 +199,19 @@ def test_json_summary_is_strict_json(tmp_path: Path) -> None:
 
 def test_a_file_written_before_a_late_column_reads_it_as_not_recorded(tmp_path: Path) -> None:
     """``near_miss_pay`` and ``vut_mean_speed_mps`` came later (issue 22), the safety
-    measures later still (issue 27), the crash label last (issue 32): an older outcome.csv
-    without them reads, with NaN there ("not labelled"); any other missing column is
-    refused."""
+    measures later still (issue 27), the crash label (issue 32), the hazards last (issue 33):
+    an older outcome.csv without them reads, with NaN there ("not labelled"); any other
+    missing column is refused."""
     path = tmp_path / "old.csv"
     write_table(path, table_from_rows(OUTCOME_SCHEMA, outcome_rows()))
-    late = 2 + len(MEASURE_NAMES) + 1
+    late = 2 + len(MEASURE_NAMES) + 1 + len(HAZARD_NAMES)
     lines = [line.split(",")[:-late] for line in path.read_text().splitlines()]
     path.write_text("\n".join(",".join(r) for r in lines) + "\n")
     old = read_table(path, OUTCOME_SCHEMA)
     assert np.isnan(old["near_miss_pay"]).all() and np.isnan(old["vut_mean_speed_mps"]).all()
     assert all(np.isnan(old[name]).all() for name in MEASURE_NAMES)
     assert np.isnan(old["crash_preventable"]).all()
+    assert all(np.isnan(old[name]).all() for name in HAZARD_NAMES)
     assert old["episode_return"].tolist() == [r["episode_return"] for r in outcome_rows()]
     path.write_text("\n".join(",".join(r[:-1]) for r in lines) + "\n")  # n_steps gone too
     with pytest.raises(TableError, match=r"missing column\(s\) \['n_steps'\]"):

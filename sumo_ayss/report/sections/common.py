@@ -14,15 +14,18 @@ from sumo_ayss.run_folder import Estimate, RunRecord
 from sumo_ayss.util.paths import display_path
 
 __all__ = [
+    "OVERBRAKING_NOTE",
     "TIMID_NOTE",
     "crash_cell",
     "crash_text",
     "display_path",
     "fmt_est",
+    "hazards_cell",
     "mobility_cell",
     "mobility_text",
     "seed_points_text",
     "seeds_text",
+    "unjustified_cell",
 ]
 
 
@@ -102,6 +105,38 @@ TIMID_NOTE = (
     "episodes: it may owe its low harm to standing still rather than to driving safely."
 )
 """What a TIMID flag means (:data:`sumo_ayss.analysis.harm.MOBILITY_FLOOR`)."""
+
+
+OVERBRAKING_NOTE = (
+    "A VUT marked OVER-BRAKING shed more speed in unjustified hard braking (harder than "
+    "3.4 m/s² while nothing ahead was critical) than 1.5 × the median VUT's over the same "
+    "episodes: its low harm may come from braking at everything, which the traffic behind it "
+    "pays for (the follower's braking in 'hazards caused'; docs/ranking.md)."
+)
+"""What an OVER-BRAKING flag means (:mod:`sumo_ayss.analysis.hazards`)."""
+
+
+def hazards_cell(o: VutOutcome | None) -> str:
+    """The hazards a VUT caused to the follower behind it, or "—" (not recorded)."""
+    h = None if o is None else o.hazards
+    if h is None or not math.isfinite(h.get("rear_end", math.nan)):
+        return "—"
+    return (
+        f"rear-ends {100 * h['rear_end']:.1f} % (caused {100 * h['rear_end_unjustified']:.1f} %), "
+        f"follower braking {h['follower_max_braking_mps2']:.1f} m/s²"
+    )
+
+
+def unjustified_cell(o: VutOutcome | None) -> str:
+    """The VUT's unjustified hard braking (rate, speed shed), flagged, or "—"."""
+    h = None if o is None else o.hazards
+    if o is None or h is None or not math.isfinite(h.get("unjustified_braking", math.nan)):
+        return "—"
+    flag = " (OVER-BRAKING)" if o.overbraking else ""
+    return (
+        f"{100 * h['unjustified_braking']:.0f} % of episodes, "
+        f"{h['unjustified_dv_mps']:.1f} m/s shed{flag}"
+    )
 
 
 def crash_text(crashes: int, episodes: int, lo: float, hi: float) -> str:
