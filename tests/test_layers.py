@@ -47,11 +47,13 @@ ANALYSIS_MAY_IMPORT = (
 #: the same purity (no file, no loader), so that a mode computes and words from data only.
 MODES_MAY_IMPORT = (*ANALYSIS_MAY_IMPORT, "sumo_ayss.modes")
 #: Pairs of layers with no import edge of any kind (module, function or type-only level):
-#: the configuration is below the ranking modes, the analysis below the modes and the files.
+#: the configuration is below the ranking modes, the analysis below the modes and the files,
+#: and the files are storage: the reader returns what is stored, the analysis scores it.
 NO_IMPORTS = (
     ("sumo_ayss.config", "sumo_ayss.modes"),
     ("sumo_ayss.analysis", "sumo_ayss.modes"),
     ("sumo_ayss.analysis", "sumo_ayss.run_folder"),
+    ("sumo_ayss.run_folder", "sumo_ayss.analysis"),
 )
 #: Packages whose ``__init__`` is a docstring: importing one of their modules runs nothing
 #: else of them (checked below), so the package edge itself carries no import.
