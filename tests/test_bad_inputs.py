@@ -1085,7 +1085,7 @@ def test_a_garbled_table_or_json_file_is_a_table_error_naming_it(tmp_path: Path)
     with pytest.raises(TableError, match=r"crossplay\.csv: not UTF-8 text"):
         read_table(path, CROSSPLAY_SCHEMA)
     _garble(tmp_path / "crossplay.json")
-    with pytest.raises(TableError, match=r"crossplay\.json: not UTF-8 text"):
+    with pytest.raises(TableError, match=r"crossplay\.json: unreadable JSON: not UTF-8 text"):
         read_json(tmp_path / "crossplay.json")
     with pytest.raises(TableError, match="cannot read"):
         read_json(tmp_path)  # a folder

@@ -24,8 +24,9 @@ means, for the POV ahead of the VUT's front, in its path or moving sideways towa
 
 The numbers: 3.4 m/s² is AASHTO's design deceleration for stopping sight distance (*A
 Policy on Geometric Design of Highways and Streets*, the "Green Book": "a comfortable
-deceleration for most drivers", which about 90 % of drivers exceed only when they must stop
-for an unexpected object; quoted from memory, not re-read this session); TTC 2.0 s is UN
+deceleration for most drivers": "A deceleration rate of 3.4 m/s² (11.2 ft/s²) is used to
+determine stopping sight distance", the Green Book's text as quoted at
+http://www.primidi.com/deceleration_rate, checked in session 9); TTC 2.0 s is UN
 R157's criticality gate of the competent and careful driver (cut-in), and the FSM's
 parameters (0.75 s reaction, 6 m/s² own and 7 m/s² leader braking, 2 m margin) are JRC's
 (Mattas et al. 2020); both in ``../shared/research/reference-drivers.md`` §1.1 and §1.4.

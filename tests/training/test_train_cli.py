@@ -65,7 +65,15 @@ def test_ctrl_c_prints_the_resume_command_not_a_traceback(tmp_path: Path) -> Non
     args = ["--config", str(config), "--seed", "0", "--out", str(out)]
     cmd = [sys.executable, "-m", "sumo_ayss.train", *args]
     latest = out / "car_following" / "pi1" / "seed_0" / "checkpoints" / "latest.json"
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # A shell that starts the suite in the background (`cmd &`) makes SIGINT ignored, and a
+    # child inherits that: give the trainer the default a person at a terminal has.
+    proc = subprocess.Popen(
+        cmd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.default_int_handler),
+    )
     try:
         deadline = time.monotonic() + 120
         while time.monotonic() < deadline and not latest.is_file():
