@@ -160,6 +160,9 @@ def cells(out: Path, studies: Sequence[Path], budget_step: int = BUDGET_STEP) ->
             "seed": seed,
             "runs": {},
         }
+        scale = harm_scale_of(runs[0])
+        if scale is not None:  # so that the cells read back without their run folders
+            meta["max_episode_pay"] = scale.max_episode_pay
         todo = []
         for r in runs:
             steps = spcp_steps(r, budget_step)
@@ -300,10 +303,13 @@ def _read_meta(folder: Path) -> dict:
 def _load_cells(folder: Path) -> tuple[dict, dict, float]:
     """(vut, opp_vut, opp_seed, step) -> (harm, collided) arrays; meta; CPU-s per episode."""
     meta = _read_meta(folder)
-    first = read_run(PROJECT_ROOT / next(iter(meta["runs"].values()))["run_dir"])
-    scale = harm_scale_of(first)
-    if scale is None:
-        sys.exit(f"{first.path}: no harm scale ({'; '.join(first.problems)})")
+    max_pay = meta.get("max_episode_pay")
+    if max_pay is None:  # cells written before the scale was stored: ask a run folder
+        first = read_run(PROJECT_ROOT / next(iter(meta["runs"].values()))["run_dir"])
+        scale = harm_scale_of(first)
+        if scale is None:
+            sys.exit(f"{first.path}: no harm scale ({'; '.join(first.problems)})")
+        max_pay = scale.max_episode_pay
     data: dict = defaultdict(list)
     cpu: dict = {}
     with _open_cells(folder) as f:
@@ -316,7 +322,7 @@ def _load_cells(folder: Path) -> tuple[dict, dict, float]:
         rows.sort()
         pay = np.array([p for _, p, _ in rows])
         crash = np.array([c for _, _, c in rows], dtype=bool)
-        cells_out[key] = (episode_harm(pay, crash, scale.max_episode_pay), crash)
+        cells_out[key] = (episode_harm(pay, crash, float(max_pay)), crash)
     n = meta["n"]
     per_episode = float(np.median([c / n for c in cpu.values()]))
     return cells_out, meta, per_episode
