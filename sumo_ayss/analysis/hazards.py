@@ -13,14 +13,19 @@ VUT's unjustified hard braking, per episode (pure numpy, no SUMO).
 * ``rear_end``: 1 if the follower ran into the VUT (SUMO's collision pair), else 0.
 
 **Unjustified hard braking.** The VUT brakes harder than :data:`HARD_BRAKING_MPS2` over a
-decision while nothing ahead was critical at its start (the state it decided on). Critical
-means, for the POV ahead of the VUT's front, in its path or moving sideways toward it:
+decision while nothing ahead was critical at its start (the state it decided on) and no
+leader had braked as hard just before. Critical means, for the POV ahead of the VUT's front,
+in its path or moving sideways toward it:
 
 * its TTC (1-D in one path, or 2-D) below :data:`CRITICAL_TTC_S`, or
 * the gap inside the Fuzzy Safety Model's unsafe distance (PFS = 1: the careful driver model
   proposed for R157 already brakes there), or
-* the POV itself braked at least as hard over the decision before (matching a braking
-  leader is never "for nothing").
+* the gap shorter than R157's minimum following distance
+  (:func:`r157_min_following_distance_m`: a vehicle that close must open the gap).
+
+And braking is answered, not unjustified, when the POV braked at least as hard over any
+decision that started within :data:`REACTION_WINDOW_S` before this one (a leader's braking,
+matched by a driver with a human reaction delay, is never "for nothing").
 
 The numbers: 3.4 m/s² is AASHTO's design deceleration for stopping sight distance (*A
 Policy on Geometric Design of Highways and Streets*, the "Green Book": "a comfortable
@@ -29,7 +34,17 @@ determine stopping sight distance", the Green Book's text as quoted at
 http://www.primidi.com/deceleration_rate, checked in session 9); TTC 2.0 s is UN
 R157's criticality gate of the competent and careful driver (cut-in), and the FSM's
 parameters (0.75 s reaction, 6 m/s² own and 7 m/s² leader braking, 2 m margin) are JRC's
-(Mattas et al. 2020); both in ``../shared/research/reference-drivers.md`` §1.1 and §1.4.
+(Mattas et al. 2020); the minimum following distance is R157 §5.2.3.3's (time gap
+1.0 s + 0.01 s per km/h, at least 2 m; esmini ``Regulation::MinDist``); the reaction window
+1.15 s is the careful driver's 0.4 s risk perception plus 0.75 s reaction (esmini's ECE
+reference driver waits 0.75 + 0.4 s). All in ``../shared/research/reference-drivers.md``
+§1.1, §1.3 and §1.4.
+
+Why these clauses (issue 33, measured in ``benchmarks/unjustified_braking.py``): with only
+the first two and the POV's braking in the one decision before, SUMO's IDM VUTs braked
+"unjustifiably" in most episodes, almost all of it at time headways well below R157's
+minimum following distance (a gap the POV had just closed by braking) while the gap was
+already opening; the over-braker's excess is braking beyond that distance.
 
 ``unjustified_braking`` is 1 if any decision of the episode was such braking,
 ``unjustified_braking_max_mps2`` the hardest of them (0: none) and ``unjustified_dv_mps``
@@ -58,6 +73,7 @@ __all__ = [
     "HAZARD_NAMES",
     "OVERBRAKING_FACTOR",
     "OVERBRAKING_FLOOR_MPS",
+    "REACTION_WINDOW_S",
     "REAR_END_WINDOW_S",
     "VUT_HAZARD_COLUMNS",
     "FollowerTrack",
@@ -66,6 +82,7 @@ __all__ = [
     "fsm_unsafe_distance_m",
     "harm_crash",
     "overbraking_flags",
+    "r157_min_following_distance_m",
     "unjustified_braking",
     "vut_hazards",
 ]
@@ -76,6 +93,9 @@ FloatArray = NDArray[np.float64]
 HARD_BRAKING_MPS2 = 3.4
 #: TTC below which the situation ahead is critical [s] (R157's careful-driver gate).
 CRITICAL_TTC_S = 2.0
+#: A leader's braking this long before a decision [s] still justifies matching it: R157's
+#: careful driver's risk perception 0.4 s plus reaction 0.75 s (reference-drivers.md §1.1).
+REACTION_WINDOW_S = 1.15
 #: A rear-end counts against the VUT when it braked unjustifiably this long before [s]:
 #: the follower's 1 s reaction plus 2 s of its braking.
 REAR_END_WINDOW_S = 3.0
@@ -90,6 +110,17 @@ def fsm_unsafe_distance_m(v_rear_mps: FloatArray, v_lead_mps: FloatArray) -> Flo
     """
     v_r, v_l = np.asarray(v_rear_mps, float), np.asarray(v_lead_mps, float)
     return v_r * _FSM_TAU_S + v_r**2 / (2 * _FSM_B_R_MAX) - v_l**2 / (2 * _FSM_B_L) + _FSM_MARGIN_M
+
+
+def r157_min_following_distance_m(v_mps: FloatArray) -> FloatArray:
+    """UN R157 §5.2.3.3's minimum following distance at speed ``v_mps`` [m].
+
+    Time gap 1.0 + v[km/h]/100 s from 10 km/h, 1.0 + (v[m/s] - 2)/7.8 s below, at least
+    2 m (esmini ``Regulation::MinDist``; reference-drivers.md §1.3).
+    """
+    v = np.asarray(v_mps, float)
+    gap_s = np.where(v * 3.6 >= 10.0, 1.0 + v * 3.6 / 100.0, 1.0 + (v - 2.0) / 7.8)
+    return np.maximum(v * gap_s, 2.0)
 
 
 @dataclass(frozen=True)
@@ -129,8 +160,21 @@ class HazardMeasures:
 HAZARD_NAMES: tuple[str, ...] = tuple(f.name for f in fields(HazardMeasures))
 
 
-def unjustified_braking(tr: PairTrajectory) -> FloatArray:
+def unjustified_braking(
+    tr: PairTrajectory,
+    *,
+    reaction_window_s: float = REACTION_WINDOW_S,
+    following_distance: bool = True,
+) -> FloatArray:
     """The VUT's deceleration over each decision [m/s²] where it was unjustified, else 0.
+
+    Args:
+        tr: The episode (uniform sample times).
+        reaction_window_s: The POV's braking over a decision that started this long before
+            still justifies (at least one decision: the one before).
+        following_distance: Inside R157's minimum following distance is critical.
+            ``reaction_window_s=0, following_distance=False`` is session 9's first rule
+            (kept to measure the change against, ``benchmarks/unjustified_braking.py``).
 
     Returns:
         Shape ``(n - 1,)``: entry ``k`` is the decision from sample ``k`` to ``k + 1``.
@@ -139,7 +183,6 @@ def unjustified_braking(tr: PairTrajectory) -> FloatArray:
         return np.zeros(0)
     dt = np.diff(tr.time_s)
     braking = -np.diff(tr.vut_speed_mps) / dt
-    pov_braking = np.concatenate([[0.0], -np.diff(tr.pov_speed_mps) / dt])[:-1]
     gap = tr.pov_ahead_gap_m()
     closing = tr.vut_speed_mps - tr.pov_speed_mps
     side = np.sign(tr.pov_y_m - tr.vut_y_m)
@@ -158,10 +201,22 @@ def unjustified_braking(tr: PairTrajectory) -> FloatArray:
         0.5 * (tr.pov_width_m + tr.vut_width_m),
     )
     close = gap < fsm_unsafe_distance_m(tr.vut_speed_mps, tr.pov_speed_mps)
+    if following_distance:
+        close |= gap < r157_min_following_distance_m(tr.vut_speed_mps)
     critical = relevant & ((np.minimum(ttc_1d, ttc2) < CRITICAL_TTC_S) | close)
-    critical = critical[:-1] | (pov_braking >= braking - 1e-6)  # rounding of equal rates
+    critical = critical[:-1] | (_leader_braked(tr, reaction_window_s) >= braking - 1e-6)
     hard = braking > HARD_BRAKING_MPS2
     return np.where(hard & ~critical, braking, 0.0)
+
+
+def _leader_braked(tr: PairTrajectory, window_s: float) -> FloatArray:
+    """Per decision ``k``, the POV's hardest braking over the decisions ``k - w .. k - 1``
+    that started within ``window_s`` before it (``w`` >= 1; 0 before the first) [m/s²]."""
+    dt = np.diff(tr.time_s)
+    pov_braking = -np.diff(tr.pov_speed_mps) / dt
+    w = max(1, int(math.floor(window_s / float(dt[0]) + 1e-9)))
+    padded = np.concatenate([np.zeros(w), pov_braking[:-1]])  # padded[k + j]: decision k - w + j
+    return np.lib.stride_tricks.sliding_window_view(padded, w).max(axis=1)
 
 
 def _follower(tr: PairTrajectory, f: FollowerTrack) -> tuple[float, float, float, float]:
