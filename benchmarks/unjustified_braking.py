@@ -125,7 +125,11 @@ def main() -> None:
             scores = {vut: [rule(tr) for tr in trs[vut]] for vut in VUTS}
             share = {v: np.mean([u.max(initial=0.0) > 0 for u in s]) for v, s in scores.items()}
             dv = {
-                v: float(np.mean([np.sum(u) * float(tr.time_s[1]) for u, tr in zip(s, trs[v])]))
+                v: float(
+                    np.mean(
+                        [np.sum(u) * float(tr.time_s[1]) for u, tr in zip(s, trs[v], strict=True)]
+                    )
+                )
                 for v, s in scores.items()
             }
             flags = overbraking_flags(dv)

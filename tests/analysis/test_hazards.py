@@ -9,9 +9,11 @@ import pytest
 
 from sumo_ayss.analysis.hazards import (
     HARD_BRAKING_MPS2,
+    REACTION_WINDOW_S,
     FollowerTrack,
     episode_hazards,
     fsm_unsafe_distance_m,
+    r157_min_following_distance_m,
     unjustified_braking,
 )
 from sumo_ayss.analysis.safety_measures import PairTrajectory
@@ -94,6 +96,42 @@ def test_braking_inside_the_fsm_unsafe_distance_is_justified() -> None:
     assert not unjustified_braking(tr).any()
 
 
+def test_r157_minimum_following_distance_by_hand() -> None:
+    # 1.0 s + 0.01 s per km/h from 10 km/h; 1.0 + (v - 2)/7.8 s below; at least 2 m
+    v = np.array([0.0, 2.0, 10.0, 100 / 3.6])
+    expected = [2.0, 2.0, 10.0 * 1.36, 100 / 3.6 * 2.0]
+    assert r157_min_following_distance_m(v) == pytest.approx(expected)
+    assert r157_min_following_distance_m(np.array(10 / 3.6)) == pytest.approx(10 / 3.6 * 1.1)
+
+
+def test_braking_inside_r157s_following_distance_is_justified() -> None:
+    # 28 m at 20 m/s, the POV as fast: outside the FSM's unsafe distance (21.8 m), TTC
+    # infinite, but inside R157's minimum following distance (34.4 m): opening it is necessary
+    assert fsm_unsafe_distance_m(np.array(20.0), np.array(20.0)) < 28.0
+    assert r157_min_following_distance_m(np.array(20.0)) > 28.0
+    tr = _traj(_braking(20.0, 5.0, 2), [20.0] * 2, gap0=28.0)
+    assert not unjustified_braking(tr).any()
+    assert unjustified_braking(tr, following_distance=False).all()  # the clause does it
+    beyond = _traj(_braking(20.0, 5.0, 2), [20.0] * 2, gap0=35.0)  # beyond it: for nothing
+    assert unjustified_braking(beyond).all()
+
+
+def test_a_leader_that_braked_within_the_reaction_window_justifies_braking() -> None:
+    # the POV brakes at 6 m/s² for one decision, then holds; the VUT, 60 m behind (far beyond
+    # every distance), brakes as hard k decisions later: an answer within 1.15 s, else not
+    def run(k: int, window_s: float = REACTION_WINDOW_S) -> float:
+        pov = np.array([20.0, 18.8] + [18.8] * (k + 1))
+        vut = np.array([20.0] * (k + 1) + [20.0 - 6.0 * DT, 20.0 - 6.0 * DT])
+        return float(unjustified_braking(_traj(vut, pov, gap0=60.0), reaction_window_s=window_s)[k])
+
+    assert int(REACTION_WINDOW_S / DT + 1e-9) == 5  # decisions that started 0.2 .. 1.0 s before
+    for k in range(1, 6):
+        assert run(k) == 0.0, k
+    assert run(6) == pytest.approx(6.0)  # 1.2 s later: no longer an answer
+    assert run(1, window_s=0.0) == 0.0  # the first rule: the decision just before only
+    assert run(3, window_s=0.0) == pytest.approx(6.0)
+
+
 def test_a_cut_in_moving_toward_the_vut_at_short_ttc_justifies_braking() -> None:
     # the POV one lane left (3.2 m), moving right at 1.5 m/s, 6 m ahead, 8 m/s slower
     tr = _traj(_braking(28.0, 6.0, 2), [20.0] * 2, gap0=6.0, pov_y=3.2, pov_lat=-1.5)
@@ -148,7 +186,9 @@ def test_overbraking_flags_the_vut_far_above_the_median() -> None:
     assert flags == {"pi1": False, "pi2": False, "over": True}
     # 1.5 x the median exactly is not above it; a pool that hardly brakes flags nobody
     assert not overbraking_flags({"a": 2.0, "b": 2.0, "c": 3.0})["c"]
-    assert overbraking_flags({"a": 0.1, "b": 0.2, "c": 0.9}) == dict.fromkeys("abc", False)
+    # (the floor: one 0.2 s decision of hard braking, 3.4 m/s², per episode = 0.68 m/s)
+    assert overbraking_flags({"a": 0.01, "b": 0.1, "c": 0.6}) == dict.fromkeys("abc", False)
+    assert overbraking_flags({"a": 0.01, "b": 0.1, "c": 0.75})["c"]
     assert overbraking_flags({"a": 5.0, "b": math.nan}) == {"a": False, "b": False}
 
 
