@@ -65,6 +65,7 @@ from sumo_ayss.run_folder import (
 from sumo_ayss.util.errors import AyssError, ConfigError
 
 if TYPE_CHECKING:
+    from sumo_ayss.analysis.harm import VutOutcome
     from sumo_ayss.config.report import ReportOptions
 
 __all__ = [
@@ -144,9 +145,26 @@ def _rows(a: CaseAnalysis[RunRecord], mode: Mode) -> list[dict[str, Any]]:
                 "margin_vs_next": _finite_or_empty(s.margin),
                 "margin_lo": _finite_or_empty(s.margin_lo),
                 "margin_hi": _finite_or_empty(s.margin_hi),
+                **_hazard_cells(o),
             }
         )
     return rows
+
+
+def _hazard_cells(o: VutOutcome | None) -> dict[str, Any]:
+    """The ``ranking.csv`` hazard cells of a VUT (:data:`~sumo_ayss.run_folder.
+    RANKING_HAZARD_COLUMNS`; none where not recorded, so the file keeps its old columns)."""
+    h = None if o is None else o.hazards
+    if o is None or h is None or not math.isfinite(h.get("unjustified_braking", math.nan)):
+        return {}
+    return {
+        "unjustified_braking_rate": h["unjustified_braking"],
+        "unjustified_dv_mps": h["unjustified_dv_mps"],
+        "rear_end_rate": _finite_or_empty(h.get("rear_end", math.nan)),
+        "rear_end_caused_rate": _finite_or_empty(h.get("rear_end_unjustified", math.nan)),
+        "follower_max_braking_mps2": _finite_or_empty(h.get("follower_max_braking_mps2", math.nan)),
+        "overbraking": o.overbraking,
+    }
 
 
 def _finite_or_empty(x: float) -> float | str:
@@ -235,10 +253,12 @@ def write_ranking(
 
     study = StudyFolder(out)
     write_ranking_csv(study.ranking_csv, rows)
+    hazards = any(r.get("unjustified_braking_rate", "") != "" for r in rows)
+    extra = " unjustified braking | hazards caused |" if hazards else ""
     lines = [
         "| case | mode | rank | VUT | score (95 % CI) | seeds | crash rate (95 % CI) | "
-        "mean speed | vs next |",
-        "|---|---|---:|---|---|---:|---|---|---|",
+        "mean speed | vs next |" + extra,
+        "|---|---|---:|---|---|---:|---|---|---|" + ("---|---|" if hazards else ""),
     ]
     labels, lines_of = _tie_labels(rows)
     for i, r in enumerate(rows):
@@ -250,6 +270,7 @@ def write_ranking(
             f"| {r['case']} | {r['mode']} | {labels[i]} | {r['vut']} | "
             f"{fmt_num(r['score'], digits)}{ci} {r['unit']} | {r['n_seeds']} | {_crash_cell(r)} | "
             f"{_mobility_cell(r)} | {r['vs_next']} |"
+            + (f" {_unjustified_cell(r)} | {_hazards_cell(r)} |" if hazards else "")
         )
     for c in checks:
         lines += [
@@ -302,6 +323,25 @@ def _mobility_cell(row: dict[str, Any]) -> str:
     from sumo_ayss.report.sections.common import mobility_text
 
     return "" if row["mobility_mps"] == "" else mobility_text(row["mobility_mps"], row["timid"])
+
+
+def _unjustified_cell(row: dict[str, Any]) -> str:
+    """``"52 %, 1.1 m/s (OVER-BRAKING)"``: episodes with unjustified hard braking, the speed
+    shed so per episode, the flag; "" where not recorded."""
+    if row.get("unjustified_braking_rate", "") == "":
+        return ""
+    flag = " (OVER-BRAKING)" if row.get("overbraking") in (True, "True") else ""
+    rate, dv = float(row["unjustified_braking_rate"]), float(row["unjustified_dv_mps"])
+    return f"{100 * rate:.0f} %, {dv:.2f} m/s{flag}"
+
+
+def _hazards_cell(row: dict[str, Any]) -> str:
+    """``"rear-ends 0.0 % (caused 0.0 %), follower 4.1 m/s²"``; "" where not recorded."""
+    if row.get("rear_end_rate", "") == "":
+        return ""
+    rear, caused = float(row["rear_end_rate"]), float(row["rear_end_caused_rate"])
+    brake = float(row["follower_max_braking_mps2"])
+    return f"rear-ends {100 * rear:.1f} % (caused {100 * caused:.1f} %), follower {brake:.1f} m/s²"
 
 
 def main(argv: Sequence[str] | None = None) -> None:

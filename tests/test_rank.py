@@ -11,7 +11,7 @@ import yaml
 from sumo_ayss.config import PROJECT_ROOT
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.rank import analyse, main, order_check, ranking_rows, write_ranking
-from sumo_ayss.run_folder import read_order_check, read_run
+from sumo_ayss.run_folder import read_order_check, read_ranking_csv, read_run
 from tests.report.test_report import EXPOSURE, OFFSET, make_crossplay, make_run
 
 
@@ -235,3 +235,36 @@ def test_ranking_md_shows_a_tie_as_a_shared_rank_and_in_the_known_order_line(tmp
     assert "| cut_in | crossplay | 1 | b |" in text
     assert "| cut_in | crossplay | 2–3 | a |" in text and "| cut_in | crossplay | 2–3 | c |" in text
     assert "Ranking: b > a ≈ c." in text
+
+
+def test_ranking_files_show_hazards_only_where_recorded(tmp_path: Path) -> None:
+    """Issue 33: the hazard columns and the OVER-BRAKING flag in ranking.csv and ranking.md
+    where a study recorded them (a follower); a study without keeps its columns exactly."""
+    from sumo_ayss.analysis.harm import VutOutcome
+    from sumo_ayss.rank import _hazard_cells
+    from sumo_ayss.run_folder import RANKING_COLUMNS, RANKING_HAZARD_COLUMNS
+
+    def row(rank: int, vut: str, o: VutOutcome | None) -> dict:
+        cells = {c: "" for c in RANKING_COLUMNS}
+        cells.update(case="car_following", mode="crossplay", rank=rank, vut=vut, score=0.3,
+                     lo=0.2, hi=0.4, n_seeds=4, unit="harm", significant_vs_next="")  # fmt: skip
+        return {**cells, **_hazard_cells(o)}
+
+    h = {"unjustified_braking": 0.52, "unjustified_dv_mps": 1.14, "rear_end": 0.01,
+         "rear_end_unjustified": 0.005, "follower_max_braking_mps2": 4.8}  # fmt: skip
+    flagged = VutOutcome(3, 100, 0.01, 0.08, 12.4, False, h, overbraking=True)
+    plain = VutOutcome(3, 100, 0.01, 0.08, 13.3, False, {**h, "unjustified_braking": 0.16})
+    bare = VutOutcome(3, 100, 0.01, 0.08, 13.3, False)  # no follower: nothing recorded
+    csv_path, md = write_ranking([row(1, "ob", flagged), row(2, "pi2", plain)], tmp_path / "a")
+    header = csv_path.read_text().splitlines()[0].split(",")
+    assert header == [*RANKING_COLUMNS, *RANKING_HAZARD_COLUMNS]
+    back = read_ranking_csv(csv_path)
+    assert back[0]["overbraking"] == "True" and back[1]["overbraking"] == "False"
+    assert back[0]["unjustified_braking_rate"] == "0.52" and back[0]["rear_end_rate"] == "0.01"
+    text = md.read_text()
+    assert "| unjustified braking | hazards caused |" in text.splitlines()[0]
+    assert "| 52 %, 1.14 m/s (OVER-BRAKING) | rear-ends 1.0 % (caused 0.5 %), follower 4.8" in text
+    assert "| 16 %, 1.14 m/s | rear-ends" in text
+    csv_path, md = write_ranking([row(1, "pi1", bare), row(2, "pi2", None)], tmp_path / "b")
+    assert csv_path.read_text().splitlines()[0].split(",") == list(RANKING_COLUMNS)
+    assert "unjustified" not in md.read_text() and "OVER-BRAKING" not in md.read_text()

@@ -43,6 +43,7 @@ __all__ = [
     "PIPELINE_JSON",
     "RANKING_COLUMNS",
     "RANKING_CSV",
+    "RANKING_HAZARD_COLUMNS",
     "RANKING_MD",
     "REPORT_DIR",
     "OrderCheck",
@@ -108,6 +109,21 @@ where the seeds cannot support one). ``crash_rate`` with its Wilson interval
 ``crash_lo``/``crash_hi`` (fractions), ``crashes`` of ``episodes``, ``mobility_mps`` (mean
 VUT speed, m/s) and ``timid`` (mobility below 80 % of the median VUT's) describe the same
 episodes as the score; empty in paper mode."""
+
+RANKING_HAZARD_COLUMNS = (
+    "unjustified_braking_rate",
+    "unjustified_dv_mps",
+    "rear_end_rate",
+    "rear_end_caused_rate",
+    "follower_max_braking_mps2",
+    "overbraking",
+)
+"""``ranking.csv``'s hazard columns (issue 33; :mod:`sumo_ayss.analysis.hazards`), written
+after :data:`RANKING_COLUMNS` only where a study recorded hazards (a follower behind the
+VUT), so a study without them keeps its file byte for byte: per VUT over the same episodes
+as the score, the share of episodes with unjustified hard braking, the speed shed so per
+episode [m/s], the share of rear-ends, of rear-ends it caused, the follower's mean largest
+braking [m/s²], and the OVER-BRAKING flag. Empty for a row without them (paper mode)."""
 
 _RANKING_ADDED = RANKING_COLUMNS[RANKING_COLUMNS.index("crash_rate") :]
 """The columns a ``ranking.csv`` written before crashes and mobility (and, later, the
@@ -209,21 +225,31 @@ def read_pipeline_json(path: Path) -> dict[str, Any]:
 
 
 def write_ranking_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
-    """Write ``ranking.csv`` (:data:`RANKING_COLUMNS`; a missing cell is written empty)."""
-    write_csv_rows(path, RANKING_COLUMNS, rows)
+    """Write ``ranking.csv`` (:data:`RANKING_COLUMNS`, then :data:`RANKING_HAZARD_COLUMNS`
+    where a row has one; a missing cell is written empty)."""
+    if any(r.get(c, "") != "" for r in rows for c in RANKING_HAZARD_COLUMNS):
+        write_csv_rows(path, RANKING_COLUMNS + RANKING_HAZARD_COLUMNS, rows)
+        return
+    bare = [{k: v for k, v in r.items() if k not in RANKING_HAZARD_COLUMNS} for r in rows]
+    write_csv_rows(path, RANKING_COLUMNS, bare)
 
 
 def read_ranking_csv(path: Path) -> list[dict[str, str]]:
     """Read ``ranking.csv``: one ``{column: cell}`` per row of :data:`RANKING_COLUMNS`,
     cells as written. A file written before the crash and mobility columns existed (e.g.
-    ``results/sensitivity_actuator``) has them empty.
+    ``results/sensitivity_actuator``) has them empty; one without hazards has
+    :data:`RANKING_HAZARD_COLUMNS` empty.
 
     Raises:
         TableError: The file is missing or unreadable, lacks a column of
             :data:`RANKING_COLUMNS` up to ``vs_next``, or has a short row (naming the file
             and the line).
     """
-    return read_csv_rows(path, RANKING_COLUMNS, optional=_RANKING_ADDED)
+    return read_csv_rows(
+        path,
+        RANKING_COLUMNS + RANKING_HAZARD_COLUMNS,
+        optional=_RANKING_ADDED + RANKING_HAZARD_COLUMNS,
+    )
 
 
 def write_measures_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
