@@ -46,6 +46,7 @@ from sumo_ayss.report.figstyle import vut_colors
 from sumo_ayss.report.leaderboard import leaderboard_table
 from sumo_ayss.report.render import render_html, render_markdown
 from sumo_ayss.report.sections.case import case_blocks, verdict_lines
+from sumo_ayss.report.sections.hazards import hazard_callout
 from sumo_ayss.report.sections.inputs import inputs_blocks
 from sumo_ayss.run_folder import RunRecord, case_runs, group_runs, load_runs
 
@@ -138,6 +139,8 @@ def build_report(
     if tables:
         blocks.append(Heading("Leaderboard", 2, "leaderboard"))
         blocks += tables
+        if (callout := hazard_callout(analyses)) is not None:
+            blocks.append(callout)
     blocks.append(Heading("Verdicts", 2, "verdicts"))
     if not analyses:
         blocks.append(Callout("No runs", ("No run folder was found.",), "warning"))

@@ -212,8 +212,10 @@ def leaderboard_table(a: CaseAnalysis[RunRecord], level: float) -> Table | None:
             "of episodes it ran into the VUT, the share the VUT caused by braking for nothing "
             "(counted in the harm score as a crash), the follower's mean largest braking. "
             "Unjustified braking: episodes where the VUT braked harder than 3.4 m/s² while "
-            "nothing ahead was critical, and the speed it shed so per episode; OVER-BRAKING: "
-            "more than 1.5 × the median VUT's (docs/ranking.md)."
+            "nothing ahead was critical (TTC below 2 s, a gap inside the FSM's unsafe distance "
+            "or R157's minimum following distance) and no leader had braked as hard in the "
+            "1.15 s before, and the speed it shed so per episode; OVER-BRAKING: more than "
+            "1.5 × the median VUT's and 0.68 m/s (docs/ranking.md)."
             if any(c.header == "hazards caused" for c in columns)
             else ""
         )

@@ -109,9 +109,10 @@ TIMID_NOTE = (
 
 OVERBRAKING_NOTE = (
     "A VUT marked OVER-BRAKING shed more speed in unjustified hard braking (harder than "
-    "3.4 m/s² while nothing ahead was critical) than 1.5 × the median VUT's over the same "
-    "episodes: its low harm may come from braking at everything, which the traffic behind it "
-    "pays for (the follower's braking in 'hazards caused'; docs/ranking.md)."
+    "3.4 m/s² while nothing ahead was critical and no leader had just braked as hard) than "
+    "1.5 × the median VUT's over the same episodes, and more than 0.68 m/s per episode: its "
+    "low harm may come from braking at everything, which the traffic behind it pays for (the "
+    "follower's braking in 'hazards caused'; docs/ranking.md)."
 )
 """What an OVER-BRAKING flag means (:mod:`sumo_ayss.analysis.hazards`)."""
 
