@@ -10,7 +10,7 @@ are positive forward, braking is negative (the POV actuator bounds are ``[-6, 6]
 from __future__ import annotations
 
 import typing
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar, Literal
@@ -45,7 +45,10 @@ MANAGED_SUMO_OPTIONS: dict[str, str] = {
     "default.action-step-length": (
         "env.vuts.<name>.params.actionStepLength (per VUT; the POV acts every step)"
     ),
+    "step-method.ballistic": "env.sim.step_method",
 }
+
+StepMethod = Literal["auto", "euler", "ballistic"]
 
 
 @dataclass(frozen=True)
@@ -66,9 +69,22 @@ class SimConfig:
     """0: only physical overlap counts as a collision (SUMO's default flags a 0.3 m gap)."""
     extra_args: tuple[str, ...] = ()
     """Extra SUMO command-line arguments, appended verbatim."""
+    step_method: StepMethod = "auto"
+    """How SUMO integrates positions, for every vehicle of the simulation (a global of SUMO,
+    ``--step-method.ballistic``): ``euler`` (SUMO's default, semi-implicit Euler),
+    ``ballistic``, or ``auto``: ballistic exactly when a vehicle type the simulation loads has
+    an ``actionStepLength`` other than the step, else Euler (:func:`integration_method`).
+
+    ``auto`` is what SUMO itself does when the option is not given (SUMO 1.28,
+    ``MSVehicleType.cpp``: a type whose action step differs from the step switches the whole
+    simulation to ballistic "to avoid collisions"), so runs written before this option keep
+    their numbers; the testbed now passes the resolved method explicitly, and a run's
+    identity records it (:mod:`sumo_ayss.run_folder.identity`): a catalog holding one VUT
+    with a longer action step moves *every* vehicle of its studies ballistically."""
 
     def __post_init__(self) -> None:
         s = self.SECTION
+        check_choice(f"{s}.step_method", self.step_method, typing.get_args(StepMethod))
         require(self.step_length_s > 0, f"{s}.step_length_s must be > 0, got {self.step_length_s}")
         require(
             self.lanechange_duration_s > 0,
@@ -94,6 +110,21 @@ class SimConfig:
                     f"{s}.extra_args: {arg!r} is set by sumo_ayss itself "
                     f"({MANAGED_SUMO_OPTIONS[name]}); remove it"
                 )
+
+
+def integration_method(sim: SimConfig, vtypes: Iterable[VehicleType]) -> str:
+    """``"euler"`` or ``"ballistic"``: how SUMO moves every vehicle of a simulation that
+    loads ``vtypes`` under ``sim`` (:attr:`SimConfig.step_method`; ``auto`` follows SUMO's
+    own rule: ballistic when any loaded type's ``actionStepLength`` [s] differs from
+    ``sim.step_length_s``)."""
+    if sim.step_method != "auto":
+        return sim.step_method
+    dt = sim.step_length_s
+    for vt in vtypes:
+        length = vt.params.get("actionStepLength")
+        if length is not None and abs(float(length) - dt) > 1e-9:
+            return "ballistic"
+    return "euler"
 
 
 ActuatorMode = Literal["clipped", "highway_env"]
