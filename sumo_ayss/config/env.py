@@ -9,11 +9,12 @@ are positive forward, braking is negative (the POV actuator bounds are ``[-6, 6]
 
 from __future__ import annotations
 
+import dataclasses
 import typing
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 from sumo_ayss.cases import DEFAULT_CASE, ROAD_EDGE, case_names, get_case
 from sumo_ayss.config.follower import FollowerConfig
@@ -397,6 +398,28 @@ class EnvConfig:
     @property
     def vut_type(self) -> VehicleType:
         return self.vuts[self.vut]
+
+    @property
+    def integration(self) -> str:
+        """``"euler"`` or ``"ballistic"``: how SUMO moves every vehicle of a simulation of
+        this env, which loads the whole catalog and the POV (:func:`integration_method`;
+        the follower may not set an action step)."""
+        return integration_method(self.sim, [*self.vuts.values(), self.pov])
+
+    def sim_key(self, own: Iterable[VehicleType]) -> dict[str, Any]:
+        """``env.sim`` as a fingerprint over the types ``own`` records it: ``step_method``
+        resolved (:attr:`integration`), and recorded, as ``integration``, only where it is
+        not what ``own`` and the POV alone imply under ``auto``. So a record whose own
+        types set the method (a VUT with a longer action step) reads as it was written
+        before the option, and a catalog that moves a run's VUT otherwise than it alone
+        would (pi1 beside a reaction VUT) is part of the key."""
+        data = dataclasses.asdict(self.sim)
+        data.pop("step_method")
+        auto = SimConfig(step_length_s=self.sim.step_length_s)
+        implied = integration_method(auto, [*own, self.pov])
+        if self.integration != implied:
+            data["integration"] = self.integration
+        return data
 
     @property
     def steps_per_decision(self) -> int:

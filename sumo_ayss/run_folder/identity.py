@@ -12,8 +12,10 @@ integration method stays. :func:`run_identity` is that view of an experiment, as
 dotted fields:
 
 * ``env.vut`` and ``env.vuts`` are left out, and ``env.follower`` (evaluation only);
-* ``env.sim.step_method`` enters resolved, as ``env.sim.integration: ballistic``, and only
-  when it resolves to ballistic (absent: Euler, as every run before the option);
+* ``env.sim.step_method`` enters resolved, as ``env.sim.integration``, and only where it is
+  not what the run's own VUT implies (:meth:`~sumo_ayss.config.EnvConfig.sim_key`): pi1
+  beside a reaction VUT holds ``ballistic``; every run folder written before the option
+  keeps its identity;
 * the run's own VUT's definition (model, parameters, controller; its ``description`` is
   display only) enters under :data:`OWN_VUT` (``env.vuts[env.vut].params.minGap``);
 * display options (:data:`DISPLAY_FIELDS`, e.g. the progress bar) are left out.
@@ -35,7 +37,7 @@ import hashlib
 import json
 from typing import Any
 
-from sumo_ayss.config import ExperimentConfig, integration_method, to_dict
+from sumo_ayss.config import ExperimentConfig, to_dict
 from sumo_ayss.vuts.catalog import VehicleType
 
 __all__ = [
@@ -94,20 +96,12 @@ def run_identity(cfg: ExperimentConfig, seed: int) -> dict[str, Any]:
     # training episode: sumo_ayss.envs.follower), and run folders before it have none.
     env.pop("follower", None)
     # The catalog does enter through one SUMO global: how every vehicle is moved. Recorded
-    # resolved, and only where it is not SUMO's default (Euler), so that the identities of
-    # runs written before the option are unchanged.
-    env["sim"].pop("step_method", None)
-    if integration_method(cfg.env.sim, _session_types(cfg)) == "ballistic":
-        env["sim"]["integration"] = "ballistic"
+    # resolved, and only where the run's own VUT does not imply it, so that the identities
+    # of runs written before the option are unchanged.
+    env["sim"] = cfg.env.sim_key([cfg.env.vut_type])
     flat = flat_config(data)
     flat.update(flat_config(vut_definition(cfg.env.vut_type), f"{OWN_VUT}."))
     return {"seed": seed, **{k: v for k, v in flat.items() if k not in DISPLAY_FIELDS}}
-
-
-def _session_types(cfg: ExperimentConfig) -> list[VehicleType]:
-    """The types a simulation of the run loads that can set SUMO's integration method: the
-    catalog and the POV (the follower has no action step of its own)."""
-    return [*cfg.env.vuts.values(), cfg.env.pov]
 
 
 def identity_differences(
