@@ -27,12 +27,13 @@ from sumo_ayss.report.blocks import (
 
 __all__ = ["RENDERER_VERSION", "render_html", "render_markdown", "renderer_stamp"]
 
-RENDERER_VERSION = 2
+RENDERER_VERSION = 3
 """The report's renderer version. Bump it whenever what a report says or shows changes (a
 statistic, a table, a sentence), then regenerate the committed reports
 (``scripts/regenerate_reports.sh``): a test fails while a committed ``summary.md`` carries
 another version. 1: every report before issue 35 (unstamped); 2: issue 35 (family-wise
-claims, paired margins, one banner)."""
+claims, paired margins, one banner); 3: issue 33 session 10 (the revised unjustified-braking
+rule in the caption, the callout on OVER-BRAKING and cases that disagree)."""
 
 
 def renderer_stamp() -> str:

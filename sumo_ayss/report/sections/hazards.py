@@ -138,7 +138,7 @@ def callout_for(cases: Sequence[CaseFacts]) -> Callout | None:
         )
         reasons = [w for w in whys if w]
         why = (
-            " Why: " + "; ".join(reasons) + "."
+            " What the columns suggest: " + "; ".join(reasons) + "."
             if reasons
             else " Nothing in these columns explains it: read its crash rate and near-misses "
             "in each case's section."
