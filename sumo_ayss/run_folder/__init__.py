@@ -54,9 +54,8 @@ The study folder ``<out>/`` (:class:`StudyFolder`) holds ``pipeline.json``, ``ra
 
 A run folder is read once into a :class:`RunRecord` (:func:`read_run`, :mod:`.record`) and
 that record is handed on; a case's cross-play table is read by :func:`load_crossplay`.
-Whether a stage is done with the inputs asked for now is one contract for every stage
-(:mod:`.stage`: :func:`fingerprint`, :class:`Stage`, :func:`is_done`); a run is identified
-by what made it, not by its study's other VUTs (:mod:`.identity`).
+Whether a stage is done with the inputs asked for now is decided above the files
+(:mod:`sumo_ayss.stages`), from the markers read here.
 
 Every file is written atomically (:mod:`sumo_ayss.util.atomic`). No other module spells one of
 these names or parses one of these files. Imports neither SUMO nor torch.
@@ -140,14 +139,17 @@ from sumo_ayss.run_folder.metadata import (
     SpcpChoice,
     read_checkpoint_state,
     read_command,
+    read_done_marker,
     read_latest,
     read_progress,
     read_run_config,
     read_seeds,
     read_spcp,
     read_versions,
+    stored_experiment,
     write_checkpoint_state,
     write_command,
+    write_done_marker,
     write_latest,
     write_progress,
     write_run_config,
@@ -169,20 +171,6 @@ from sumo_ayss.run_folder.schemas import (
     INDICATOR_ACCEL,
     INDICATOR_DELTA_V_BAR,
     OUTCOME_SCHEMA,
-)
-from sumo_ayss.run_folder.stage import (
-    AyssStage,
-    CrossplayStage,
-    DiscriminabilityStage,
-    EvaluateStage,
-    OutcomeStage,
-    Stage,
-    TrainStage,
-    fingerprint,
-    is_done,
-    read_done_marker,
-    stored_experiment,
-    write_done_marker,
 )
 from sumo_ayss.run_folder.study import (
     MEASURES_COLUMNS,
@@ -285,46 +273,37 @@ __all__ = [
     "AdaptiveRecord",
     "AyssRecord",
     "AyssSamples",
-    "AyssStage",
     "CaseFolder",
     "CaseRuns",
     "CellStore",
     "Column",
     "CrossplayOpponent",
     "CrossplayRecord",
-    "CrossplayStage",
     "CrossplayTables",
     "DiagonalCheck",
-    "DiscriminabilityStage",
     "Estimate",
     "EvalCurve",
-    "EvaluateStage",
     "OrderCheck",
     "OrderChecks",
     "Outcome",
     "OutcomeRecord",
-    "OutcomeStage",
     "OutcomeSubset",
     "RunConfig",
     "RunFolder",
     "RunRecord",
     "Seeds",
     "SpcpChoice",
-    "Stage",
     "StageHeader",
     "StudyFolder",
     "Table",
     "TableSchema",
-    "TrainStage",
     "Training",
     "case_dir_for",
     "case_of",
     "case_runs",
     "config_key",
     "find_run_dirs",
-    "fingerprint",
     "group_runs",
-    "is_done",
     "is_run_dir",
     "load_crossplay",
     "load_runs",

@@ -9,6 +9,7 @@
 ``checkpoints/latest.json`` :func:`write_latest` / :func:`read_latest`
 ``<checkpoint>/state.json`` :func:`write_checkpoint_state` / :func:`read_checkpoint_state`
 ``progress.json``           :func:`write_progress` / :func:`read_progress`
+``evaluate.done.json``      :func:`write_done_marker` / :func:`read_done_marker`
 ==========================  =============================================================
 
 Readers raise :class:`~sumo_ayss.util.errors.CheckpointError` naming the file and the field;
@@ -28,9 +29,16 @@ from typing import Any
 
 import yaml
 
-from sumo_ayss.config import EnvConfig, check_seed, safe_load_yaml, write_yaml
+from sumo_ayss.config import (
+    EnvConfig,
+    ExperimentConfig,
+    check_seed,
+    experiment_from_dict,
+    safe_load_yaml,
+    write_yaml,
+)
 from sumo_ayss.run_folder.jsonio import json_field, read_json
-from sumo_ayss.run_folder.layout import PROGRESS_JSON
+from sumo_ayss.run_folder.layout import PROGRESS_JSON, RunFolder
 from sumo_ayss.util.atomic import atomic_write_json, atomic_write_text
 from sumo_ayss.util.errors import CheckpointError, ConfigError
 
@@ -40,14 +48,17 @@ __all__ = [
     "SpcpChoice",
     "read_checkpoint_state",
     "read_command",
+    "read_done_marker",
     "read_latest",
     "read_progress",
     "read_run_config",
     "read_seeds",
     "read_spcp",
     "read_versions",
+    "stored_experiment",
     "write_checkpoint_state",
     "write_command",
+    "write_done_marker",
     "write_latest",
     "write_progress",
     "write_run_config",
@@ -123,6 +134,19 @@ def read_run_config(path: Path) -> RunConfig:
     except (ConfigError, KeyError, OSError, UnicodeDecodeError, yaml.YAMLError) as e:
         raise CheckpointError(f"{path}: unreadable run configuration ({e})") from e
     return RunConfig(vut, seed, data)
+
+
+def stored_experiment(folder: RunFolder) -> tuple[ExperimentConfig, int]:
+    """The experiment and seed a run folder's ``config.yaml`` records.
+
+    Raises:
+        CheckpointError: If the file is missing or unreadable, naming it.
+    """
+    stored = read_run_config(folder.config)
+    try:
+        return experiment_from_dict(stored.experiment, folder.path), stored.seed
+    except ConfigError as e:
+        raise CheckpointError(f"{folder.config}: unreadable run configuration ({e})") from e
 
 
 # --------------------------------------------------------------------------- command.txt
@@ -313,3 +337,20 @@ def read_progress(run_dir: Path) -> dict[str, Any] | None:
         return read_json(run_dir / PROGRESS_JSON, error=CheckpointError)
     except CheckpointError:
         return None
+
+
+def write_done_marker(path: Path, key: str) -> None:
+    """Write a stand-alone done marker (``evaluate.done.json``): ``{"inputs": key}``."""
+    atomic_write_json(path, {"inputs": key})
+
+
+def read_done_marker(path: Path) -> str | None:
+    """The fingerprint a stand-alone done marker records; None when the file is missing.
+
+    Raises:
+        CheckpointError: The file exists but is unreadable or not a JSON object.
+    """
+    if not path.is_file():
+        return None
+    inputs = read_json(path, error=CheckpointError).get("inputs")
+    return inputs if isinstance(inputs, str) else None
