@@ -77,7 +77,7 @@ from sumo_ayss.run_folder import (
     RunFolder,
     RunRecord,
     StudyFolder,
-    read_eval_rows,
+    read_eval_table,
     read_order_check,
     read_run,
 )
@@ -109,7 +109,7 @@ def spcp_steps(run: RunRecord, budget_step: int = BUDGET_STEP) -> dict[int, int]
     from sumo_ayss.training.selection import select_spcp
 
     criterion = run.experiment.train.selection
-    rows = read_eval_rows(run.folder.eval_table)[0]
+    rows = read_eval_table(run.folder.eval_table)
     last = int(max(r["step"] for r in rows))
     out = {}
     for budget in range(budget_step, last + 1, budget_step):
@@ -608,7 +608,7 @@ def early_stop(
         for key, r in runs.items():
             run = read_run(PROJECT_ROOT / r["run_dir"])
             score = CRITERIA[run.experiment.train.selection]
-            rows = read_eval_rows(run.folder.eval_table)[0]
+            rows = read_eval_table(run.folder.eval_table)
             curves[key] = (
                 [int(x["step"]) for x in rows],
                 [score(x) for x in rows],

@@ -26,7 +26,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
-from sumo_ayss.run_folder import RunFolder, read_eval_rows, read_latest, read_progress
+from sumo_ayss.run_folder import RunFolder, read_eval_table, read_latest, read_progress
 from sumo_ayss.util.errors import CheckpointError
 
 STATES = ("queued", "running", "done", "failed", "interrupted", "cancelled")
@@ -107,7 +107,7 @@ def _finished_steps(folder: RunFolder, total: int) -> int:
 def _candidates(folder: RunFolder) -> list[tuple[int, str]]:
     """(step, mean evaluation reward to 2 decimals) of each SPCP candidate in ``eval.csv``."""
     try:
-        rows = read_eval_rows(folder.eval_table, skip_bad_rows=True)[0]
+        rows = read_eval_table(folder.eval_table, skip_bad_rows=True)
     except CheckpointError:
         return []
     return [(int(row["step"]), f"{row['mean_return']:.2f}") for row in rows]

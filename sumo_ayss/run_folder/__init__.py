@@ -87,8 +87,7 @@ from sumo_ayss.run_folder.discriminability import (
     write_discriminability,
 )
 from sumo_ayss.run_folder.eval_table import (
-    EVAL_COLUMNS,
-    read_eval_rows,
+    EVAL_SCHEMA,
     read_eval_table,
     write_eval_table,
 )
@@ -240,8 +239,8 @@ __all__ = [
     "DISCRIMINABILITY_JSON",
     "DISCRIMINABILITY_PNG",
     "EVALUATE_DONE_JSON",
-    "EVAL_COLUMNS",
     "EVAL_CSV",
+    "EVAL_SCHEMA",
     "INDICATOR_ACCEL",
     "INDICATOR_DELTA_V_BAR",
     "JOB_LOG",
@@ -316,7 +315,6 @@ __all__ = [
     "read_crossplay_table",
     "read_discriminability_json",
     "read_done_marker",
-    "read_eval_rows",
     "read_eval_table",
     "read_inevitable",
     "read_json",

@@ -62,7 +62,7 @@ from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.envs.vec_env import PairVecEnv
 from sumo_ayss.run_folder import (
-    EVAL_COLUMNS,
+    EVAL_SCHEMA,
     MODEL_ZIP,
     STATE_JSON,
     RunFolder,
@@ -210,7 +210,7 @@ class Trainer:
 
         row: dict[str, Any] = {"step": step, **summary.as_dict(), "wall_s": round(wall, 3)}
         row["checkpoint"] = self.folder.checkpoint_model(step_dir)
-        row = {k: row[k] for k in EVAL_COLUMNS}
+        row = {k: row[k] for k in EVAL_SCHEMA.names}
         self.rows.append(row)
         model.logger.record("eval/mean_return", summary.mean_return)
         model.logger.record("eval/crash_rate", summary.crash_rate)

@@ -291,6 +291,37 @@ def test_one_json_reader_one_error_family(tmp_path: Path) -> None:
         read_adaptive(bad)
 
 
+def test_one_csv_reader_one_error_family(run_folder: RunFolder, tmp_path: Path) -> None:
+    """Every stored CSV file (the episode tables, ``eval.csv``, the study's ``ranking.csv``
+    and ``measures.csv``) is read by ``table.read_table``: the same messages, naming the file,
+    the column and the row, as a ``StoredFileError`` (``eval.csv``, a run's own record,
+    raises ``CheckpointError``; the others ``TableError``)."""
+    from sumo_ayss.run_folder import read_measures_csv, read_ranking_csv
+    from sumo_ayss.util.errors import StoredFileError
+
+    f = run_folder
+    rows = read_eval_table(f.eval_table)
+    lines = f.eval_table.read_text().splitlines()
+    f.eval_table.write_text("\n".join([*lines, lines[2].replace(",100,", ",two,")]) + "\n")
+    with pytest.raises(CheckpointError, match=r"eval\.csv: column 'n_episodes', row 2: expected"):
+        read_eval_table(f.eval_table)
+    kept = read_eval_table(f.eval_table, skip_bad_rows=True)
+    assert [r["step"] for r in kept] == [r["step"] for r in rows] == [5000, 10000]
+    curve = read_run(f.path).eval_curve
+    assert curve is not None and curve.n_dropped == 1 and len(curve) == 2
+    f.eval_table.write_text("\n".join([*lines, lines[2].replace(",3.25,", ",inf,")]) + "\n")
+    with pytest.raises(CheckpointError, match=r"eval\.csv, column 'wall_s', row 2: inf not"):
+        read_eval_table(f.eval_table)
+    assert read_eval_table(tmp_path / "eval.csv") == []  # not written yet: no candidate
+    for reader in (read_ranking_csv, read_measures_csv):
+        path = tmp_path / "study.csv"
+        path.write_text("case\n")
+        with pytest.raises(TableError, match=r"study\.csv: missing column\(s\) \['"):
+            reader(path)
+        with pytest.raises(StoredFileError, match=r"x\.csv: table file not found"):
+            reader(tmp_path / "x.csv")
+
+
 def test_config_yaml_holds_the_vut_once_and_legacy_folders_still_read(tmp_path: Path) -> None:
     path = tmp_path / "config.yaml"
     write_run_config(path, RunConfig("pi2", 3, {"env": {"case": "cut_in"}, "train": {}}))
