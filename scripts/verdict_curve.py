@@ -73,7 +73,6 @@ from sumo_ayss.analysis.crossplay import crossplay_matrix, rank_crossplay
 from sumo_ayss.analysis.harm import episode_harm, harm_scale_of
 from sumo_ayss.analysis.seeds import kendall_tau
 from sumo_ayss.run_folder import (
-    MODEL_ZIP,
     RunFolder,
     RunRecord,
     StudyFolder,
@@ -193,7 +192,7 @@ def cells(out: Path, studies: Sequence[Path], budget_step: int = BUDGET_STEP) ->
                 try:
                     key = (run.experiment.env.vut, run.config_seed, step)
                     if key not in policies:
-                        ckpt = run.folder.step_dir(step) / MODEL_ZIP
+                        ckpt = run.folder.candidate_model(step)
                         policies = {
                             key: load_greedy_policy(
                                 ckpt,

@@ -26,7 +26,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
-from sumo_ayss.run_folder import RunFolder, read_eval_table, read_latest, read_progress
+from sumo_ayss.run_folder import RunFolder, read_eval_table, read_progress
+from sumo_ayss.training.checkpoint_files import LATEST_JSON, read_latest
 from sumo_ayss.util.errors import CheckpointError
 
 STATES = ("queued", "running", "done", "failed", "interrupted", "cancelled")
@@ -99,7 +100,7 @@ def _finished_steps(folder: RunFolder, total: int) -> int:
     if folder.spcp_json.is_file():
         return total
     try:
-        return read_latest(folder.latest)[0]
+        return read_latest(folder.checkpoints / LATEST_JSON)[0]
     except CheckpointError:  # missing (no checkpoint yet) or being replaced
         return 0
 

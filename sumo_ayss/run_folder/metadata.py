@@ -6,13 +6,13 @@
 ``versions.json``           :func:`write_versions` / :func:`read_versions`
 ``seeds.json``              :func:`write_seeds` / :func:`read_seeds`
 ``spcp.json``               :func:`write_spcp` / :func:`read_spcp`
-``checkpoints/latest.json`` :func:`write_latest` / :func:`read_latest`
-``<checkpoint>/state.json`` :func:`write_checkpoint_state` / :func:`read_checkpoint_state`
 ``progress.json``           :func:`write_progress` / :func:`read_progress`
 ``evaluate.done.json``      :func:`write_done_marker` / :func:`read_done_marker`
 ==========================  =============================================================
 
-Readers raise :class:`~sumo_ayss.util.errors.CheckpointError` naming the file and the field;
+The checkpoints' own files (``latest.json``, ``state.json``) are the trainer's
+(:mod:`sumo_ayss.training.checkpoint_files`). Readers raise
+:class:`~sumo_ayss.util.errors.CheckpointError` naming the file and the field;
 callers that tolerate a missing or broken file (the report, the progress display) catch it.
 Imports neither SUMO nor torch.
 """
@@ -46,20 +46,16 @@ __all__ = [
     "RunConfig",
     "Seeds",
     "SpcpChoice",
-    "read_checkpoint_state",
     "read_command",
     "read_done_marker",
-    "read_latest",
     "read_progress",
     "read_run_config",
     "read_seeds",
     "read_spcp",
     "read_versions",
     "stored_experiment",
-    "write_checkpoint_state",
     "write_command",
     "write_done_marker",
-    "write_latest",
     "write_progress",
     "write_run_config",
     "write_seeds",
@@ -279,46 +275,6 @@ def read_spcp(path: Path) -> SpcpChoice:
         checkpoint=str(data.get("checkpoint", "")),
         no_signal=data.get("no_signal") is True,
     )
-
-
-# --------------------------------------------------------------------------- checkpoints
-
-
-def write_latest(path: Path, step_dir: Path) -> None:
-    """Write ``checkpoints/latest.json``: ``{"step": 80016, "dir": "step_000080016"}``."""
-    atomic_write_json(path, {"step": int(step_dir.name.split("_")[1]), "dir": step_dir.name})
-
-
-def read_latest(path: Path) -> tuple[int, str]:
-    """Read ``checkpoints/latest.json``: ``(step, folder name)``.
-
-    Raises:
-        CheckpointError: The file is unreadable, ``dir`` does not name a ``step_*`` folder
-            (no path), or ``step`` is not an integer.
-    """
-    data = read_json(path, error=CheckpointError)
-    name = data.get("dir")
-    if not isinstance(name, str) or Path(name).name != name or not name.startswith("step_"):
-        raise CheckpointError(f"{path}: 'dir' must name a step_* folder, got {name!r}")
-    step = json_field(data, "step", int, str(path), error=CheckpointError)
-    return step, name
-
-
-def write_checkpoint_state(path: Path, state: Mapping[str, Any]) -> None:
-    """Write a checkpoint's ``state.json`` (counters, env state, RNG states)."""
-    atomic_write_json(path, dict(state))
-
-
-def read_checkpoint_state(path: Path) -> dict[str, Any]:
-    """Read a checkpoint's ``state.json``; it must hold ``num_timesteps`` and ``next_eval``.
-
-    Raises:
-        CheckpointError: The file is unreadable or not a checkpoint state.
-    """
-    data = read_json(path, error=CheckpointError)
-    for key in ("num_timesteps", "next_eval"):
-        json_field(data, key, object, f"{path}: not a checkpoint state", error=CheckpointError)
-    return data
 
 
 def write_progress(run_dir: Path, stage: str, **fields: Any) -> None:
