@@ -72,14 +72,8 @@ import numpy as np
 from sumo_ayss.analysis.crossplay import crossplay_matrix, rank_crossplay
 from sumo_ayss.analysis.harm import episode_harm, harm_scale_of
 from sumo_ayss.analysis.seeds import kendall_tau
-from sumo_ayss.run_folder import (
-    RunFolder,
-    RunRecord,
-    StudyFolder,
-    read_eval_table,
-    read_order_check,
-    read_run,
-)
+from sumo_ayss.run_folder import RunFolder, RunRecord, StudyFolder, read_eval_table, read_run
+from sumo_ayss.run_folder.study import read_order_check
 from sumo_ayss.util.atomic import atomic_write_text
 from sumo_ayss.util.paths import PROJECT_ROOT, portable_path
 

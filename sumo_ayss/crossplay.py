@@ -49,17 +49,15 @@ from sumo_ayss.run_folder import (
     CellStore,
     CrossplayOpponent,
     CrossplayRecord,
-    RunFolder,
     RunRecord,
+    StudyFolder,
     Table,
-    case_dir_for,
     case_of,
     read_crossplay_json,
     read_inevitable,
     read_outcome_json,
     read_run,
     read_table,
-    run_dir_for,
     table_from_rows,
     write_crossplay_json,
     write_inevitable,
@@ -84,7 +82,7 @@ def case_runs(out: Path, case: str, vuts: Sequence[str], seeds: Sequence[int]) -
     Raises:
         CheckpointError: If a run folder has no ``spcp.zip`` (its job did not finish).
     """
-    folders = [RunFolder(run_dir_for(out, case, v, s)) for v in vuts for s in seeds]
+    folders = [StudyFolder(out).run(case, v, s) for v in vuts for s in seeds]
     missing = [str(f.path) for f in folders if not f.spcp_zip.is_file()]
     if missing:
         raise CheckpointError(
@@ -446,7 +444,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             runs = case_runs(Path(cfg.out), case, cfg.grid.vuts, seeds)
             run_case(
                 runs,
-                case_dir_for(cfg.out, case),
+                StudyFolder(cfg.out).case(case).path,
                 n=cfg.evaluate.n_outcome,
                 seed=DEFAULT_OUTCOME_SEED,
                 force=args.force,

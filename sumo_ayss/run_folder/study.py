@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.run_folder.jsonio import json_field, read_json
-from sumo_ayss.run_folder.layout import CaseFolder, case_dir_for
+from sumo_ayss.run_folder.layout import CaseFolder, RunFolder, case_dir_for, run_dir_for
 from sumo_ayss.run_folder.table import read_table, text_schema, write_rows
 from sumo_ayss.util.atomic import atomic_write_json
 from sumo_ayss.util.errors import TableError
@@ -187,6 +187,10 @@ class StudyFolder:
     def case(self, case: str) -> CaseFolder:
         """The case folder ``<out>/<case>/``."""
         return CaseFolder(case_dir_for(self.path, case))
+
+    def run(self, case: str, vut: str, seed: int) -> RunFolder:
+        """The run folder ``<out>/<case>/<vut>/seed_<seed>/``."""
+        return RunFolder(run_dir_for(self.path, case, vut, seed))
 
 
 # --------------------------------------------------------------------------- pipeline.json

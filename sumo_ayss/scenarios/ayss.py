@@ -50,22 +50,22 @@ import numpy.typing as npt
 from tqdm import tqdm
 
 from sumo_ayss.analysis.metrics import ttc_longitudinal
-from sumo_ayss.cases import get_case
+from sumo_ayss.cases import CAR_FOLLOWING, CUT_IN, get_case
 from sumo_ayss.config import ActuatorConfig, AyssConfig
 from sumo_ayss.envs.car_following import target_speed_mps as cf_target_speed_mps
 from sumo_ayss.envs.cut_in import LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.run_folder import (
-    AYSS_SCHEMA,
-    INDICATOR_ACCEL,
-    INDICATOR_DELTA_V_BAR,
-    Table,
-)
+from sumo_ayss.run_folder import AYSS_SCHEMA, Table
 from sumo_ayss.scenarios.outcome import MeanInterval
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.sim.actuator import pov_acceleration
 from sumo_ayss.util.errors import ActionError, SimulationError
+
+#: Aggressiveness indicator of car-following: POV acceleration [m/s²], < 0 brakes.
+INDICATOR_ACCEL = CAR_FOLLOWING.indicator_column
+#: Aggressiveness indicator of cut-in: Δv̄ [m/s], < 0 closes in.
+INDICATOR_DELTA_V_BAR = CUT_IN.indicator_column
 
 __all__ = [
     "INDICATOR_ACCEL",

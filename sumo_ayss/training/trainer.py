@@ -61,7 +61,7 @@ from sumo_ayss.config import (
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.envs.vec_env import PairVecEnv
-from sumo_ayss.run_folder import EVAL_SCHEMA, RunFolder, run_dir_for, write_eval_table, write_spcp
+from sumo_ayss.run_folder import EVAL_SCHEMA, RunFolder, StudyFolder, write_eval_table, write_spcp
 from sumo_ayss.scenarios.rollout import summarize
 from sumo_ayss.training import checkpoint
 from sumo_ayss.training.callback import CandidateCallback
@@ -374,7 +374,7 @@ def train(
     check_device(cfg.train.device)  # before the run folder exists
     seed = check_seed(seed, "--seed")
     check_out_dir(Path(out), "--out")
-    folder = RunFolder(run_dir_for(out, cfg.env.case, cfg.env.vut, seed))
+    folder = StudyFolder(out).run(cfg.env.case, cfg.env.vut, seed)
     run_dir = folder.path
     if resume:
         if not folder.config.is_file():

@@ -31,7 +31,6 @@ from sumo_ayss.run_folder import (
     AYSS_CSV,
     AYSS_SCHEMA,
     CROSSPLAY_SCHEMA,
-    EVAL_CSV,
     OUTCOME_JSON,
     OUTCOME_SCHEMA,
     CaseFolder,
@@ -40,7 +39,6 @@ from sumo_ayss.run_folder import (
     StageHeader,
     Table,
     find_run_dirs,
-    load_crossplay,
     read_run,
     write_eval_table,
     write_outcome_json,
@@ -49,6 +47,8 @@ from sumo_ayss.run_folder import (
     write_table,
     write_versions,
 )
+from sumo_ayss.run_folder.crossplay import load_crossplay
+from sumo_ayss.run_folder.layout import EVAL_CSV
 from sumo_ayss.scenarios.outcome import MeanInterval, OutcomeSummary, Proportion
 from sumo_ayss.training.selection import Selection
 from sumo_ayss.vuts.catalog import BUILTIN_VUTS

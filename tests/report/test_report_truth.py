@@ -17,7 +17,8 @@ from sumo_ayss.report import write_report
 from sumo_ayss.report.crossplay_figure import crossplay_lines
 from sumo_ayss.report.figstyle import set_wrapped_title, style
 from sumo_ayss.report.leaderboard import leaderboard_rows, leaderboard_table, leaderboard_text
-from sumo_ayss.run_folder import load_crossplay, read_run
+from sumo_ayss.run_folder import read_run
+from sumo_ayss.run_folder.crossplay import load_crossplay
 from tests.report.test_report import FAST, make_crossplay, make_run
 
 

@@ -25,10 +25,8 @@ from sumo_ayss.run_folder import (
     Seeds,
     StageHeader,
     Table,
-    case_dir_for,
     find_run_dirs,
     read_ayss_json,
-    read_command,
     read_crossplay_json,
     read_done_marker,
     read_eval_table,
@@ -36,11 +34,7 @@ from sumo_ayss.run_folder import (
     read_progress,
     read_run,
     read_run_config,
-    read_seeds,
-    read_spcp,
     read_table,
-    read_versions,
-    run_dir_for,
     write_ayss_json,
     write_command,
     write_crossplay_json,
@@ -54,6 +48,8 @@ from sumo_ayss.run_folder import (
     write_table,
     write_versions,
 )
+from sumo_ayss.run_folder.layout import case_dir_for, run_dir_for
+from sumo_ayss.run_folder.metadata import read_command, read_seeds, read_spcp, read_versions
 from sumo_ayss.scenarios.outcome import MeanInterval, OutcomeSummary, Proportion
 from sumo_ayss.training.checkpoint_files import (
     LATEST_JSON,
@@ -299,7 +295,7 @@ def test_one_csv_reader_one_error_family(run_folder: RunFolder, tmp_path: Path) 
     and ``measures.csv``) is read by ``table.read_table``: the same messages, naming the file,
     the column and the row, as a ``StoredFileError`` (``eval.csv``, a run's own record,
     raises ``CheckpointError``; the others ``TableError``)."""
-    from sumo_ayss.run_folder import read_measures_csv, read_ranking_csv
+    from sumo_ayss.run_folder.study import read_measures_csv, read_ranking_csv
     from sumo_ayss.util.errors import StoredFileError
 
     f = run_folder

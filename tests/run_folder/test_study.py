@@ -9,22 +9,24 @@ from pathlib import Path
 import pytest
 
 from sumo_ayss.run_folder import (
-    MEASURES_COLUMNS,
-    RANKING_COLUMNS,
     CaseFolder,
     OrderCheck,
     OrderChecks,
     StudyFolder,
     read_discriminability_json,
-    read_measures_csv,
-    read_order_check,
-    read_pipeline_json,
-    read_ranking_csv,
     write_discriminability,
     write_measures_csv,
     write_order_check,
     write_pipeline_json,
     write_ranking_csv,
+)
+from sumo_ayss.run_folder.study import (
+    MEASURES_COLUMNS,
+    RANKING_COLUMNS,
+    read_measures_csv,
+    read_order_check,
+    read_pipeline_json,
+    read_ranking_csv,
 )
 from sumo_ayss.util.errors import TableError
 
