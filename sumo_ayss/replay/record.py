@@ -30,8 +30,6 @@ from sumo_ayss.replay.playback import (
 )
 from sumo_ayss.replay.source import Kind, initial_condition, load_policy, read_row, select_row
 from sumo_ayss.run_folder import (
-    AYSS_CSV,
-    OUTCOME_CSV,
     RunRecord,
     read_run,
 )
@@ -270,7 +268,7 @@ def _info(
     return {
         "source": {
             "run_dir": portable_path(run.path),
-            "table": AYSS_CSV if kind == "ayss" else OUTCOME_CSV,
+            "table": (run.folder.ayss_csv if kind == "ayss" else run.folder.outcome_csv).name,
             "row": index,
             "values": {k: _json_value(v) for k, v in row.items()},
             "spcp_step": run.spcp.step if run.spcp is not None else None,

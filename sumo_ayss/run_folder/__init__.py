@@ -89,8 +89,6 @@ from sumo_ayss.run_folder.eval_table import (
     write_eval_table,
 )
 from sumo_ayss.run_folder.layout import (
-    AYSS_CSV,
-    OUTCOME_CSV,
     OUTCOME_JSON,
     VERSIONS_JSON,
     CaseFolder,
@@ -154,11 +152,9 @@ from sumo_ayss.run_folder.table import (
 )
 
 __all__ = [
-    "AYSS_CSV",
     "AYSS_SCHEMA",
     "CROSSPLAY_SCHEMA",
     "EVAL_SCHEMA",
-    "OUTCOME_CSV",
     "OUTCOME_JSON",
     "OUTCOME_SCHEMA",
     "VERSIONS_JSON",

@@ -12,6 +12,7 @@ import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from sumo_ayss.util.errors import ConfigError
 
@@ -40,6 +41,7 @@ __all__ = [
     "TB_DIR",
     "VERSIONS_JSON",
     "CaseFolder",
+    "FolderFile",
     "RunFolder",
     "case_dir_for",
     "find_run_dirs",
@@ -130,6 +132,18 @@ def seed_of_dir(path: Path) -> int | None:
     return int(match.group(1)) if match else None
 
 
+class FolderFile:
+    """A file of a folder record (:class:`RunFolder`, :class:`CaseFolder`, a study's): the
+    attribute's value is the path of the file named once here, ``folder.path / name``."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+
+    def __get__(self, folder: Any, owner: type | None = None) -> Path:
+        path: Path = folder.path / self.name
+        return path
+
+
 @dataclass(frozen=True)
 class RunFolder:
     """The paths of one run folder's files.
@@ -143,85 +157,22 @@ class RunFolder:
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
 
-    @property
-    def config(self) -> Path:
-        """``config.yaml``."""
-        return self.path / CONFIG_YAML
-
-    @property
-    def command(self) -> Path:
-        """``command.txt``."""
-        return self.path / COMMAND_TXT
-
-    @property
-    def versions(self) -> Path:
-        """``versions.json``."""
-        return self.path / VERSIONS_JSON
-
-    @property
-    def seeds(self) -> Path:
-        """``seeds.json``."""
-        return self.path / SEEDS_JSON
-
-    @property
-    def eval_table(self) -> Path:
-        """``eval.csv``."""
-        return self.path / EVAL_CSV
-
-    @property
-    def spcp_json(self) -> Path:
-        """``spcp.json``."""
-        return self.path / SPCP_JSON
-
-    @property
-    def spcp_zip(self) -> Path:
-        """``spcp.zip``."""
-        return self.path / SPCP_ZIP
-
-    @property
-    def progress(self) -> Path:
-        """``progress.json``."""
-        return self.path / PROGRESS_JSON
-
-    @property
-    def tb(self) -> Path:
-        """``tb/``."""
-        return self.path / TB_DIR
-
-    @property
-    def checkpoints(self) -> Path:
-        """``checkpoints/``."""
-        return self.path / CHECKPOINTS_DIR
-
-    @property
-    def outcome_csv(self) -> Path:
-        """``outcome.csv``."""
-        return self.path / OUTCOME_CSV
-
-    @property
-    def outcome_json(self) -> Path:
-        """``outcome.json``."""
-        return self.path / OUTCOME_JSON
-
-    @property
-    def ayss_csv(self) -> Path:
-        """``ayss.csv``."""
-        return self.path / AYSS_CSV
-
-    @property
-    def ayss_json(self) -> Path:
-        """``ayss.json``."""
-        return self.path / AYSS_JSON
-
-    @property
-    def evaluate_done(self) -> Path:
-        """``evaluate.done.json``."""
-        return self.path / EVALUATE_DONE_JSON
-
-    @property
-    def job_log(self) -> Path:
-        """``job.log``."""
-        return self.path / JOB_LOG
+    config = FolderFile(CONFIG_YAML)
+    command = FolderFile(COMMAND_TXT)
+    versions = FolderFile(VERSIONS_JSON)
+    seeds = FolderFile(SEEDS_JSON)
+    eval_table = FolderFile(EVAL_CSV)
+    spcp_json = FolderFile(SPCP_JSON)
+    spcp_zip = FolderFile(SPCP_ZIP)
+    progress = FolderFile(PROGRESS_JSON)
+    tb = FolderFile(TB_DIR)
+    checkpoints = FolderFile(CHECKPOINTS_DIR)
+    outcome_csv = FolderFile(OUTCOME_CSV)
+    outcome_json = FolderFile(OUTCOME_JSON)
+    ayss_csv = FolderFile(AYSS_CSV)
+    ayss_json = FolderFile(AYSS_JSON)
+    evaluate_done = FolderFile(EVALUATE_DONE_JSON)
+    job_log = FolderFile(JOB_LOG)
 
     def step_dir(self, step: int) -> Path:
         """The checkpoint folder of the candidate at training step ``step``."""
@@ -251,57 +202,23 @@ class CaseFolder:
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
 
-    @property
-    def crossplay_csv(self) -> Path:
-        """``crossplay.csv``."""
-        return self.path / CROSSPLAY_CSV
-
-    @property
-    def crossplay_json(self) -> Path:
-        """``crossplay.json``."""
-        return self.path / CROSSPLAY_JSON
-
-    @property
-    def inevitable_json(self) -> Path:
-        """``inevitable.json``: the scenarios no braking survives (:func:`read_inevitable`)."""
-        return self.path / INEVITABLE_JSON
-
-    @property
-    def crossplay_partial(self) -> Path:
-        """``crossplay.partial/``: the finished cells of a cross-play table not yet written
-        whole (:class:`~.crossplay_partial.CellStore`)."""
-        return self.path / CROSSPLAY_PARTIAL
-
-    @property
-    def crossplay_reference_partial(self) -> Path:
-        """``crossplay_reference.partial/``: the same for ``crossplay_reference.csv``."""
-        return self.path / CROSSPLAY_REFERENCE_PARTIAL
-
-    @property
-    def crossplay_reference_csv(self) -> Path:
-        """``crossplay_reference.csv``: the reference drivers against the same opponents
-        and scenarios (:data:`~.schemas.CROSSPLAY_SCHEMA`; they have no SPCPs of their own)."""
-        return self.path / CROSSPLAY_REFERENCE_CSV
-
-    @property
-    def adaptive_json(self) -> Path:
-        """``adaptive.json`` (adaptive seeding's looks, :mod:`.adaptive`)."""
-        return self.path / ADAPTIVE_JSON
-
-    @property
-    def discriminability_json(self) -> Path:
-        """``discriminability.json``."""
-        return self.path / DISCRIMINABILITY_JSON
-
-    @property
-    def discriminability_csv(self) -> Path:
-        """``discriminability.csv``."""
-        return self.path / DISCRIMINABILITY_CSV
-
-    @property
-    def discriminability_png(self) -> Path:
-        """``discriminability.png``."""
-        return self.path / DISCRIMINABILITY_PNG
+    crossplay_csv = FolderFile(CROSSPLAY_CSV)
+    crossplay_json = FolderFile(CROSSPLAY_JSON)
+    #: ``inevitable.json``: the scenarios no braking survives (:func:`read_inevitable`).
+    inevitable_json = FolderFile(INEVITABLE_JSON)
+    #: ``crossplay.partial/``: the finished cells of a cross-play table not yet written whole
+    #: (:class:`~.crossplay_partial.CellStore`).
+    crossplay_partial = FolderFile(CROSSPLAY_PARTIAL)
+    #: ``crossplay_reference.partial/``: the same for ``crossplay_reference.csv``.
+    crossplay_reference_partial = FolderFile(CROSSPLAY_REFERENCE_PARTIAL)
+    #: ``crossplay_reference.csv``: the reference drivers against the same opponents and scenarios
+    #: (:data:`~.schemas.CROSSPLAY_SCHEMA`; they have no SPCPs of their own).
+    crossplay_reference_csv = FolderFile(CROSSPLAY_REFERENCE_CSV)
+    #: ``adaptive.json`` (adaptive seeding's looks, :mod:`.adaptive`).
+    adaptive_json = FolderFile(ADAPTIVE_JSON)
+    discriminability_json = FolderFile(DISCRIMINABILITY_JSON)
+    discriminability_csv = FolderFile(DISCRIMINABILITY_CSV)
+    discriminability_png = FolderFile(DISCRIMINABILITY_PNG)
 
 
 def is_run_dir(path: Path) -> bool:

@@ -32,7 +32,13 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.run_folder.jsonio import json_field, read_json
-from sumo_ayss.run_folder.layout import CaseFolder, RunFolder, case_dir_for, run_dir_for
+from sumo_ayss.run_folder.layout import (
+    CaseFolder,
+    FolderFile,
+    RunFolder,
+    case_dir_for,
+    run_dir_for,
+)
 from sumo_ayss.run_folder.table import read_table, text_schema, write_rows
 from sumo_ayss.util.atomic import atomic_write_json
 from sumo_ayss.util.errors import TableError
@@ -154,35 +160,12 @@ class StudyFolder:
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
 
-    @property
-    def pipeline_json(self) -> Path:
-        """``pipeline.json``."""
-        return self.path / PIPELINE_JSON
-
-    @property
-    def ranking_csv(self) -> Path:
-        """``ranking.csv``."""
-        return self.path / RANKING_CSV
-
-    @property
-    def ranking_md(self) -> Path:
-        """``ranking.md``."""
-        return self.path / RANKING_MD
-
-    @property
-    def order_check_json(self) -> Path:
-        """``order_check.json``."""
-        return self.path / ORDER_CHECK_JSON
-
-    @property
-    def measures_csv(self) -> Path:
-        """``measures.csv``."""
-        return self.path / MEASURES_CSV
-
-    @property
-    def report_dir(self) -> Path:
-        """``report/``."""
-        return self.path / REPORT_DIR
+    pipeline_json = FolderFile(PIPELINE_JSON)
+    ranking_csv = FolderFile(RANKING_CSV)
+    ranking_md = FolderFile(RANKING_MD)
+    order_check_json = FolderFile(ORDER_CHECK_JSON)
+    measures_csv = FolderFile(MEASURES_CSV)
+    report_dir = FolderFile(REPORT_DIR)
 
     def case(self, case: str) -> CaseFolder:
         """The case folder ``<out>/<case>/``."""
