@@ -172,7 +172,8 @@ class Table:
         return len(next(iter(self.columns.values()))) if self.columns else 0
 
     def __getitem__(self, name: str) -> npt.NDArray[Any]:
-        return self.columns[name]
+        column: npt.NDArray[Any] = self.columns[name]
+        return column
 
     def rows(self) -> Iterator[dict[str, Any]]:
         """Rows as dicts of Python scalars, in order."""
