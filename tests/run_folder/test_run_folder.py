@@ -245,6 +245,11 @@ def test_readers_name_the_file_and_field(run_folder: RunFolder) -> None:
     f.outcome_json.write_text('{"settings": {}, "summary": {"n_episodes": 2}}')
     with pytest.raises(TableError, match=r"outcome\.json: summary: missing field 'crash_rate'"):
         read_outcome_json(f.outcome_json)
+    f.outcome_json.write_text(
+        '{"settings": {}, "summary": {"n_episodes": 2, "crash_rate": {"value": "x"}}}'
+    )
+    with pytest.raises(TableError, match=r"summary\.crash_rate: value: expected int or float"):
+        read_outcome_json(f.outcome_json)
     f.seeds.write_text('{"train_seed": 1, "sumo_seed": "x", "eval_seed": 2}')
     with pytest.raises(CheckpointError, match=r"seeds\.json: sumo_seed: expected int, got 'x'"):
         read_seeds(f.seeds)
