@@ -70,6 +70,19 @@ def _script_report_imports(scripts: Path) -> list[str]:
     return found
 
 
+def _names_used_from(package: Path, prefix: str) -> set[str]:
+    """Distinct names that modules outside ``prefix`` import from it (any of its modules)."""
+    found = set()
+    for path in package.rglob("*.py"):
+        module = ".".join(path.relative_to(package.parent).with_suffix("").parts)
+        if _within(module.removesuffix(".__init__"), prefix):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and _within(node.module or "", prefix):
+                found |= {f"{node.module}.{a.name}".rsplit(".", 1)[-1] for a in node.names}
+    return found
+
+
 def measure(root: Path) -> dict[str, object]:
     """The measured end states of the tree at ``root``."""
     package = root / "sumo_ayss"
@@ -112,6 +125,9 @@ def measure(root: Path) -> dict[str, object]:
         "report imports from scripts": len(_script_report_imports(root / "scripts")),
         "run_folder lines": sum(run_folder.values()),
         "run_folder exported names": len(_all_names(package / "run_folder" / "__init__.py")),
+        "run_folder names imported by the rest of the package": len(
+            _names_used_from(package, "sumo_ayss.run_folder")
+        ),
         "package root modules": " ".join(root_modules),
         "train.py lines": lines.get("sumo_ayss.train", 0),
         "CaseAnalysis fields": len(fields),
