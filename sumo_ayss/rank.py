@@ -52,9 +52,9 @@ from sumo_ayss.modes import (
 )
 from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.run_folder import (
-    OUTCOME_JSON,
     OrderCheck,
     OrderChecks,
+    RunFolder,
     RunRecord,
     StudyFolder,
     case_runs,
@@ -336,7 +336,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument(
         "--no-run",
         action="store_true",
-        help=f"rank the grid's existing run folders (with {OUTCOME_JSON}) without running jobs "
+        help=f"rank the grid's existing run folders (with {RunFolder.outcome_json.name}) without "
+        "running jobs "
         "or cross-play (cross-play rows appear where <out>/<case>/crossplay.csv exists)",
     )
     parser.add_argument("--no-live", action="store_true", help="no live table (log lines)")

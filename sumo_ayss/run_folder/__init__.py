@@ -89,8 +89,6 @@ from sumo_ayss.run_folder.eval_table import (
     write_eval_table,
 )
 from sumo_ayss.run_folder.layout import (
-    OUTCOME_JSON,
-    VERSIONS_JSON,
     CaseFolder,
     RunFolder,
     find_run_dirs,
@@ -155,9 +153,7 @@ __all__ = [
     "AYSS_SCHEMA",
     "CROSSPLAY_SCHEMA",
     "EVAL_SCHEMA",
-    "OUTCOME_JSON",
     "OUTCOME_SCHEMA",
-    "VERSIONS_JSON",
     "AdaptiveLook",
     "AdaptiveRecord",
     "CaseFolder",

@@ -12,7 +12,7 @@ import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, overload
 
 from sumo_ayss.util.errors import ConfigError
 
@@ -133,13 +133,23 @@ def seed_of_dir(path: Path) -> int | None:
 
 
 class FolderFile:
-    """A file of a folder record (:class:`RunFolder`, :class:`CaseFolder`, a study's): the
-    attribute's value is the path of the file named once here, ``folder.path / name``."""
+    """A file of a folder record (:class:`RunFolder`, :class:`CaseFolder`, a study's), named
+    once: on a folder the attribute is the file's path, ``folder.path / name``; on the class
+    it is this descriptor, whose :attr:`name` is the file's name (``RunFolder.outcome_json.name``
+    is ``"outcome.json"``)."""
 
     def __init__(self, name: str) -> None:
         self.name = name
 
-    def __get__(self, folder: Any, owner: type | None = None) -> Path:
+    @overload
+    def __get__(self, folder: None, owner: type | None = None) -> FolderFile: ...
+
+    @overload
+    def __get__(self, folder: object, owner: type | None = None) -> Path: ...
+
+    def __get__(self, folder: Any, owner: type | None = None) -> Path | FolderFile:
+        if folder is None:
+            return self
         path: Path = folder.path / self.name
         return path
 

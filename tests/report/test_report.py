@@ -30,7 +30,6 @@ from sumo_ayss.report.__main__ import main
 from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     CROSSPLAY_SCHEMA,
-    OUTCOME_JSON,
     OUTCOME_SCHEMA,
     CaseFolder,
     RunConfig,
@@ -47,7 +46,7 @@ from sumo_ayss.run_folder import (
     write_versions,
 )
 from sumo_ayss.run_folder.crossplay import load_crossplay
-from sumo_ayss.run_folder.layout import AYSS_CSV, EVAL_CSV
+from sumo_ayss.run_folder.layout import AYSS_CSV, EVAL_CSV, OUTCOME_JSON
 from sumo_ayss.scenarios.outcome import MeanInterval, OutcomeSummary, Proportion
 from sumo_ayss.training.selection import Selection
 from sumo_ayss.vuts.catalog import BUILTIN_VUTS

@@ -403,3 +403,12 @@ def test_adaptive_record_round_trips_and_refuses_another_layout(tmp_path: Path) 
     path.write_text('{"format": 1, "looks": "x"}')
     with pytest.raises(TableError, match=r"adaptive\.json: looks: expected list, got .x."):
         read_adaptive(path)
+
+
+def test_each_file_of_a_folder_is_named_once(tmp_path: Path) -> None:
+    """A folder record's attribute is the file's path on a folder and, on the class, the
+    descriptor that names it (what a help text or a heading quotes)."""
+    folder = RunFolder(tmp_path)
+    assert folder.outcome_json == tmp_path / "outcome.json"
+    assert RunFolder.outcome_json.name == folder.outcome_json.name == "outcome.json"
+    assert CaseFolder.crossplay_csv.name == "crossplay.csv"
