@@ -57,6 +57,7 @@ __all__ = [
     "write_command",
     "write_done_marker",
     "write_progress",
+    "write_provenance",
     "write_run_config",
     "write_seeds",
     "write_spcp",
@@ -218,6 +219,17 @@ def read_seeds(path: Path) -> Seeds:
             for f in dataclasses.fields(Seeds)
         }
     )
+
+
+def write_provenance(
+    folder: RunFolder, command: str, versions: Mapping[str, str], seeds: Seeds
+) -> None:
+    """Write what records how a run was made, beside its ``config.yaml``: ``command.txt``,
+    ``versions.json`` and ``seeds.json`` (:func:`write_command`, :func:`write_versions`,
+    :func:`write_seeds`)."""
+    write_command(folder.command, command)
+    write_versions(folder.versions, versions)
+    write_seeds(folder.seeds, seeds)
 
 
 # --------------------------------------------------------------------------- spcp.json

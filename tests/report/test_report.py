@@ -43,10 +43,10 @@ from sumo_ayss.run_folder import (
     write_run_config,
     write_spcp,
     write_table,
-    write_versions,
 )
 from sumo_ayss.run_folder.crossplay import load_crossplay
 from sumo_ayss.run_folder.layout import AYSS_CSV, EVAL_CSV, OUTCOME_JSON
+from sumo_ayss.run_folder.metadata import write_versions
 from sumo_ayss.scenarios.outcome import MeanInterval, OutcomeSummary, Proportion
 from sumo_ayss.training.selection import Selection
 from sumo_ayss.vuts.catalog import BUILTIN_VUTS

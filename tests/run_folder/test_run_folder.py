@@ -36,20 +36,23 @@ from sumo_ayss.run_folder import (
     read_run_config,
     read_table,
     write_ayss_json,
-    write_command,
     write_crossplay_json,
     write_done_marker,
     write_eval_table,
     write_outcome_json,
     write_progress,
+    write_provenance,
     write_run_config,
-    write_seeds,
     write_spcp,
     write_table,
-    write_versions,
 )
 from sumo_ayss.run_folder.layout import case_dir_for, run_dir_for
-from sumo_ayss.run_folder.metadata import read_command, read_seeds, read_spcp, read_versions
+from sumo_ayss.run_folder.metadata import (
+    read_command,
+    read_seeds,
+    read_spcp,
+    read_versions,
+)
 from sumo_ayss.scenarios.outcome import MeanInterval, OutcomeSummary, Proportion
 from sumo_ayss.training.checkpoint_files import (
     LATEST_JSON,
@@ -127,9 +130,8 @@ def run_folder(tmp_path: Path) -> RunFolder:
     }
     train = {"total_timesteps": 10000, "eval_every": 5000}
     write_run_config(folder.config, RunConfig("pi2", 3, {"env": env, "train": train}))
-    write_command(folder.command, "python -m sumo_ayss.train --seed 3")
-    write_versions(folder.versions, {"python": "3.11.2", "numpy": "2.0.0"})
-    write_seeds(folder.seeds, Seeds(3, 3, 2024))
+    command, versions = "python -m sumo_ayss.train --seed 3", {"python": "3.11.2", "numpy": "2.0.0"}
+    write_provenance(folder, command, versions, Seeds(3, 3, 2024))
     rows = _eval_rows(folder)
     write_eval_table(folder.eval_table, rows)
     step_dir = folder.step_dir(10000)
