@@ -113,8 +113,8 @@ def available_modes(a: CaseAnalysis[RunRecord]) -> list[str]:
 
 def _rows(a: CaseAnalysis[RunRecord], mode: Mode) -> list[dict[str, Any]]:
     """The ``ranking.csv`` rows of one case in one mode, with crashes and mobility where
-    the mode reads outcomes (``CaseAnalysis.outcomes``)."""
-    outcomes = a.outcomes.get(mode.name, {})
+    the mode reads outcomes (:meth:`~sumo_ayss.modes.Mode.outcomes`)."""
+    outcomes = mode.outcomes(a)
     unit = mode.unit(a)
     rows = []
     for s in mode.standings(a):

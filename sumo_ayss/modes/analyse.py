@@ -1,5 +1,6 @@
-"""A case's analysis with the verdict of the mode asked for (the analysis computes every
-mode's data; the mode gives the verdict, :attr:`~sumo_ayss.modes.registry.Mode.verdict`)."""
+"""A case's analysis: its data (:func:`sumo_ayss.analysis.case.analyse_case`), every
+registered mode's own result (:meth:`~sumo_ayss.modes.registry.Mode.compute`) and the
+verdict of the mode asked for (:meth:`~sumo_ayss.modes.registry.Mode.verdict`)."""
 
 from __future__ import annotations
 
@@ -40,9 +41,13 @@ def analyse_case(
     crossplay: CrossplayInput | None = None,
     paper: bool = True,
 ) -> CaseAnalysis[R]:
-    """:func:`sumo_ayss.analysis.case.analyse_case` (same arguments), then every registered
-    mode's own result (:meth:`~sumo_ayss.modes.registry.Mode.compute`, in ``results``), and
-    the ``verdict`` given by the mode ``options.mode``.
+    """:func:`sumo_ayss.analysis.case.analyse_case` (same arguments: the case's data), then
+    every registered mode's own result in registry order
+    (:meth:`~sumo_ayss.modes.registry.Mode.compute`, in ``results``; the built-in modes'
+    :class:`~sumo_ayss.modes.crossplay.CrossplayResult`,
+    :class:`~sumo_ayss.modes.exposure.ExposureResult`,
+    :class:`~sumo_ayss.modes.paper.PaperResult`), and the ``verdict`` given by the mode
+    ``options.mode``.
 
     Raises:
         ConfigError: If ``options.mode`` is not a registered mode.
