@@ -4,8 +4,10 @@ verdict of the mode asked for (:meth:`~sumo_ayss.modes.registry.Mode.verdict`)."
 
 from __future__ import annotations
 
+import contextlib
+import os
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 from sumo_ayss.modes.registry import get_mode, registered_modes
 
@@ -14,7 +16,7 @@ if TYPE_CHECKING:
     from sumo_ayss.analysis.crossplay import CrossplayInput
     from sumo_ayss.analysis.crossplay_scoring import CrossplayTablesLike
 
-__all__ = ["CaseInput", "analyse_case", "analyse_cases"]
+__all__ = ["CaseInput", "analyse_case", "analyse_cases", "input_problems"]
 
 R = TypeVar("R", bound="RunLike")
 
@@ -83,3 +85,28 @@ def analyse_cases(
         )
         for c in cases
     ]
+
+
+def input_problems(analyses: Sequence[CaseAnalysis[Any]]) -> list[str]:
+    """The problems of the analysed cases' input files, one console line each (the report,
+    ``rank`` and the pipeline print them; ``--strict`` makes them an error).
+
+    They are the lines of the report's "Missing or incomplete data" callouts
+    (:attr:`~sumo_ayss.analysis.case.CaseAnalysis.problems`), each naming its file: a run's
+    problem starts with the file's name (``eval.csv missing``) and is joined to the run
+    folder's path (its ``path``); a case's own problem (an unreadable cross-play table, which
+    names its file) is prefixed with the case.
+    """
+    from sumo_ayss.analysis.case import run_label
+
+    lines = []
+    for a in analyses:
+        own = list(a.problems)
+        for members in a.runs.values():
+            for run in members:
+                for problem in run.problems:
+                    lines.append(f"{run.path}{os.sep}{problem}")
+                    with contextlib.suppress(ValueError):
+                        own.remove(f"{run_label(run)}: {problem}")
+        lines += [p if p.startswith(os.sep) else f"{a.case}: {p}" for p in own]
+    return lines

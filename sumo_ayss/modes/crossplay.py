@@ -92,7 +92,7 @@ def compute_crossplay(a: CaseAnalysis[Any]) -> CrossplayResult:
     used (its lost rows are a line in ``a.problems``)."""
     from sumo_ayss.analysis.crossplay import CrossplayGap, rank_crossplay
     from sumo_ayss.analysis.harm import vut_outcomes
-    from sumo_ayss.analysis.reference import CAREFUL_HUMAN, ScenarioSet, read_against_reference
+    from sumo_ayss.analysis.reference import ScenarioSet, read_against_reference
     from sumo_ayss.util.errors import ConfigError
 
     options, found, runs = a.options, a.tables, a.runs
@@ -130,7 +130,7 @@ def compute_crossplay(a: CaseAnalysis[Any]) -> CrossplayResult:
         scenario_set = ScenarioSet.of(m.n_scenarios, len(found.inevitable[2]), options.level)
     references: dict[str, ReferenceReading] = {}
     if found.reference is not None:
-        for name in sorted(found.reference.vuts, key=lambda v: (v != CAREFUL_HUMAN, v)):
+        for name in sorted(found.reference.vuts, key=_careful_human_first):
             try:
                 references[name] = read_against_reference(
                     m,
@@ -156,6 +156,13 @@ def compute_crossplay(a: CaseAnalysis[Any]) -> CrossplayResult:
         references=references,
         scenario_set=scenario_set,
     )
+
+
+def _careful_human_first(driver: str) -> tuple[bool, str]:
+    """Sort key of the reference drivers: the careful human first, then by name."""
+    from sumo_ayss.analysis.reference import CAREFUL_HUMAN
+
+    return driver != CAREFUL_HUMAN, driver
 
 
 def crossplay_result(a: CaseAnalysis[Any], name: str = NAME) -> CrossplayResult:

@@ -19,7 +19,6 @@ from sumo_ayss.modes.formatting import fmt_num, ranking_line
 from sumo_ayss.modes.paper import paper_result
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragraph, Table
-from sumo_ayss.report.checks import training_status
 from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.crossplay import crossplay_blocks
 from sumo_ayss.report.sections.discriminability import discriminability_blocks
@@ -33,6 +32,7 @@ from sumo_ayss.report.sections.outcome import (
 from sumo_ayss.report.sections.paper import paper_blocks
 from sumo_ayss.report.sections.reference import reference_blocks
 from sumo_ayss.run_folder import RunRecord
+from sumo_ayss.training.trust import training_status
 
 __all__ = ["case_blocks", "verdict_lines"]
 
