@@ -141,6 +141,9 @@ class Case:
             case (results/ladders); otherwise the caution every exposure verdict carries.
         one_decision_note: Said by the discriminability section when responses were
             measured over one decision; empty: nothing to say.
+        vec_env: The env can run as a member of a
+            :class:`~sumo_ayss.envs.vec_env.PairVecEnv` (several pairs in one simulation);
+            False: ``train.n_envs`` must be 1 (the configuration refuses more).
     """
 
     name: str
@@ -164,6 +167,7 @@ class Case:
     paper_rows: tuple[PaperRow, ...] = ()
     exposure_caution: str = ""
     one_decision_note: str = ""
+    vec_env: bool = True
 
     def __post_init__(self) -> None:
         where = f"case {self.name!r}"

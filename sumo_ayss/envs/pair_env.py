@@ -456,7 +456,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         cfg = self.config
         if self.sumo_seed is None:  # never seeded: fresh entropy, not the env's RNG
             self.sumo_seed = sumo_seed_of(int(np.random.SeedSequence().entropy))  # type: ignore[arg-type]
-        vtypes = session_vtypes(cfg)
+        vtypes = self._session_vtypes()
         network = cfg.network if cfg.network is not None else network_path(cfg.case)
         session = SumoSession(
             network, vtypes, cfg.sim, self.sumo_seed, owner=f"{type(self).__name__}({cfg.vut})"
@@ -473,6 +473,11 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             follower_type="follower" if cfg.follower.enabled else None,
         )
         return self._pair
+
+    def _session_vtypes(self) -> dict[str, VehicleType]:
+        """The vehicle types the env's simulation loads (:func:`session_vtypes`; a case may
+        load more, e.g. a reference driver for an online replay)."""
+        return session_vtypes(self.config)
 
     @staticmethod
     def _check_road(cfg: EnvConfig) -> None:
