@@ -139,6 +139,18 @@ class LeadAndCutInEnv(PairEnv):
         self.replays = 0
         self.replay_wall_s = 0.0
 
+    @classmethod
+    def ayss_start(cls, sample: InitialCondition) -> InitialCondition:
+        """The AYSS sample with the case's fixed supporting POV and primary
+        (:attr:`~sumo_ayss.cases.Case.ayss_fixed_obs`)."""
+        _same_lane, v_support, h_support, primary = LEAD_AND_CUT_IN.ayss_fixed_obs
+        return TwoPovStart(
+            *sample.as_tuple(),
+            support_speed_mps=v_support,
+            support_gap_m=h_support,
+            primary=round(primary),
+        )
+
     # ------------------------------------------------------------------ gym API
 
     def reset(
@@ -232,6 +244,7 @@ class LeadAndCutInEnv(PairEnv):
         info["collision"] = c.primary_vut
         info["pov_failure"] = c.failure
         info["vut_contact"] = c.primary_vut or c.support_vut
+        info["contact"] = c.any
         info["reward_collision"] = -float(c.povs)
         alpha_c = self._reward_cfg.alpha_collision
         if c.any:
@@ -396,6 +409,7 @@ class LeadAndCutInEnv(PairEnv):
             "support_gap_m": s.pos_m - self._pov_length_m - k.vut_pos_m,
             "support_pos_m": s.pos_m,
             "support_lane": s.lane,
+            "support_y_m": pair.lane_centre_y_m(s.lane) + s.lateral_offset_m,
             "cut_in_vut_lane": (pov_lane if cut_primary else s.lane) == vut_lane,
             "cut_changing": changing_primary if cut_primary else changing_support,
         }

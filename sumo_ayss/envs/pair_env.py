@@ -165,6 +165,12 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
 
     # ------------------------------------------------------------------ case hooks
 
+    @classmethod
+    def ayss_start(cls, sample: InitialCondition) -> InitialCondition:
+        """The start of an AYSS sample's scenario (its first three observation columns as
+        ``sample``): ``sample`` itself, unless the case fixes more of the state there."""
+        return sample
+
     @abstractmethod
     def _placement(self, ic: InitialCondition) -> PairPlacement: ...
 

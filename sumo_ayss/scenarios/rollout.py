@@ -126,7 +126,7 @@ def episode_result(rewards: Sequence[float], infos: Sequence[Mapping[str, Any]])
     changed = False
     for reward, info in zip(rewards, infos, strict=True):
         total += float(reward)
-        if not info["collision"]:
+        if not info.get("contact", info["collision"]):  # a case with several POVs: any
             pay += float(reward)
         speed_sum += float(info["vut_speed_mps"])
         changed = changed or bool(info.get("lane_change_started", False))

@@ -23,7 +23,7 @@ Body widths come from the vehicle types, SUMO's default 1.8 m where a type gives
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -117,3 +117,26 @@ def hazards_of(
     (:func:`~sumo_ayss.analysis.hazards.episode_hazards`)."""
     tr = trajectory_from_infos(config, reset_info, infos)
     return episode_hazards(tr, follower_of(reset_info, infos))
+
+
+class SecondPovTrack(NamedTuple):
+    """A second POV's samples over one episode (case ``lead_and_cut_in``): front-bumper
+    lane position [m], world y of the front bumper's centre [m], speed [m/s]."""
+
+    x_m: np.ndarray
+    y_m: np.ndarray
+    speed_mps: np.ndarray
+
+
+def second_pov_of(
+    reset_info: Mapping[str, Any], infos: Sequence[Mapping[str, Any]]
+) -> SecondPovTrack | None:
+    """The second (supporting) POV's samples of one episode, or None when it had none."""
+    if "support_pos_m" not in reset_info:
+        return None
+    samples = [reset_info, *infos]
+
+    def col(key: str) -> np.ndarray:
+        return np.array([float(s[key]) for s in samples])
+
+    return SecondPovTrack(col("support_pos_m"), col("support_y_m"), col("support_speed_mps"))
