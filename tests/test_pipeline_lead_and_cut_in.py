@@ -62,6 +62,11 @@ def test_lead_and_cut_in_pipeline_end_to_end(tmp_path: Path) -> None:
         assert np.isin(label[table["collided"]], [0.0, 1.0]).all()
         assert np.isnan(label[~table["collided"]]).all()
         assert (table["near_miss_pay"] >= 0).all()
+    # Safety measures per POV: the primary's per episode in outcome.csv, the supporting
+    # POV's summarised in outcome.json with the share of POV failures.
+    support = json.loads((run / "outcome.json").read_text())["supporting_pov"]
+    assert support["n"] == 12 and 0.0 <= support["pov_failure_rate"] <= 1.0
+    assert {"min_ttc_s", "min_thw_s", "max_drac_mps2"} <= set(support["measures"])
     assert report is not None
     text = report.read_text(encoding="utf-8")
     assert "Two-lane lead and cut-in (two POVs): leaderboard (crossplay mode)" in text

@@ -245,6 +245,7 @@ class LeadAndCutInEnv(PairEnv):
         info["pov_failure"] = c.failure
         info["vut_contact"] = c.primary_vut or c.support_vut
         info["contact"] = c.any
+        info["support_vut_contact"] = c.support_vut
         info["reward_collision"] = -float(c.povs)
         alpha_c = self._reward_cfg.alpha_collision
         if c.any:
@@ -410,6 +411,7 @@ class LeadAndCutInEnv(PairEnv):
             "support_pos_m": s.pos_m,
             "support_lane": s.lane,
             "support_y_m": pair.lane_centre_y_m(s.lane) + s.lateral_offset_m,
+            "support_lateral_speed_mps": s.lateral_speed_mps,
             "cut_in_vut_lane": (pov_lane if cut_primary else s.lane) == vut_lane,
             "cut_changing": changing_primary if cut_primary else changing_support,
         }

@@ -30,6 +30,7 @@ from sumo_ayss.envs.lead_and_cut_in import (
 )
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.scenarios.preventability import label_crashes
+from sumo_ayss.scenarios.rollout import run_episode
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.vuts.catalog import VehicleType
 
@@ -225,3 +226,17 @@ def test_the_case_refuses_shared_simulations_and_the_highway_env_actuator() -> N
     with pytest.raises(ConfigError, match="must be 'clipped'"):
         sim = dataclasses.replace(cfg.sim, lateral_resolution_m=0.1)
         LeadAndCutInEnv(dataclasses.replace(cfg, actuator=actuator, sim=sim))
+
+
+def test_safety_measures_are_read_per_pov(make: Callable[..., LeadAndCutInEnv]) -> None:
+    """The supporting POV's cut-in into a faster VUT: its measures show the contact (TTC
+    0), the primary's, 40 m ahead holding speed, do not."""
+    start = TwoPovStart(
+        25.0, 25.0, 40.0, support_speed_mps=12.0, support_gap_m=0.5, primary=PRIMARY_LEAD
+    )
+    action = encode_action(HOLD, CUT_LANE_CHANGE)
+    episode = run_episode(make(), lambda obs: np.full(len(obs), action), start)
+    assert episode.pov_failure and not episode.collided
+    assert episode.support_measures is not None and episode.measures is not None
+    assert episode.support_measures.min_ttc_s == 0.0
+    assert episode.measures.min_ttc_s > 1.0
