@@ -42,6 +42,8 @@ from sumo_ayss.config.env import (
     RewardShape,
     ShapeKind,
     SimConfig,
+    StepMethod,
+    integration_method,
 )
 from sumo_ayss.config.experiment import (
     ExperimentConfig,
@@ -83,6 +85,7 @@ __all__ = [
     "RewardShape",
     "ShapeKind",
     "SimConfig",
+    "StepMethod",
     "TrainConfig",
     "build",
     "check_out_dir",
@@ -90,6 +93,7 @@ __all__ = [
     "check_sumo_network",
     "env_config_from_mapping",
     "experiment_from_dict",
+    "integration_method",
     "load_experiment",
     "load_pipeline",
     "read_yaml",

@@ -9,11 +9,12 @@ are positive forward, braking is negative (the POV actuator bounds are ``[-6, 6]
 
 from __future__ import annotations
 
+import dataclasses
 import typing
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 from sumo_ayss.cases import DEFAULT_CASE, ROAD_EDGE, case_names, get_case
 from sumo_ayss.config.follower import FollowerConfig
@@ -45,7 +46,10 @@ MANAGED_SUMO_OPTIONS: dict[str, str] = {
     "default.action-step-length": (
         "env.vuts.<name>.params.actionStepLength (per VUT; the POV acts every step)"
     ),
+    "step-method.ballistic": "env.sim.step_method",
 }
+
+StepMethod = Literal["auto", "euler", "ballistic"]
 
 
 @dataclass(frozen=True)
@@ -66,9 +70,22 @@ class SimConfig:
     """0: only physical overlap counts as a collision (SUMO's default flags a 0.3 m gap)."""
     extra_args: tuple[str, ...] = ()
     """Extra SUMO command-line arguments, appended verbatim."""
+    step_method: StepMethod = "auto"
+    """How SUMO integrates positions, for every vehicle of the simulation (a global of SUMO,
+    ``--step-method.ballistic``): ``euler`` (SUMO's default, semi-implicit Euler),
+    ``ballistic``, or ``auto``: ballistic exactly when a vehicle type the simulation loads has
+    an ``actionStepLength`` other than the step, else Euler (:func:`integration_method`).
+
+    ``auto`` is what SUMO itself does when the option is not given (SUMO 1.28,
+    ``MSVehicleType.cpp``: a type whose action step differs from the step switches the whole
+    simulation to ballistic "to avoid collisions"), so runs written before this option keep
+    their numbers; the testbed now passes the resolved method explicitly, and a run's
+    identity records it (:mod:`sumo_ayss.run_folder.identity`): a catalog holding one VUT
+    with a longer action step moves *every* vehicle of its studies ballistically."""
 
     def __post_init__(self) -> None:
         s = self.SECTION
+        check_choice(f"{s}.step_method", self.step_method, typing.get_args(StepMethod))
         require(self.step_length_s > 0, f"{s}.step_length_s must be > 0, got {self.step_length_s}")
         require(
             self.lanechange_duration_s > 0,
@@ -94,6 +111,21 @@ class SimConfig:
                     f"{s}.extra_args: {arg!r} is set by sumo_ayss itself "
                     f"({MANAGED_SUMO_OPTIONS[name]}); remove it"
                 )
+
+
+def integration_method(sim: SimConfig, vtypes: Iterable[VehicleType]) -> str:
+    """``"euler"`` or ``"ballistic"``: how SUMO moves every vehicle of a simulation that
+    loads ``vtypes`` under ``sim`` (:attr:`SimConfig.step_method`; ``auto`` follows SUMO's
+    own rule: ballistic when any loaded type's ``actionStepLength`` [s] differs from
+    ``sim.step_length_s``)."""
+    if sim.step_method != "auto":
+        return sim.step_method
+    dt = sim.step_length_s
+    for vt in vtypes:
+        length = vt.params.get("actionStepLength")
+        if length is not None and abs(float(length) - dt) > 1e-9:
+            return "ballistic"
+    return "euler"
 
 
 ActuatorMode = Literal["clipped", "highway_env"]
@@ -366,6 +398,28 @@ class EnvConfig:
     @property
     def vut_type(self) -> VehicleType:
         return self.vuts[self.vut]
+
+    @property
+    def integration(self) -> str:
+        """``"euler"`` or ``"ballistic"``: how SUMO moves every vehicle of a simulation of
+        this env, which loads the whole catalog and the POV (:func:`integration_method`;
+        the follower may not set an action step)."""
+        return integration_method(self.sim, [*self.vuts.values(), self.pov])
+
+    def sim_key(self, own: Iterable[VehicleType]) -> dict[str, Any]:
+        """``env.sim`` as a fingerprint over the types ``own`` records it: ``step_method``
+        resolved (:attr:`integration`), and recorded, as ``integration``, only where it is
+        not what ``own`` and the POV alone imply under ``auto``. So a record whose own
+        types set the method (a VUT with a longer action step) reads as it was written
+        before the option, and a catalog that moves a run's VUT otherwise than it alone
+        would (pi1 beside a reaction VUT) is part of the key."""
+        data = dataclasses.asdict(self.sim)
+        data.pop("step_method")
+        auto = SimConfig(step_length_s=self.sim.step_length_s)
+        implied = integration_method(auto, [*own, self.pov])
+        if self.integration != implied:
+            data["integration"] = self.integration
+        return data
 
     @property
     def steps_per_decision(self) -> int:

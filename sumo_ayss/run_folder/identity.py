@@ -3,11 +3,19 @@
 A run (case, VUT, seed) is made from its experiment (``env``, ``agent``, ``train``), its
 seed and **its own VUT's definition**. The other VUTs of the study's catalog
 (``env.vuts``, which every ``config.yaml`` stores whole: the built-ins plus the study's own)
-never enter its simulation's dynamics, and the VUT's *name* is a label: a study that adds,
-drops, redefines or renames another VUT, or renames this one without changing it, asks for
-the same run. :func:`run_identity` is that view of an experiment, as flat dotted fields:
+enter its simulation's dynamics in one way only: SUMO moves every vehicle ballistically
+when any loaded type has an ``actionStepLength`` other than the step
+(``env.sim.step_method``, :func:`~sumo_ayss.config.integration_method`). Otherwise the
+VUT's *name* is a label: a study that adds, drops, redefines or renames another VUT, or
+renames this one without changing it, asks for the same run, as long as the resolved
+integration method stays. :func:`run_identity` is that view of an experiment, as flat
+dotted fields:
 
 * ``env.vut`` and ``env.vuts`` are left out, and ``env.follower`` (evaluation only);
+* ``env.sim.step_method`` enters resolved, as ``env.sim.integration``, and only where it is
+  not what the run's own VUT implies (:meth:`~sumo_ayss.config.EnvConfig.sim_key`): pi1
+  beside a reaction VUT holds ``ballistic``; every run folder written before the option
+  keeps its identity;
 * the run's own VUT's definition (model, parameters, controller; its ``description`` is
   display only) enters under :data:`OWN_VUT` (``env.vuts[env.vut].params.minGap``);
 * display options (:data:`DISPLAY_FIELDS`, e.g. the progress bar) are left out.
@@ -87,6 +95,10 @@ def run_identity(cfg: ExperimentConfig, seed: int) -> dict[str, Any]:
     # The follower behind the VUT is in the evaluation episodes only (it never changes a
     # training episode: sumo_ayss.envs.follower), and run folders before it have none.
     env.pop("follower", None)
+    # The catalog does enter through one SUMO global: how every vehicle is moved. Recorded
+    # resolved, and only where the run's own VUT does not imply it, so that the identities
+    # of runs written before the option are unchanged.
+    env["sim"] = cfg.env.sim_key([cfg.env.vut_type])
     flat = flat_config(data)
     flat.update(flat_config(vut_definition(cfg.env.vut_type), f"{OWN_VUT}."))
     return {"seed": seed, **{k: v for k, v in flat.items() if k not in DISPLAY_FIELDS}}

@@ -352,7 +352,7 @@ class DiscriminabilityStage:
                 "case": env.case,
                 "vuts": {v: to_dict(env.vuts[v]) for v in self.vuts},
                 "pov": to_dict(env.pov),
-                "sim": to_dict(env.sim),
+                "sim": env.sim_key(env.vuts[v] for v in self.vuts),
                 "decision_period_s": env.decision_period_s,
                 "settings": dict(self.settings),
             }

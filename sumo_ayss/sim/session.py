@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 import libsumo
 from libsumo import _libsumo
 
-from sumo_ayss.config import SimConfig
+from sumo_ayss.config import SimConfig, integration_method
 from sumo_ayss.sim.network import sumo_binary
 from sumo_ayss.util.errors import SimulationError
 from sumo_ayss.vuts.catalog import VehicleType, vtypes_xml
@@ -70,6 +70,11 @@ class SumoSession:
         self._routes: set[str] = set()  # routes known to be in the running simulation
 
     @property
+    def integration(self) -> str:
+        """``"euler"`` or ``"ballistic"``: how SUMO moves every vehicle of this simulation."""
+        return integration_method(self.sim, self.vtypes.values())
+
+    @property
     def running(self) -> bool:
         return SumoSession._live is self
 
@@ -82,6 +87,10 @@ class SumoSession:
             "--additional-files", str(additional),
             "--step-length", repr(s.step_length_s),
             "--seed", str(self.seed),
+            # Always explicit: SUMO would switch every vehicle to ballistic on its own when a
+            # loaded type has a longer action step (env.sim.step_method).
+            "--step-method.ballistic",
+            str(self.integration == "ballistic").lower(),
             # A collision is reported and the vehicles keep driving (they pass through each
             # other); the default action teleports them away and hides the crash.
             "--collision.action", "warn",

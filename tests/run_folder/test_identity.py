@@ -6,7 +6,7 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
-from sumo_ayss.config import ExperimentConfig, to_dict
+from sumo_ayss.config import ExperimentConfig, SimConfig, integration_method, to_dict
 from sumo_ayss.run_folder import RunConfig, RunFolder, TrainStage, stored_experiment
 from sumo_ayss.run_folder.identity import (
     identity_differences,
@@ -86,6 +86,52 @@ def test_committed_run_folders_are_still_done_under_a_catalog_of_their_vut_alone
     for path in folders[::7]:
         folder = RunFolder(path)
         cfg, seed = stored_experiment(folder)
+        # The catalog's one effect on the dynamics (SUMO's integration method) kept:
+        method = integration_method(cfg.env.sim, [*cfg.env.vuts.values(), cfg.env.pov])
         alone = _with_catalog(cfg, {cfg.env.vut: cfg.env.vut_type})
+        alone = _with_sim(alone, step_method=method)
         stage = TrainStage(folder, alone, seed)
         assert stage.key() == stage.recorded(), path
+
+
+def _with_sim(cfg: ExperimentConfig, **changes: object) -> ExperimentConfig:
+    sim = dataclasses.replace(cfg.env.sim, **changes)  # type: ignore[arg-type]
+    return dataclasses.replace(cfg, env=dataclasses.replace(cfg.env, sim=sim))
+
+
+REACTION = VehicleType("IDM", {"minGap": 5.0, "actionStepLength": 1.0}, "decides every 1 s")
+
+
+def test_a_catalog_that_makes_sumo_ballistic_is_part_of_every_run_of_it() -> None:
+    """One VUT with a longer action step switches SUMO to ballistic integration for every
+    vehicle of the simulation (SUMO 1.28): pi1 beside it is not pi1 alone."""
+    base = ExperimentConfig()
+    beside = _with_catalog(base, {**base.env.vuts, "r10": REACTION})
+    assert "env.sim.integration" not in run_identity(base, 0)
+    assert "env.sim.step_method" not in run_identity(base, 0)
+    assert identity_differences(base, 0, beside, 0) == [
+        "env.sim.integration: '(absent)' -> 'ballistic'"
+    ]
+    assert not is_redefinition(identity_differences(base, 0, beside, 0))
+    # Asked explicitly, the same method is the same run, whatever the catalog holds.
+    assert run_identity(_with_sim(base, step_method="ballistic"), 0) == run_identity(beside, 0)
+    assert run_identity(_with_sim(beside, step_method="euler"), 0) == run_identity(base, 0)
+    # A study of the reaction VUT alone is ballistic too: its own run is unchanged by it.
+    own = dataclasses.replace(beside, env=dataclasses.replace(beside.env, vut="r10"))
+    alone = _with_catalog(own, {"r10": REACTION})
+    assert run_identity(alone, 0) == run_identity(own, 0)
+
+
+def test_a_committed_reaction_run_is_not_the_same_run_beside_vuts_without_the_option() -> None:
+    """The committed reaction ladder moved every VUT ballistically (its catalog holds r06 and
+    r10); its r02 asked alone (Euler) is another run, and the resume check names why."""
+    folder = RunFolder(ROOT / "results/ladders/reaction_a/car_following/r02/seed_201")
+    cfg, seed = stored_experiment(folder)
+    assert integration_method(cfg.env.sim, cfg.env.vuts.values()) == "ballistic"
+    alone = _with_catalog(cfg, {"r02": cfg.env.vut_type})
+    stage = TrainStage(folder, alone, seed)
+    assert stage.recorded() is not None and stage.key() != stage.recorded()
+    assert "env.sim.integration: 'ballistic' -> '(absent)'" in identity_differences(
+        cfg, seed, alone, seed
+    )
+    assert SimConfig().step_method == "auto"
