@@ -167,8 +167,8 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
 
     @classmethod
     def ayss_start(cls, sample: InitialCondition) -> InitialCondition:
-        """The start of an AYSS sample's scenario (its first three observation columns as
-        ``sample``): ``sample`` itself, unless the case fixes more of the state there."""
+        """The start of an AYSS sample's scenario (its first three observation columns):
+        ``sample``, unless the case fixes more of the state there."""
         return sample
 
     @abstractmethod
@@ -481,8 +481,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         return self._pair
 
     def _session_vtypes(self) -> dict[str, VehicleType]:
-        """The vehicle types the env's simulation loads (:func:`session_vtypes`; a case may
-        load more, e.g. a reference driver for an online replay)."""
+        """The vehicle types the env's simulation loads (a case may load more)."""
         return session_vtypes(self.config)
 
     @staticmethod
