@@ -81,6 +81,12 @@ def test_lead_and_cut_in_pipeline_end_to_end(tmp_path: Path) -> None:
     fcd = sumo.trajectory.read_text()
     assert all(f'id="{v}"' in fcd for v in ("vut", "pov", "pov2"))
     assert all(sumo.info["reproduces_row"].values())
+    # An AYSS sample replays from the case's fixed supporting POV (PairEnv.ayss_start).
+    sample = export_scenario(run, tmp_path / "ayss", ayss_row=0)
+    assert sample.info["reproduces_row"] == {"action": True}
+    start = sample.info["initial_condition"]
+    assert (start["support_gap_m"], start["support_speed_mps"], start["primary"]) == (40, 20, 0)
+    assert 'id="pov2"' in sample.trajectory.read_text()
     xo = export_xosc(run, tmp_path / "xosc", outcome_row=0)
     assert "pov2" in xo.info["bodies_m"] and 'name="pov2"' in xo.xosc.read_text()
     assert all(xo.info["reproduces_row"].values())

@@ -447,6 +447,7 @@ class LeadAndCutInEnv(PairEnv):
             return False
         finally:
             self._vut_law, pair.vut_type = own_law, own_type
+            self.initial_condition = ic  # the episode's, as given (a checkpoint stores it)
             self._done = True
             self.replays += 1
             self.replay_wall_s += time.perf_counter() - t0

@@ -160,6 +160,17 @@ def test_unpreventable_crash_is_penalised_and_matches_the_preventability_replay(
     n_hard = len(rewards)
     n_soft = len(run(env, soft, action)[0])
     assert env.replays == 2
+    # A plain start (the supporting POV derived) stays the episode's start after the replay
+    # (a training checkpoint stores it as a plain InitialCondition).
+    odd = env.config.odd
+    gaps = (2.0 + 0.01 * k for k in range(100))
+    plain = next(
+        ic
+        for g in gaps
+        if two_pov_start(ic := InitialCondition(20.0, 25.0, g), odd).primary == PRIMARY_LEAD
+    )
+    assert run(env, plain, action)[1]["collision"] and env.replays == 3
+    assert type(env.initial_condition) is InitialCondition
     env.close()
     labels = label_crashes(
         config("weak"),
