@@ -28,6 +28,7 @@ LEAD_AND_CUT_IN = register_case(
         lanes=2,
         lane_change=True,
         vec_env=False,
+        default_grid=False,  # the paper's two cases stay the default grid
         env="sumo_ayss.envs.lead_and_cut_in:LeadAndCutInEnv",
         gym_id="sumo_ayss/LeadAndCutIn-v0",
         observation=(

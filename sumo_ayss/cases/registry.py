@@ -26,6 +26,7 @@ __all__ = [
     "case_info",
     "case_names",
     "case_of_indicator",
+    "default_grid_cases",
     "get_case",
     "indicator_columns",
     "register_case",
@@ -144,6 +145,8 @@ class Case:
         vec_env: The env can run as a member of a
             :class:`~sumo_ayss.envs.vec_env.PairVecEnv` (several pairs in one simulation);
             False: ``train.n_envs`` must be 1 (the configuration refuses more).
+        default_grid: A pipeline whose ``grid`` names no cases runs this one
+            (:func:`default_grid_cases`); False: only where a grid names it.
     """
 
     name: str
@@ -168,6 +171,7 @@ class Case:
     exposure_caution: str = ""
     one_decision_note: str = ""
     vec_env: bool = True
+    default_grid: bool = True
 
     def __post_init__(self) -> None:
         where = f"case {self.name!r}"
@@ -265,6 +269,11 @@ def case_names() -> tuple[str, ...]:
 def registered_cases() -> tuple[Case, ...]:
     """The registered cases, in registration order."""
     return _REGISTRY.records()
+
+
+def default_grid_cases() -> tuple[str, ...]:
+    """The cases of a pipeline grid that names none, in registration order."""
+    return tuple(c.name for c in _REGISTRY if c.default_grid)
 
 
 def case_info(name: str) -> Case:

@@ -184,8 +184,8 @@ def test_configuration_accepts_a_registered_case(toy: Case) -> None:
         sim=SimConfig(lateral_resolution_m=0.1),
     )
     assert GridConfig(cases=(toy.name,)).cases == (toy.name,)
-    pipeline = PipelineConfig()  # the default grid runs every registered case
-    assert pipeline.grid.cases == (*BUILTIN, toy.name)
+    pipeline = PipelineConfig()  # the default grid: every registered case but the opt-in
+    assert pipeline.grid.cases == ("car_following", "cut_in", toy.name)
     assert pipeline.experiments[toy.name].name == "toy_merge.yaml"
 
 
