@@ -101,6 +101,16 @@ class LeadAndCutInEnv(PairEnv):
         1.0,
     )
     N_ACTIONS: ClassVar[int] = N_ACTIONS
+    #: The lead brakes (offset -5 m/s: the actuator's -6 m/s²), or the cut-in POV cuts in
+    #: at once and brakes or holds; the other POV holds its speed.
+    ICS_STRATEGIES: ClassVar[dict[str, tuple[int, ...]]] = {
+        "lead brakes": (encode_action(0, 1 + SPEED_OFFSETS_MPS.index(0.0)),),
+        "cut in, brake": (
+            encode_action(SPEED_OFFSETS_MPS.index(0.0), CUT_LANE_CHANGE),
+            encode_action(SPEED_OFFSETS_MPS.index(0.0), 1),
+        ),
+        "cut in, hold speed": (encode_action(SPEED_OFFSETS_MPS.index(0.0), CUT_LANE_CHANGE),),
+    }
 
     def __init__(
         self,

@@ -121,6 +121,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
     N_ACTIONS: ClassVar[int]
     #: Smallest gap [m] a given initial condition may ask for (cut-in: side by side, < 0).
     IC_GAP_MIN_M: ClassVar[float] = 0.0
+    ICS_STRATEGIES: ClassVar[dict[str, tuple[int, ...]]]  # worst POV plays: scenarios/inevitable
 
     def __init__(
         self,
@@ -167,8 +168,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
 
     @classmethod
     def ayss_start(cls, sample: InitialCondition) -> InitialCondition:
-        """The start of an AYSS sample's scenario (its first three observation columns):
-        ``sample``, unless the case fixes more of the state there."""
+        """The start of an AYSS sample's scenario (a case may fix more of the state)."""
         return sample
 
     @abstractmethod

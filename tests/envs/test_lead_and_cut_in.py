@@ -251,3 +251,22 @@ def test_safety_measures_are_read_per_pov(make: Callable[..., LeadAndCutInEnv]) 
     assert episode.support_measures is not None and episode.measures is not None
     assert episode.support_measures.min_ttc_s == 0.0
     assert episode.measures.min_ttc_s > 1.0
+
+
+def test_inevitable_collision_states_use_the_cases_own_worst_plays() -> None:
+    """The ICS check drives the case's own joint actions: a lead 3 m ahead of a VUT closing
+    at 5 m/s cannot be avoided by full braking; 40 m ahead at equal speeds it can."""
+    from sumo_ayss.scenarios.inevitable import ics_flags, pov_strategies
+
+    assert set(pov_strategies("lead_and_cut_in")) == {
+        "lead brakes",
+        "cut in, brake",
+        "cut in, hold speed",
+    }
+    near = TwoPovStart(
+        20.0, 25.0, 0.5, support_speed_mps=20.0, support_gap_m=60.0, primary=PRIMARY_LEAD
+    )
+    far = TwoPovStart(
+        20.0, 20.0, 40.0, support_speed_mps=20.0, support_gap_m=60.0, primary=PRIMARY_LEAD
+    )
+    assert ics_flags(config(), [near, far]) == [True, False]
