@@ -41,11 +41,8 @@ from sumo_ayss.envs import make_env
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.grid.threads import set_torch_threads
 from sumo_ayss.run_folder import (
-    AyssStage,
-    OutcomeStage,
     RunRecord,
     StageHeader,
-    is_done,
     read_run,
     write_ayss_json,
     write_outcome_json,
@@ -61,6 +58,7 @@ from sumo_ayss.scenarios.outcome import (
 )
 from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
 from sumo_ayss.scenarios.rollout import Policy
+from sumo_ayss.stages import AyssStage, OutcomeStage, is_done
 from sumo_ayss.util.errors import AyssError
 from sumo_ayss.util.paths import portable_path
 from sumo_ayss.vuts.catalog import controller_imports

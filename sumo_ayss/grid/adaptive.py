@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from sumo_ayss.config import PipelineConfig
+from sumo_ayss.config.identity import vut_key
 from sumo_ayss.grid.jobs import JobSpec
 from sumo_ayss.grid.progress import JobStatus
 from sumo_ayss.run_folder import (
@@ -36,7 +37,6 @@ from sumo_ayss.run_folder import (
     read_adaptive,
     write_adaptive,
 )
-from sumo_ayss.run_folder.identity import vut_key
 from sumo_ayss.util.errors import AyssError
 
 if TYPE_CHECKING:

@@ -15,15 +15,8 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.config import AyssConfig, ExperimentConfig
-from sumo_ayss.run_folder import (
-    EvaluateStage,
-    RunFolder,
-    TrainStage,
-    is_done,
-    read_run,
-    run_dir_for,
-    write_progress,
-)
+from sumo_ayss.run_folder import RunFolder, read_run, run_dir_for, write_progress
+from sumo_ayss.stages import EvaluateStage, TrainStage, is_done
 from sumo_ayss.util.errors import ControllerError, DiskFullError
 from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
 

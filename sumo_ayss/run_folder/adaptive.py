@@ -5,7 +5,7 @@ when it resumes (the seeds already added are part of the grid) and by ``rank --n
 A look is stored as an :class:`AdaptiveLook`, the fields of the analysis's
 :class:`sumo_ayss.analysis.sequential.SettleCheck`. ``vuts`` names the VUTs looked at, each
 with its definition's key
-(:func:`~sumo_ayss.run_folder.identity.vut_key`): a grid whose VUTs are others (one added,
+(:func:`~sumo_ayss.config.identity.vut_key`): a grid whose VUTs are others (one added,
 dropped, redefined or renamed) ignores the record and starts over (records written before
 ``vuts`` existed are taken as they are).
 """

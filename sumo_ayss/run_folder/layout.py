@@ -30,20 +30,14 @@ __all__ = [
     "EVALUATE_DONE_JSON",
     "EVAL_CSV",
     "JOB_LOG",
-    "LATEST_JSON",
     "MODEL_ZIP",
     "OUTCOME_CSV",
     "OUTCOME_JSON",
     "PROGRESS_JSON",
-    "REPLAY_PKL",
-    "RESUME_FILES",
-    "RESUME_MODEL_ZIP",
     "SEEDS_JSON",
     "SPCP_JSON",
     "SPCP_ZIP",
-    "STATE_JSON",
     "TB_DIR",
-    "TORCH_RNG_PT",
     "VERSIONS_JSON",
     "CaseFolder",
     "RunFolder",
@@ -74,21 +68,10 @@ PROGRESS_JSON = "progress.json"
 TB_DIR = "tb"
 """TensorBoard logs."""
 CHECKPOINTS_DIR = "checkpoints"
-"""``step_XXXXXXXXX/`` per candidate and ``latest.json``."""
-LATEST_JSON = "latest.json"
-"""In ``checkpoints/``: names the latest complete checkpoint (written last)."""
+"""``step_XXXXXXXXX/`` per candidate and ``latest.json`` (the checkpoints' own files are
+the trainer's: :mod:`sumo_ayss.training.checkpoint_files`)."""
 MODEL_ZIP = "model.zip"
 """In a checkpoint: the candidate's model."""
-RESUME_MODEL_ZIP = "resume_model.zip"
-"""In the latest checkpoint: the full model for a resume."""
-REPLAY_PKL = "replay.pkl"
-"""In the latest checkpoint: the replay buffer."""
-STATE_JSON = "state.json"
-"""In the latest checkpoint: counters, env state and RNG states."""
-TORCH_RNG_PT = "torch_rng.pt"
-"""In the latest checkpoint: torch's RNG state."""
-RESUME_FILES = (REPLAY_PKL, RESUME_MODEL_ZIP)
-"""Files of a checkpoint that only the latest keeps (what a resume needs beyond model.zip)."""
 
 # -- written by evaluate and the pipeline ------------------------------------------------------
 OUTCOME_CSV = "outcome.csv"
@@ -211,11 +194,6 @@ class RunFolder:
         return self.path / CHECKPOINTS_DIR
 
     @property
-    def latest(self) -> Path:
-        """``checkpoints/latest.json``."""
-        return self.path / CHECKPOINTS_DIR / LATEST_JSON
-
-    @property
     def outcome_csv(self) -> Path:
         """``outcome.csv``."""
         return self.path / OUTCOME_CSV
@@ -248,6 +226,10 @@ class RunFolder:
     def step_dir(self, step: int) -> Path:
         """The checkpoint folder of the candidate at training step ``step``."""
         return self.checkpoints / f"step_{step:09d}"
+
+    def candidate_model(self, step: int) -> Path:
+        """The model of the candidate at training step ``step``."""
+        return self.step_dir(step) / MODEL_ZIP
 
     def checkpoint_model(self, step_dir: Path) -> str:
         """``checkpoints/step_XXXXXXXXX/model.zip`` relative to the run folder, as written

@@ -17,8 +17,9 @@ file                    writer / reader                   what
 ``report/``             (the report)                      ``report.html``, ``summary.md``
 ======================  ================================  ====================================
 
-Every file is written atomically. The CSV readers return the cells as written (strings):
-a script that writes a file back (``scripts/keep_paper_rows.py``) keeps every digit.
+Every file is written atomically. The CSV files are read by the one CSV reader
+(:func:`~.table.read_table`) with a schema of text columns: the cells as written, so a script
+that writes a file back (``scripts/keep_paper_rows.py``) keeps every digit.
 Imports neither SUMO nor torch.
 """
 
@@ -30,9 +31,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.csvio import read_csv_rows, write_csv_rows
 from sumo_ayss.run_folder.jsonio import json_field, read_json
 from sumo_ayss.run_folder.layout import CaseFolder, case_dir_for
+from sumo_ayss.run_folder.table import read_table, text_schema, write_rows
 from sumo_ayss.util.atomic import atomic_write_json
 from sumo_ayss.util.errors import TableError
 
@@ -210,7 +211,7 @@ def read_pipeline_json(path: Path) -> dict[str, Any]:
 
 def write_ranking_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
     """Write ``ranking.csv`` (:data:`RANKING_COLUMNS`; a missing cell is written empty)."""
-    write_csv_rows(path, RANKING_COLUMNS, rows)
+    write_rows(path, RANKING_COLUMNS, rows)
 
 
 def read_ranking_csv(path: Path) -> list[dict[str, str]]:
@@ -220,15 +221,15 @@ def read_ranking_csv(path: Path) -> list[dict[str, str]]:
 
     Raises:
         TableError: The file is missing or unreadable, lacks a column of
-            :data:`RANKING_COLUMNS` up to ``vs_next``, or has a short row (naming the file
-            and the line).
+            :data:`RANKING_COLUMNS` up to ``vs_next`` or has one of none, or has a row of
+            the wrong length (naming the file and the row).
     """
-    return read_csv_rows(path, RANKING_COLUMNS, optional=_RANKING_ADDED)
+    return list(read_table(path, text_schema(RANKING_CSV, RANKING_COLUMNS, _RANKING_ADDED)).rows())
 
 
 def write_measures_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
     """Write ``measures.csv`` (:data:`MEASURES_COLUMNS`)."""
-    write_csv_rows(path, MEASURES_COLUMNS, rows)
+    write_rows(path, MEASURES_COLUMNS, rows)
 
 
 def read_measures_csv(path: Path) -> list[dict[str, str]]:
@@ -237,7 +238,7 @@ def read_measures_csv(path: Path) -> list[dict[str, str]]:
     Raises:
         TableError: As :func:`read_ranking_csv`, for :data:`MEASURES_COLUMNS`.
     """
-    return read_csv_rows(path, MEASURES_COLUMNS)
+    return list(read_table(path, text_schema(MEASURES_CSV, MEASURES_COLUMNS)).rows())
 
 
 # --------------------------------------------------------------------------- order_check.json

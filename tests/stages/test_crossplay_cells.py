@@ -5,7 +5,7 @@ while every SPCP it recorded for it is still in the pool."""
 from __future__ import annotations
 
 from sumo_ayss.run_folder import CrossplayOpponent, CrossplayRecord, DiagonalCheck
-from sumo_ayss.run_folder.crossplay_cells import merged_rows, plan_cells
+from sumo_ayss.stages.crossplay_cells import merged_rows, plan_cells
 
 A0, B0 = CrossplayOpponent("a", 0, "sa"), CrossplayOpponent("b", 0, "sb")
 

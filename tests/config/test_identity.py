@@ -7,14 +7,15 @@ import dataclasses
 from pathlib import Path
 
 from sumo_ayss.config import ExperimentConfig, SimConfig, integration_method, to_dict
-from sumo_ayss.run_folder import RunConfig, RunFolder, TrainStage, stored_experiment
-from sumo_ayss.run_folder.identity import (
+from sumo_ayss.config.identity import (
     identity_differences,
     is_redefinition,
     run_identity,
     vut_key,
 )
+from sumo_ayss.run_folder import RunConfig, RunFolder, stored_experiment
 from sumo_ayss.run_folder.metadata import write_run_config
+from sumo_ayss.stages import TrainStage
 from sumo_ayss.training.config_check import check_same_config
 from sumo_ayss.vuts.catalog import VehicleType
 

@@ -8,7 +8,7 @@ changes (a VUT added, dropped, redefined or renamed; adaptive seeding's new seed
 cell whose VUT and opponent are unchanged is kept from the recorded table, and only the
 others are driven: a new VUT against every opponent, every new opponent against every VUT.
 
-A VUT is matched by its definition's key (:func:`~sumo_ayss.run_folder.identity.vut_key`,
+A VUT is matched by its definition's key (:func:`~sumo_ayss.config.identity.vut_key`,
 recorded in ``crossplay.json`` as ``vut_keys``), so a renamed VUT keeps its cells under its
 new name; a record written before the keys existed matches a VUT by name, and only while
 every SPCP it recorded for that VUT is still in the pool (a redefined VUT retrains, and so
@@ -29,7 +29,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from sumo_ayss.run_folder.crossplay import CrossplayOpponent, CrossplayRecord, DiagonalCheck
+from sumo_ayss.run_folder import CrossplayOpponent, CrossplayRecord, DiagonalCheck
 
 __all__ = ["CellPlan", "merged_rows", "plan_cells"]
 

@@ -20,7 +20,7 @@ dotted fields:
   display only) enters under :data:`OWN_VUT` (``env.vuts[env.vut].params.minGap``);
 * display options (:data:`DISPLAY_FIELDS`, e.g. the progress bar) are left out.
 
-The training stage's fingerprint (:class:`~sumo_ayss.run_folder.stage.TrainStage`) and the
+The training stage's fingerprint (:class:`~sumo_ayss.stages.contract.TrainStage`) and the
 resume check (:mod:`sumo_ayss.training.config_check`) both read it, from the requested
 experiment and from the stored ``config.yaml`` alike, so run folders written before this
 module (whose ``config.yaml`` holds the whole catalog of their study) keep matching: their
@@ -33,11 +33,11 @@ Imports neither SUMO nor torch.
 
 from __future__ import annotations
 
-import hashlib
-import json
 from typing import Any
 
-from sumo_ayss.config import ExperimentConfig, to_dict
+from sumo_ayss.config.experiment import ExperimentConfig
+from sumo_ayss.config.mapping import to_dict
+from sumo_ayss.util.fingerprint import fingerprint
 from sumo_ayss.vuts.catalog import VehicleType
 
 __all__ = [
@@ -80,10 +80,9 @@ def vut_definition(vt: VehicleType) -> dict[str, Any]:
 
 
 def vut_key(vt: VehicleType) -> str:
-    """16 hex digits of SHA-256 over :func:`vut_definition` (JSON, sorted keys): equal for
+    """:func:`~sumo_ayss.util.fingerprint.fingerprint` of :func:`vut_definition`: equal for
     two names of one vehicle, different for a redefined one."""
-    text = json.dumps(vut_definition(vt), sort_keys=True, default=str)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+    return fingerprint(vut_definition(vt))
 
 
 def run_identity(cfg: ExperimentConfig, seed: int) -> dict[str, Any]:

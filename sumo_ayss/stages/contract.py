@@ -31,26 +31,30 @@ neither SUMO nor torch.
 
 from __future__ import annotations
 
-import hashlib
 import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from sumo_ayss.config import AyssConfig, EnvConfig, ExperimentConfig, experiment_from_dict, to_dict
-from sumo_ayss.run_folder.crossplay import CrossplayRecord, read_crossplay_json
-from sumo_ayss.run_folder.discriminability import read_discriminability_json
-from sumo_ayss.run_folder.identity import DISPLAY_FIELDS, flat_config, run_identity
-from sumo_ayss.run_folder.jsonio import read_json
-from sumo_ayss.run_folder.layout import CaseFolder, RunFolder
-from sumo_ayss.run_folder.metadata import read_run_config
-from sumo_ayss.run_folder.summaries import read_ayss_json, read_outcome_json
-from sumo_ayss.util.atomic import atomic_write_json
-from sumo_ayss.util.errors import CheckpointError, ConfigError, TableError
+from sumo_ayss.config import AyssConfig, EnvConfig, ExperimentConfig, to_dict
+from sumo_ayss.config.identity import run_identity
+from sumo_ayss.run_folder import (
+    CaseFolder,
+    CrossplayRecord,
+    RunFolder,
+    read_ayss_json,
+    read_crossplay_json,
+    read_discriminability_json,
+    read_done_marker,
+    read_outcome_json,
+    stored_experiment,
+    write_done_marker,
+)
+from sumo_ayss.util.errors import TableError
+from sumo_ayss.util.fingerprint import fingerprint
 
 __all__ = [
-    "DISPLAY_FIELDS",
     "AyssStage",
     "CrossplayStage",
     "DiscriminabilityStage",
@@ -59,29 +63,8 @@ __all__ = [
     "Stage",
     "TrainStage",
     "fingerprint",
-    "flat_config",
     "is_done",
-    "read_done_marker",
-    "stored_experiment",
-    "write_done_marker",
 ]
-
-
-def fingerprint(*parts: Any) -> str:
-    """16 hex digits of SHA-256 over ``parts`` in order: a :class:`~pathlib.Path` counts
-    by its file's bytes, anything else by its JSON (sorted keys; ``str()`` of what JSON
-    cannot hold).
-
-    Raises:
-        OSError: A path's file cannot be read.
-    """
-    h = hashlib.sha256()
-    for part in parts:
-        if isinstance(part, Path):
-            h.update(part.read_bytes())
-        else:
-            h.update(json.dumps(part, sort_keys=True, default=str).encode())
-    return h.hexdigest()[:16]
 
 
 class Stage(Protocol):
@@ -118,37 +101,7 @@ def is_done(stage: Stage) -> bool:
     return all(p.is_file() for p in stage.outputs) and stage.recorded() == stage.key()
 
 
-def write_done_marker(path: Path, key: str) -> None:
-    """Write a stand-alone done marker (``evaluate.done.json``): ``{"inputs": key}``."""
-    atomic_write_json(path, {"inputs": key})
-
-
-def read_done_marker(path: Path) -> str | None:
-    """The fingerprint a stand-alone done marker records; None when the file is missing.
-
-    Raises:
-        CheckpointError: The file exists but is unreadable or not a JSON object.
-    """
-    if not path.is_file():
-        return None
-    inputs = read_json(path, error=CheckpointError).get("inputs")
-    return inputs if isinstance(inputs, str) else None
-
-
 # --------------------------------------------------------------------------- train
-
-
-def stored_experiment(folder: RunFolder) -> tuple[ExperimentConfig, int]:
-    """The experiment and seed a run folder's ``config.yaml`` records.
-
-    Raises:
-        CheckpointError: If the file is missing or unreadable, naming it.
-    """
-    stored = read_run_config(folder.config)
-    try:
-        return experiment_from_dict(stored.experiment, folder.path), stored.seed
-    except ConfigError as e:
-        raise CheckpointError(f"{folder.config}: unreadable run configuration ({e})") from e
 
 
 @dataclass(frozen=True)
@@ -157,7 +110,7 @@ class TrainStage:
 
     Its marker is ``config.yaml`` (written when the run starts: the inputs themselves) with
     ``spcp.json`` (written last). Both sides are read as the run's identity
-    (:func:`~sumo_ayss.run_folder.identity.run_identity`: its own VUT's definition, not the
+    (:func:`~sumo_ayss.config.identity.run_identity`: its own VUT's definition, not the
     study's catalog nor the VUT's name): a run whose identity differs is not done, and may
     not be resumed either (:func:`sumo_ayss.training.config_check.
     check_same_config` names the fields).

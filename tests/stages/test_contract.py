@@ -13,26 +13,28 @@ from sumo_ayss import discriminability as disc
 from sumo_ayss.analysis.discriminability import BoxGrid
 from sumo_ayss.config import AyssConfig, EnvConfig, ExperimentConfig, TrainConfig, load_pipeline
 from sumo_ayss.run_folder import (
-    AyssStage,
     CaseFolder,
     CrossplayOpponent,
     CrossplayRecord,
-    CrossplayStage,
     DiagonalCheck,
-    DiscriminabilityStage,
-    EvaluateStage,
-    OutcomeStage,
     RunFolder,
     StageHeader,
     StudyFolder,
-    TrainStage,
-    fingerprint,
-    is_done,
     read_crossplay_json,
     read_done_marker,
     write_ayss_json,
     write_crossplay_json,
     write_outcome_json,
+)
+from sumo_ayss.stages import (
+    AyssStage,
+    CrossplayStage,
+    DiscriminabilityStage,
+    EvaluateStage,
+    OutcomeStage,
+    TrainStage,
+    fingerprint,
+    is_done,
 )
 from sumo_ayss.training.run_metadata import write_metadata
 from sumo_ayss.util.errors import CheckpointError, TableError
