@@ -23,8 +23,9 @@ sys.path.insert(0, str(ROOT))
 
 from tests import test_layers as layers  # noqa: E402  (after the path is set)
 
-#: Stages whose imports of the report the issue counts (plus every script).
-REPORT_FREE = ("sumo_ayss.pipeline", "sumo_ayss.rank", "sumo_ayss.crossplay", "sumo_ayss.grid")
+#: Stages whose imports of the report the issue counts (plus every script): the layer test's
+#: (which holds them to rendered documents only, and scripts to none).
+REPORT_FREE = layers.REPORT_FREE
 #: CaseAnalysis fields that belong to one mode (by prefix, or named).
 MODE_PREFIXES = ("exposure_", "crossplay_", "paper_")
 MODE_FIELDS = {"indices", "ranking", "pairs", "premise", "crossplay", "outcomes", "references"}
@@ -53,21 +54,6 @@ def _class_fields(path: Path, name: str) -> list[tuple[str, str]]:
                 if isinstance(s, ast.AnnAssign) and isinstance(s.target, ast.Name)
             ]
     return []
-
-
-def _script_report_imports(scripts: Path) -> list[str]:
-    found = []
-    for path in sorted(scripts.glob("*.py")):
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if isinstance(node, ast.ImportFrom) and _within(node.module or "", "sumo_ayss.report"):
-                found.append(f"scripts/{path.name}: {node.module}")
-            elif isinstance(node, ast.Import):
-                found += [
-                    f"scripts/{path.name}: {a.name}"
-                    for a in node.names
-                    if _within(a.name, "sumo_ayss.report")
-                ]
-    return found
 
 
 def measure(root: Path) -> dict[str, object]:
@@ -109,7 +95,7 @@ def measure(root: Path) -> dict[str, object]:
         "edges config -> modes": edges("config", "modes"),
         "edges run_folder -> analysis": edges("run_folder", "analysis"),
         "report imports from pipeline/rank/crossplay/grid (modules)": len(report_edges),
-        "report imports from scripts": len(_script_report_imports(root / "scripts")),
+        "report imports from scripts": len(layers.script_report_imports(root / "scripts")),
         "run_folder lines": sum(run_folder.values()),
         "run_folder exported names": len(_all_names(package / "run_folder" / "__init__.py")),
         "package root modules": " ".join(root_modules),

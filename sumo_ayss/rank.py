@@ -113,8 +113,8 @@ def available_modes(a: CaseAnalysis[RunRecord]) -> list[str]:
 
 def _rows(a: CaseAnalysis[RunRecord], mode: Mode) -> list[dict[str, Any]]:
     """The ``ranking.csv`` rows of one case in one mode, with crashes and mobility where
-    the mode reads outcomes (``CaseAnalysis.outcomes``)."""
-    outcomes = a.outcomes.get(mode.name, {})
+    the mode reads outcomes (:meth:`~sumo_ayss.modes.Mode.outcomes`)."""
+    outcomes = mode.outcomes(a)
     unit = mode.unit(a)
     rows = []
     for s in mode.standings(a):
@@ -290,7 +290,7 @@ def _tie_labels(
 
 def _crash_cell(row: dict[str, Any]) -> str:
     """The crash rate of a ``ranking.csv`` row as the report writes it; "" in paper mode."""
-    from sumo_ayss.report.sections.common import crash_text
+    from sumo_ayss.modes.formatting import crash_text
 
     if row["crashes"] == "":
         return ""
@@ -299,7 +299,7 @@ def _crash_cell(row: dict[str, Any]) -> str:
 
 def _mobility_cell(row: dict[str, Any]) -> str:
     """The mobility of a ``ranking.csv`` row as the report writes it; "" in paper mode."""
-    from sumo_ayss.report.sections.common import mobility_text
+    from sumo_ayss.modes.formatting import mobility_text
 
     return "" if row["mobility_mps"] == "" else mobility_text(row["mobility_mps"], row["timid"])
 
@@ -308,6 +308,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     import dataclasses
 
     from sumo_ayss.cli import STRICT_HELP, prog
+    from sumo_ayss.modes import input_problems
     from sumo_ayss.pipeline import (
         add_config_flags,
         config_from_args,
@@ -316,7 +317,6 @@ def main(argv: Sequence[str] | None = None) -> None:
         plan_jobs,
         run_pipeline,
     )
-    from sumo_ayss.report.checks import input_problems
 
     parser = argparse.ArgumentParser(
         prog=prog("python -m sumo_ayss.rank"),
@@ -390,7 +390,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         )
     print(f"ranking (every mode): {md} and {csv_path.name}")
     if result is None:  # --no-run
-        from sumo_ayss.report.checks import fewest_seeds, trust_warnings
+        from sumo_ayss.training.trust import fewest_seeds, trust_warnings
 
         for warning in trust_warnings(
             [(str(d), r.training) for d, r in zip(done, runs, strict=True)],

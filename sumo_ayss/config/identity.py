@@ -39,6 +39,7 @@ from sumo_ayss.config.experiment import ExperimentConfig
 from sumo_ayss.config.mapping import to_dict
 from sumo_ayss.util.fingerprint import fingerprint
 from sumo_ayss.vuts.catalog import VehicleType
+from sumo_ayss.vuts.controller_spec import identity_target
 
 __all__ = [
     "DISPLAY_FIELDS",
@@ -74,8 +75,13 @@ def flat_config(data: Any, prefix: str = "") -> dict[str, Any]:
 
 def vut_definition(vt: VehicleType) -> dict[str, Any]:
     """What a VUT is, as plain data: model, parameters and controller (its description
-    aside)."""
+    aside); a registered controller by the form its records were first keyed by
+    (:func:`~sumo_ayss.vuts.controller_spec.identity_target`), so that run folders written
+    before the registered names keep their identity and definition key."""
     data: dict[str, Any] = to_dict(vt)
+    controller = data.get("controller")
+    if isinstance(controller, dict) and isinstance(controller.get("target"), str):
+        controller["target"] = identity_target(controller["target"])
     return {k: v for k, v in data.items() if k not in VUT_DISPLAY_FIELDS}
 
 

@@ -136,3 +136,36 @@ def test_a_committed_reaction_run_is_not_the_same_run_beside_vuts_without_the_op
         cfg, seed, alone, seed
     )
     assert SimConfig().step_method == "auto"
+
+
+def test_committed_configs_naming_a_controller_by_module_path_read_as_its_registered_name() -> None:
+    """Run folders written before the registered controller names store module paths (one,
+    ``sumo_ayss.hwenv_laws``, no longer a module): read back, the target is the registered
+    name; the run is the same run as one asked for now with the catalog entry of today,
+    and the same vehicle as the definition key its study's records stored."""
+    import json
+
+    from sumo_ayss.vuts.catalog import BUILTIN_VUTS
+    from sumo_ayss.vuts.reference_types import OVERBRAKER_VUT
+
+    studies = [
+        ("results/paper_fidelity/car_following", "hwenv_pi1", BUILTIN_VUTS["hwenv_pi1"]),
+        ("results/overbraking/car_following", "overbraker", OVERBRAKER_VUT),
+    ]
+    for case_dir, vut, today in studies:
+        folder = RunFolder(ROOT / case_dir / vut / "seed_0")
+        text = folder.config.read_text(encoding="utf-8")
+        old = {"hwenv_pi1": "sumo_ayss.hwenv_laws:HighwayEnvIDM"}.get(
+            vut, "sumo_ayss.vuts.overbraking:OverBraker"
+        )
+        assert f"target: {old}" in text  # the old-style config, as committed
+        cfg, seed = stored_experiment(folder)
+        stored = cfg.env.vut_type.controller
+        assert stored is not None and ":" not in stored.target  # a registered name
+        assert stored.target == (today.controller.target if today.controller else None)
+        stage = TrainStage(folder, _with_catalog(cfg, {vut: today}), seed)
+        assert stage.key() == stage.recorded(), folder
+        record = ROOT / case_dir / "crossplay.json"
+        keys = json.loads(record.read_text(encoding="utf-8")).get("vut_keys", {})
+        if vut in keys:
+            assert vut_key(today) == vut_key(cfg.env.vut_type) == keys[vut]

@@ -7,14 +7,14 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from sumo_ayss.report.blocks import Block, BulletList, Heading, Paragraph, Table
-from sumo_ayss.report.checks import (
+from sumo_ayss.report.sections.common import display_path, seeds_text
+from sumo_ayss.run_folder import VERSIONS_JSON, RunRecord
+from sumo_ayss.training.trust import (
     NOISE_SE,
     TRUSTED_TIMESTEPS,
     improving_runs,
     training_status,
 )
-from sumo_ayss.report.sections.common import display_path, seeds_text
-from sumo_ayss.run_folder import VERSIONS_JSON, RunRecord
 
 __all__ = ["inputs_blocks", "training_table"]
 

@@ -1,8 +1,8 @@
-"""Checks that keep a report from misleading: training budget, SPCP still improving, mixed runs.
+"""Whether a study's training can be trusted: training budget, seeds, SPCP still improving.
 
-They read the run records (:class:`~sumo_ayss.run_folder.RunRecord`: each run's
-:class:`~sumo_ayss.run_folder.Training`, from ``config.yaml``, ``eval.csv`` and
-``spcp.json``) and the analyses; no file.
+They read each run's :class:`~sumo_ayss.run_folder.Training` (from ``config.yaml``,
+``eval.csv`` and ``spcp.json``, read with the run record); no file. The report writes them
+at its top, the pipeline and ``rank`` print them on the terminal.
 
 - :func:`training_status` — the state of a run's learning curve at the end (its
   :class:`~sumo_ayss.run_folder.Training`, read with the run): the SPCP is the last
@@ -15,27 +15,17 @@ They read the run records (:class:`~sumo_ayss.run_folder.RunRecord`: each run's
   :mod:`sumo_ayss.config.budget` covers the protocol), or SPCPs may still be improving at
   such a budget; :func:`budget_note` — at a validated budget, what was validated and what
   was not, once.
-- :func:`input_problems` — the missing, unreadable or empty input files of analysed cases,
-  one console line each naming the file (``report`` and ``rank`` print them; ``--strict``
-  makes them an error).
 
 Imports neither SUMO nor torch.
 """
 
 from __future__ import annotations
 
-import contextlib
-import os
 from collections import Counter
 from collections.abc import Iterable, Sequence
-from typing import TYPE_CHECKING
 
 from sumo_ayss.config.budget import BUDGETS, Budget
 from sumo_ayss.run_folder import Training
-
-if TYPE_CHECKING:
-    from sumo_ayss.analysis.case import CaseAnalysis
-    from sumo_ayss.run_folder import RunRecord
 
 TRUSTED_TIMESTEPS = min(b.total_timesteps for b in BUDGETS.values())
 """Training transitions per run below which verdicts are flagged as not to be trusted: the
@@ -175,27 +165,3 @@ def budget_note(runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None)
 def improving_runs(runs: Sequence[tuple[str, Training]]) -> list[str]:
     """The labels of the runs whose SPCP is the last candidate of their training."""
     return [label for label, t in runs if t.still_improving]
-
-
-def input_problems(analyses: Sequence[CaseAnalysis[RunRecord]]) -> list[str]:
-    """The problems of the analysed cases' input files, one console line each.
-
-    They are the lines of the report's "Missing or incomplete data" callouts
-    (:attr:`~sumo_ayss.analysis.case.CaseAnalysis.problems`), each naming its file: a run's
-    problem starts with the file's name (``eval.csv missing``) and is joined to the run
-    folder's path; a case's own problem (an unreadable cross-play table, which names its
-    file) is prefixed with the case.
-    """
-    from sumo_ayss.analysis.case import run_label
-
-    lines = []
-    for a in analyses:
-        own = list(a.problems)
-        for members in a.runs.values():
-            for run in members:
-                for problem in run.problems:
-                    lines.append(f"{run.path}{os.sep}{problem}")
-                    with contextlib.suppress(ValueError):
-                        own.remove(f"{run_label(run)}: {problem}")
-        lines += [p if p.startswith(os.sep) else f"{a.case}: {p}" for p in own]
-    return lines
