@@ -33,3 +33,4 @@ paper_study configs/paper_fidelity.yaml results/paper_fidelity
 paper_study configs/fidelity_ablation/sumo_vut.yaml results/fidelity_ablation/sumo_vut
 paper_study configs/fidelity_ablation/clipped_pov.yaml results/fidelity_ablation/clipped_pov
 rank configs/overbraking.yaml --out results/overbraking  # issue 33
+rank configs/ladders/braking_lead_and_cut_in.yaml --out results/ladders/braking_lead_and_cut_in_a  # issue 39

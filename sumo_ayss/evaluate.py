@@ -54,6 +54,7 @@ from sumo_ayss.scenarios.outcome import (
     DEFAULT_OUTCOME_SEED,
     OutcomeResult,
     run_outcome,
+    supporting_pov_summary,
 )
 from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
 from sumo_ayss.scenarios.rollout import Policy
@@ -117,6 +118,12 @@ def _outcome_stage(
     return run_outcome(env, policy, n=n, seed=seed, progress=progress)
 
 
+def _per_pov(result: OutcomeResult) -> dict[str, Any] | None:
+    """``outcome.json``'s sections of a case with a second POV (issue 39), else None."""
+    support = supporting_pov_summary(result.episodes)
+    return None if support is None else {"supporting_pov": support}
+
+
 def _write_outcome(
     run: RunRecord, result: OutcomeResult, n: int, seed: int, reference: str | None
 ) -> None:
@@ -151,6 +158,7 @@ def _write_outcome(
         to_dict(run.experiment.env.odd),
         result.summary.as_dict(),
         result.wall_s,
+        _per_pov(result),
     )
     s = result.summary
     logger.info(

@@ -174,6 +174,7 @@ def write_outcome_json(
     odd: Mapping[str, Any],
     summary: Mapping[str, Any],
     wall_s: float,
+    extra: Mapping[str, Any] | None = None,
 ) -> None:
     """Write ``outcome.json``.
 
@@ -184,6 +185,7 @@ def write_outcome_json(
         odd: The run's ODD (``to_dict(EnvConfig.odd)``).
         summary: ``OutcomeSummary.as_dict()``.
         wall_s: Wall time of the rollouts, s.
+        extra: Further sections of a case (e.g. ``supporting_pov``); None: none.
     """
     record = {
         **header.as_dict("outcome"),
@@ -191,6 +193,7 @@ def write_outcome_json(
         "odd": dict(odd),
         "summary": dict(summary),
         "wall_s": round(wall_s, 3),
+        **(extra or {}),
     }
     write_json(path, record)
 

@@ -72,6 +72,7 @@ __all__ = [
     "INDICATOR_DELTA_V_BAR",
     "AyssResult",
     "CutInStepResult",
+    "ayss_rows_table",
     "car_following_indicator",
     "car_following_rows",
     "cut_in_mask",
@@ -345,7 +346,7 @@ def _action_counts(actions: IntArray) -> dict[str, int]:
     return {str(int(v)): int(c) for v, c in zip(values, counts, strict=True)}
 
 
-def _rows(
+def ayss_rows_table(
     sample: IntArray,
     obs: npt.NDArray[np.float32],
     actions: IntArray,
@@ -356,6 +357,9 @@ def _rows(
     h_after: FloatArray,
     dvb_before: FloatArray,
 ) -> Table:
+    """The ``ayss.csv`` table of kept samples (indices ``sample`` into the draws; ``obs``,
+    ``actions``, ... one entry per kept sample); ``same_lane`` is the observation's 4th
+    column in cut-in, else 1."""
     n = len(sample)
     same_lane = obs[:, 3].astype(np.int64) if obs.shape[1] == 4 else np.ones(n, dtype=np.int64)
     return Table(
@@ -405,7 +409,7 @@ def car_following_rows(
         kept_obs[:, 0].astype(np.float64), actions, env.config.actuator
     )
     nan = np.full(len(critical), np.nan)
-    table = _rows(
+    table = ayss_rows_table(
         critical, kept_obs, actions, target, ttc[critical], INDICATOR_ACCEL, accel, nan, nan
     )
     return table, 0.0
@@ -434,7 +438,7 @@ def cut_in_rows(
         kept_obs[:, 2].astype(np.float64),
         progress=progress,
     )
-    table = _rows(
+    table = ayss_rows_table(
         idx,
         kept_obs,
         actions[keep],
