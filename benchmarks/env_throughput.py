@@ -6,6 +6,7 @@ libsumo calls the scene needs, with no Python env around it: it is the ceiling.
 
     python benchmarks/env_throughput.py [--steps 60000] [--repeats 3]
     python benchmarks/env_throughput.py --follower    # the cost of issue 33's follower
+    python benchmarks/env_throughput.py --cases cut_in lead_and_cut_in  # per case (issue 39)
 
 With ``--follower`` each case runs twice on the outcome stage's path (every reset from a
 given initial condition of a scenario set): without and with the follower behind the VUT.
@@ -68,6 +69,41 @@ def bench_follower(case: str, steps: int, follower: bool) -> float:
     return steps / dt
 
 
+def bench_case(case: str, steps: int) -> dict[str, float]:
+    """Env steps/s of ``case`` on the outcome stage's path (given initial conditions of a
+    scenario set, random actions), with the episodes, crashes and, for a case that labels
+    its crashes online (lead_and_cut_in), the replays and their share of the wall time."""
+    from sumo_ayss.config import EnvConfig
+    from sumo_ayss.envs import make_env
+    from sumo_ayss.envs.odd import sample_initial_conditions
+
+    cfg = EnvConfig(case=case)
+    ics = sample_initial_conditions(cfg.odd, steps + 1, 0)
+    env = make_env(cfg, sumo_seed=0)
+    rng = np.random.default_rng(0)
+    actions = rng.integers(0, env.action_space.n, size=steps)
+    k = episodes = crashes = 0
+    env.reset(options={"initial_condition": ics[k]})
+    t0 = time.perf_counter()
+    for a in actions:
+        _, _, term, trunc, info = env.step(int(a))
+        if term or trunc:
+            episodes += 1
+            crashes += bool(info["collision"])
+            k += 1
+            env.reset(options={"initial_condition": ics[k]})
+    dt = time.perf_counter() - t0
+    replays, replay_s = getattr(env, "replays", 0), getattr(env, "replay_wall_s", 0.0)
+    env.close()
+    return {
+        "steps_per_s": steps / dt,
+        "episodes": episodes,
+        "crashes": crashes,
+        "replays": replays,
+        "replay_share": replay_s / dt,
+    }
+
+
 def bench_raw(steps: int) -> float:
     import libsumo
 
@@ -112,7 +148,23 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=60_000)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--follower", action="store_true", help="the follower's cost")
+    parser.add_argument("--cases", nargs="+", default=None, help="steps/s per case")
     args = parser.parse_args()
+    if args.cases:
+        print(
+            f"{'case':<18}{'steps/s (median)':>18}{'min':>10}{'max':>10}{'episodes':>10}"
+            f"{'crashes':>9}{'replays':>9}{'replay share':>14}"
+        )
+        for case in args.cases:
+            runs = [bench_case(case, args.steps) for _ in range(args.repeats)]
+            rates = [r["steps_per_s"] for r in runs]
+            last = runs[-1]
+            print(
+                f"{case:<18}{statistics.median(rates):>18,.0f}{min(rates):>10,.0f}"
+                f"{max(rates):>10,.0f}{last['episodes']:>10}{last['crashes']:>9}"
+                f"{last['replays']:>9}{statistics.median(r['replay_share'] for r in runs):>14.1%}"
+            )
+        return
     if args.follower:
         print(f"{'case':<16}{'follower':>9}{'steps/s (median)':>18}{'min':>10}{'max':>10}")
         for case in ("car_following", "cut_in"):

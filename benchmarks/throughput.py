@@ -51,7 +51,7 @@ from torch.nn import functional as F
 
 from sumo_ayss.agents import AyssDQN, PrioritizedReplayBuffer
 from sumo_ayss.config import ExperimentConfig, TrainConfig, load_experiment
-from sumo_ayss.train import Trainer, check_device, hparams_for_n_envs
+from sumo_ayss.training.trainer import Trainer, check_device, hparams_for_n_envs
 from sumo_ayss.util.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parent.parent

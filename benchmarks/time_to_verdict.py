@@ -35,7 +35,8 @@ from pathlib import Path
 import yaml
 
 from sumo_ayss.config.budget import BUDGETS
-from sumo_ayss.run_folder import OrderCheck, StudyFolder, read_adaptive, read_order_check
+from sumo_ayss.run_folder import OrderCheck, StudyFolder, read_adaptive
+from sumo_ayss.run_folder.study import read_order_check
 from sumo_ayss.util.atomic import atomic_write_text
 from sumo_ayss.util.paths import PROJECT_ROOT
 

@@ -41,7 +41,7 @@ from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.envs.vec_env import PairVecEnv
-from sumo_ayss.train import hparams_for_n_envs
+from sumo_ayss.training.trainer import hparams_for_n_envs
 
 #: Random actions are drawn ahead of the timed loop, in blocks of about this many transitions.
 _BLOCK = 4096

@@ -23,8 +23,9 @@ sys.path.insert(0, str(ROOT))
 
 from tests import test_layers as layers  # noqa: E402  (after the path is set)
 
-#: Stages whose imports of the report the issue counts (plus every script).
-REPORT_FREE = ("sumo_ayss.pipeline", "sumo_ayss.rank", "sumo_ayss.crossplay", "sumo_ayss.grid")
+#: Stages whose imports of the report the issue counts (plus every script): the layer test's
+#: (which holds them to rendered documents only, and scripts to none).
+REPORT_FREE = layers.REPORT_FREE
 #: CaseAnalysis fields that belong to one mode (by prefix, or named).
 MODE_PREFIXES = ("exposure_", "crossplay_", "paper_")
 MODE_FIELDS = {"indices", "ranking", "pairs", "premise", "crossplay", "outcomes", "references"}
@@ -55,18 +56,16 @@ def _class_fields(path: Path, name: str) -> list[tuple[str, str]]:
     return []
 
 
-def _script_report_imports(scripts: Path) -> list[str]:
-    found = []
-    for path in sorted(scripts.glob("*.py")):
+def _names_used_from(package: Path, prefix: str) -> set[str]:
+    """Distinct names that modules outside ``prefix`` import from it (any of its modules)."""
+    found = set()
+    for path in package.rglob("*.py"):
+        module = ".".join(path.relative_to(package.parent).with_suffix("").parts)
+        if _within(module.removesuffix(".__init__"), prefix):
+            continue
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if isinstance(node, ast.ImportFrom) and _within(node.module or "", "sumo_ayss.report"):
-                found.append(f"scripts/{path.name}: {node.module}")
-            elif isinstance(node, ast.Import):
-                found += [
-                    f"scripts/{path.name}: {a.name}"
-                    for a in node.names
-                    if _within(a.name, "sumo_ayss.report")
-                ]
+            if isinstance(node, ast.ImportFrom) and _within(node.module or "", prefix):
+                found |= {f"{node.module}.{a.name}".rsplit(".", 1)[-1] for a in node.names}
     return found
 
 
@@ -109,9 +108,12 @@ def measure(root: Path) -> dict[str, object]:
         "edges config -> modes": edges("config", "modes"),
         "edges run_folder -> analysis": edges("run_folder", "analysis"),
         "report imports from pipeline/rank/crossplay/grid (modules)": len(report_edges),
-        "report imports from scripts": len(_script_report_imports(root / "scripts")),
+        "report imports from scripts": len(layers.script_report_imports(root / "scripts")),
         "run_folder lines": sum(run_folder.values()),
         "run_folder exported names": len(_all_names(package / "run_folder" / "__init__.py")),
+        "run_folder names imported by the rest of the package": len(
+            _names_used_from(package, "sumo_ayss.run_folder")
+        ),
         "package root modules": " ".join(root_modules),
         "train.py lines": lines.get("sumo_ayss.train", 0),
         "CaseAnalysis fields": len(fields),

@@ -16,7 +16,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from sumo_ayss.run_folder import StudyFolder, read_ranking_csv
+from sumo_ayss.run_folder import StudyFolder
+from sumo_ayss.run_folder.study import read_ranking_csv
 from sumo_ayss.util.atomic import atomic_write_text
 
 MODES = ("crossplay", "exposure", "paper")

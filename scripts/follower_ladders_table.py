@@ -15,7 +15,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from sumo_ayss.run_folder import StudyFolder, read_order_check, read_ranking_csv
+from sumo_ayss.run_folder.study import StudyFolder, read_order_check, read_ranking_csv
 
 MODE = "crossplay"
 

@@ -128,9 +128,9 @@ def committed_ladders() -> list[dict]:
     from sumo_ayss.analysis.crossplay import rank_crossplay
     from sumo_ayss.analysis.crossplay_scoring import score_crossplay
     from sumo_ayss.analysis.harm import harm_scale_of
-    from sumo_ayss.run_folder import read_ranking_csv
     from sumo_ayss.run_folder.crossplay import read_crossplay_table
     from sumo_ayss.run_folder.record import read_run
+    from sumo_ayss.run_folder.study import read_ranking_csv
 
     rows = []
     for path in sorted((PROJECT_ROOT / "results").rglob("crossplay.csv")):

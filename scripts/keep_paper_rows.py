@@ -14,7 +14,8 @@ import sys
 from pathlib import Path
 
 from sumo_ayss.rank import write_ranking
-from sumo_ayss.run_folder import StudyFolder, read_order_check, read_ranking_csv
+from sumo_ayss.run_folder import StudyFolder
+from sumo_ayss.run_folder.study import read_order_check, read_ranking_csv
 
 
 def main(study: Path, previous: Path) -> None:

@@ -31,14 +31,9 @@ from matplotlib.figure import Figure
 
 from sumo_ayss.analysis.crossplay_scoring import crossplay_input
 from sumo_ayss.analysis.harm import run_episodes
-from sumo_ayss.run_folder import (
-    StudyFolder,
-    group_runs,
-    load_crossplay,
-    read_order_check,
-    read_ranking_csv,
-    read_run,
-)
+from sumo_ayss.run_folder import StudyFolder, group_runs, read_run
+from sumo_ayss.run_folder.crossplay import load_crossplay
+from sumo_ayss.run_folder.study import read_order_check, read_ranking_csv
 from sumo_ayss.util.atomic import atomic_write_text
 
 

@@ -22,7 +22,9 @@ import numpy as np
 
 from sumo_ayss.analysis.crossplay_scoring import crossplay_input
 from sumo_ayss.analysis.stats import student_t_sf
-from sumo_ayss.run_folder import StudyFolder, group_runs, load_crossplay, read_order_check, read_run
+from sumo_ayss.run_folder import StudyFolder, group_runs, read_run
+from sumo_ayss.run_folder.crossplay import load_crossplay
+from sumo_ayss.run_folder.study import read_order_check
 
 NS = (3, 4, 5, 6, 8, 10)
 REPS = 4000

@@ -40,3 +40,4 @@ for study in braking reaction acc_time_gap min_gap; do
       --out "results/follower_ladders/$study"
   fi
 done
+rank configs/ladders/braking_lead_and_cut_in.yaml --out results/ladders/braking_lead_and_cut_in_a  # issue 39

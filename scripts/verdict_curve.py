@@ -72,15 +72,8 @@ import numpy as np
 from sumo_ayss.analysis.crossplay import crossplay_matrix, rank_crossplay
 from sumo_ayss.analysis.harm import episode_harm, harm_scale_of
 from sumo_ayss.analysis.seeds import kendall_tau
-from sumo_ayss.run_folder import (
-    MODEL_ZIP,
-    RunFolder,
-    RunRecord,
-    StudyFolder,
-    read_eval_rows,
-    read_order_check,
-    read_run,
-)
+from sumo_ayss.run_folder import RunFolder, RunRecord, StudyFolder, read_eval_table, read_run
+from sumo_ayss.run_folder.study import read_order_check
 from sumo_ayss.util.atomic import atomic_write_text
 from sumo_ayss.util.paths import PROJECT_ROOT, portable_path
 
@@ -109,7 +102,7 @@ def spcp_steps(run: RunRecord, budget_step: int = BUDGET_STEP) -> dict[int, int]
     from sumo_ayss.training.selection import select_spcp
 
     criterion = run.experiment.train.selection
-    rows = read_eval_rows(run.folder.eval_table)[0]
+    rows = read_eval_table(run.folder.eval_table)
     last = int(max(r["step"] for r in rows))
     out = {}
     for budget in range(budget_step, last + 1, budget_step):
@@ -193,7 +186,7 @@ def cells(out: Path, studies: Sequence[Path], budget_step: int = BUDGET_STEP) ->
                 try:
                     key = (run.experiment.env.vut, run.config_seed, step)
                     if key not in policies:
-                        ckpt = run.folder.step_dir(step) / MODEL_ZIP
+                        ckpt = run.folder.candidate_model(step)
                         policies = {
                             key: load_greedy_policy(
                                 ckpt,
@@ -608,7 +601,7 @@ def early_stop(
         for key, r in runs.items():
             run = read_run(PROJECT_ROOT / r["run_dir"])
             score = CRITERIA[run.experiment.train.selection]
-            rows = read_eval_rows(run.folder.eval_table)[0]
+            rows = read_eval_table(run.folder.eval_table)
             curves[key] = (
                 [int(x["step"]) for x in rows],
                 [score(x) for x in rows],

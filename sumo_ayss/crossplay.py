@@ -13,7 +13,7 @@ outcome scenarios (``evaluate.n_outcome`` of the outcome seed) and writes, per c
   (:class:`~sumo_ayss.run_folder.CrossplayRecord`). A rerun with the same settings, VUTs and
   SPCPs skips the case (the stage contract, :class:`~sumo_ayss.run_folder.CrossplayStage`);
   a study that added, dropped, redefined or renamed a VUT, or added seeds, drives only the
-  cells it does not hold yet (:mod:`sumo_ayss.run_folder.crossplay_cells`).
+  cells it does not hold yet (:mod:`sumo_ayss.stages.crossplay_cells`).
 
 A stage interrupted mid-case resumes from the cells it finished (each kept in
 ``<case>/crossplay.partial/`` until the table is written: :class:`~sumo_ayss.run_folder.CellStore`).
@@ -41,6 +41,7 @@ from typing import Any
 from sumo_ayss.analysis.crossplay import BLOCKS
 from sumo_ayss.analysis.crossplay_scoring import case_matrix
 from sumo_ayss.cli import prog
+from sumo_ayss.config.identity import vut_key
 from sumo_ayss.run_folder import (
     CROSSPLAY_SCHEMA,
     OUTCOME_SCHEMA,
@@ -48,26 +49,21 @@ from sumo_ayss.run_folder import (
     CellStore,
     CrossplayOpponent,
     CrossplayRecord,
-    CrossplayStage,
-    RunFolder,
     RunRecord,
+    StudyFolder,
     Table,
-    case_dir_for,
     case_of,
-    is_done,
     read_crossplay_json,
     read_inevitable,
     read_outcome_json,
     read_run,
     read_table,
-    run_dir_for,
     table_from_rows,
     write_crossplay_json,
     write_inevitable,
     write_table,
 )
-from sumo_ayss.run_folder.crossplay_cells import CellPlan, merged_rows, plan_cells
-from sumo_ayss.run_folder.identity import vut_key
+from sumo_ayss.stages import CellPlan, CrossplayStage, is_done, merged_rows, plan_cells
 from sumo_ayss.util.errors import AyssError, CheckpointError, TableError
 from sumo_ayss.vuts.catalog import controller_imports
 from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
@@ -86,7 +82,7 @@ def case_runs(out: Path, case: str, vuts: Sequence[str], seeds: Sequence[int]) -
     Raises:
         CheckpointError: If a run folder has no ``spcp.zip`` (its job did not finish).
     """
-    folders = [RunFolder(run_dir_for(out, case, v, s)) for v in vuts for s in seeds]
+    folders = [StudyFolder(out).run(case, v, s) for v in vuts for s in seeds]
     missing = [str(f.path) for f in folders if not f.spcp_zip.is_file()]
     if missing:
         raise CheckpointError(
@@ -113,7 +109,7 @@ def run_case(
     Skipped when the stage is done with these settings and SPCPs
     (:class:`~sumo_ayss.run_folder.CrossplayStage`), unless ``force``. Otherwise only the
     cells (VUT × opponent) that the case's recorded table does not hold are driven (a VUT
-    added, redefined or renamed; new opponents: :func:`~sumo_ayss.run_folder.crossplay_cells.
+    added, redefined or renamed; new opponents: :func:`~sumo_ayss.stages.crossplay_cells.
     plan_cells`), the rest kept; the written table equals a full run's. After the rollouts,
     every SPCP's episodes against its own VUT are compared with its run's ``outcome.csv``
     (:func:`~sumo_ayss.scenarios.crossplay.diagonal_check`); the result goes into
@@ -355,7 +351,7 @@ def _record(folder: CaseFolder) -> CrossplayRecord | None:
 
 def _reusable(folder: CaseFolder, requested: CrossplayRecord) -> CellPlan | None:
     """The cells of the case's recorded cross-play that ``requested`` keeps
-    (:func:`~sumo_ayss.run_folder.crossplay_cells.plan_cells`), or None when there is no
+    (:func:`~sumo_ayss.stages.crossplay_cells.plan_cells`), or None when there is no
     usable record (none, unreadable, other scenarios or rollout, no diagonal check)."""
     if not (folder.crossplay_csv.is_file() and folder.crossplay_json.is_file()):
         return None
@@ -448,7 +444,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             runs = case_runs(Path(cfg.out), case, cfg.grid.vuts, seeds)
             run_case(
                 runs,
-                case_dir_for(cfg.out, case),
+                StudyFolder(cfg.out).case(case).path,
                 n=cfg.evaluate.n_outcome,
                 seed=DEFAULT_OUTCOME_SEED,
                 force=args.force,

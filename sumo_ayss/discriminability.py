@@ -49,13 +49,8 @@ from sumo_ayss.config import (
     load_pipeline,
     read_yaml,
 )
-from sumo_ayss.run_folder import (
-    CaseFolder,
-    DiscriminabilityStage,
-    is_done,
-    read_discriminability_json,
-    write_discriminability,
-)
+from sumo_ayss.run_folder import CaseFolder, read_discriminability_json, write_discriminability
+from sumo_ayss.stages import DiscriminabilityStage, is_done
 from sumo_ayss.util.errors import AyssError, ConfigError
 
 logger = logging.getLogger(__name__)

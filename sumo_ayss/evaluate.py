@@ -41,11 +41,8 @@ from sumo_ayss.envs import make_env
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.grid.threads import set_torch_threads
 from sumo_ayss.run_folder import (
-    AyssStage,
-    OutcomeStage,
     RunRecord,
     StageHeader,
-    is_done,
     read_run,
     write_ayss_json,
     write_outcome_json,
@@ -57,9 +54,11 @@ from sumo_ayss.scenarios.outcome import (
     DEFAULT_OUTCOME_SEED,
     OutcomeResult,
     run_outcome,
+    supporting_pov_summary,
 )
 from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
 from sumo_ayss.scenarios.rollout import Policy
+from sumo_ayss.stages import AyssStage, OutcomeStage, is_done
 from sumo_ayss.util.errors import AyssError
 from sumo_ayss.util.paths import portable_path
 from sumo_ayss.vuts.catalog import controller_imports
@@ -119,6 +118,12 @@ def _outcome_stage(
     return run_outcome(env, policy, n=n, seed=seed, progress=progress)
 
 
+def _per_pov(result: OutcomeResult) -> dict[str, Any] | None:
+    """``outcome.json``'s sections of a case with a second POV (issue 39), else None."""
+    support = supporting_pov_summary(result.episodes)
+    return None if support is None else {"supporting_pov": support}
+
+
 def _write_outcome(
     run: RunRecord, result: OutcomeResult, n: int, seed: int, reference: str | None
 ) -> None:
@@ -153,6 +158,7 @@ def _write_outcome(
         to_dict(run.experiment.env.odd),
         result.summary.as_dict(),
         result.wall_s,
+        _per_pov(result),
     )
     s = result.summary
     logger.info(

@@ -159,7 +159,7 @@ def final_messages(result: PipelineResult) -> list[str]:
     ]
     done = [s for s in result.statuses if s.state == "done"]
     if done:
-        from sumo_ayss.report.checks import fewest_seeds, trust_warnings
+        from sumo_ayss.training.trust import fewest_seeds, trust_warnings
 
         training = {r.path: r.training for r in result.runs}
         runs = [(s.spec.name, training[Path(s.spec.run_dir).resolve()]) for s in done]
@@ -463,7 +463,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         print(leaderboard_text(result.analyses))
     for line in final_messages(result):
         print(line)
-    from sumo_ayss.report.checks import input_problems
+    from sumo_ayss.modes import input_problems
 
     problems = input_problems(result.analyses)
     for line in problems:

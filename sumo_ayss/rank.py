@@ -52,9 +52,9 @@ from sumo_ayss.modes import (
 )
 from sumo_ayss.modes.formatting import fmt_num
 from sumo_ayss.run_folder import (
-    OUTCOME_JSON,
     OrderCheck,
     OrderChecks,
+    RunFolder,
     RunRecord,
     StudyFolder,
     case_runs,
@@ -114,8 +114,8 @@ def available_modes(a: CaseAnalysis[RunRecord]) -> list[str]:
 
 def _rows(a: CaseAnalysis[RunRecord], mode: Mode) -> list[dict[str, Any]]:
     """The ``ranking.csv`` rows of one case in one mode, with crashes and mobility where
-    the mode reads outcomes (``CaseAnalysis.outcomes``)."""
-    outcomes = a.outcomes.get(mode.name, {})
+    the mode reads outcomes (:meth:`~sumo_ayss.modes.Mode.outcomes`)."""
+    outcomes = mode.outcomes(a)
     unit = mode.unit(a)
     rows = []
     for s in mode.standings(a):
@@ -311,7 +311,7 @@ def _tie_labels(
 
 def _crash_cell(row: dict[str, Any]) -> str:
     """The crash rate of a ``ranking.csv`` row as the report writes it; "" in paper mode."""
-    from sumo_ayss.report.sections.common import crash_text
+    from sumo_ayss.modes.formatting import crash_text
 
     if row["crashes"] == "":
         return ""
@@ -320,7 +320,7 @@ def _crash_cell(row: dict[str, Any]) -> str:
 
 def _mobility_cell(row: dict[str, Any]) -> str:
     """The mobility of a ``ranking.csv`` row as the report writes it; "" in paper mode."""
-    from sumo_ayss.report.sections.common import mobility_text
+    from sumo_ayss.modes.formatting import mobility_text
 
     return "" if row["mobility_mps"] == "" else mobility_text(row["mobility_mps"], row["timid"])
 
@@ -348,6 +348,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     import dataclasses
 
     from sumo_ayss.cli import STRICT_HELP, prog
+    from sumo_ayss.modes import input_problems
     from sumo_ayss.pipeline import (
         add_config_flags,
         config_from_args,
@@ -356,7 +357,6 @@ def main(argv: Sequence[str] | None = None) -> None:
         plan_jobs,
         run_pipeline,
     )
-    from sumo_ayss.report.checks import input_problems
 
     parser = argparse.ArgumentParser(
         prog=prog("python -m sumo_ayss.rank"),
@@ -376,7 +376,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument(
         "--no-run",
         action="store_true",
-        help=f"rank the grid's existing run folders (with {OUTCOME_JSON}) without running jobs "
+        help=f"rank the grid's existing run folders (with {RunFolder.outcome_json.name}) without "
+        "running jobs "
         "or cross-play (cross-play rows appear where <out>/<case>/crossplay.csv exists)",
     )
     parser.add_argument("--no-live", action="store_true", help="no live table (log lines)")
@@ -430,7 +431,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         )
     print(f"ranking (every mode): {md} and {csv_path.name}")
     if result is None:  # --no-run
-        from sumo_ayss.report.checks import fewest_seeds, trust_warnings
+        from sumo_ayss.training.trust import fewest_seeds, trust_warnings
 
         for warning in trust_warnings(
             [(str(d), r.training) for d, r in zip(done, runs, strict=True)],

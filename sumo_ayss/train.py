@@ -20,7 +20,7 @@ from typing import Any
 
 from sumo_ayss.cli import prog
 from sumo_ayss.config import load_experiment
-from sumo_ayss.run_folder import run_dir_for
+from sumo_ayss.run_folder import StudyFolder
 from sumo_ayss.training.trainer import train
 from sumo_ayss.util.errors import AyssError
 
@@ -78,7 +78,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         if args.device is not None:
             overrides["device"] = args.device
         cfg = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, **overrides))
-        run_dir = run_dir_for(args.out, cfg.env.case, cfg.env.vut, args.seed)
+        run_dir = StudyFolder(args.out).run(cfg.env.case, cfg.env.vut, args.seed).path
         run_dir = train(cfg, args.seed, args.out, resume=args.resume, argv=argv)
     except AyssError as e:
         sys.exit(f"error: {e}")

@@ -726,9 +726,14 @@ RESUME_CORRUPTIONS: list[tuple[str, str, Corruption, str]] = [
         "text in eval.csv",
         "eval.csv",
         lambda p: p.write_text(p.read_text().replace(",2,", ",two,", 1)),
-        "column 'n_episodes' must be a number, got 'two'",
+        "eval.csv: column 'n_episodes', row 0: expected int, got 'two'",
     ),
-    ("eval.csv not a table", "eval.csv", lambda p: p.write_text("hello\n1\n"), "not an eval table"),
+    (
+        "eval.csv not a table",
+        "eval.csv",
+        lambda p: p.write_text("hello\n1\n"),
+        "eval.csv: missing column(s) ['step'",
+    ),
 ]
 
 

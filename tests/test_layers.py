@@ -55,6 +55,20 @@ NO_IMPORTS = (
     ("sumo_ayss.analysis", "sumo_ayss.run_folder"),
     ("sumo_ayss.run_folder", "sumo_ayss.analysis"),
 )
+#: The stages whose imports of the report are counted (issue 34: data flows one way, the
+#: report is the end of it): what they take from it may only shrink.
+REPORT_FREE = ("sumo_ayss.pipeline", "sumo_ayss.rank", "sumo_ayss.crossplay", "sumo_ayss.grid")
+#: What of the report they still take: rendered study documents only (the report the
+#: pipeline writes at its end, the terminal leaderboard, ranking.md's reference-driver lines,
+#: measures.csv); helpers, checks and formatting live below the report.
+REPORT_DOCUMENTS = (
+    "sumo_ayss.report",
+    "sumo_ayss.report.document",
+    "sumo_ayss.report.leaderboard",
+    "sumo_ayss.report.measures",
+    "sumo_ayss.report.sections",
+    "sumo_ayss.report.sections.reference",
+)
 #: Packages whose ``__init__`` is a docstring: importing one of their modules runs nothing
 #: else of them (checked below), so the package edge itself carries no import.
 PACKAGES_WITHOUT_CODE = frozenset({"sumo_ayss.util"})
@@ -245,6 +259,47 @@ def test_layers_that_must_not_import_each_other() -> None:
         if _within(a, (low,)) and _within(b, (high,))
     )
     assert found == []
+
+
+def report_imports(modules: dict[str, Path]) -> list[tuple[str, str]]:
+    """The import edges (any level) from :data:`REPORT_FREE` into the report."""
+    top, lazy = import_edges(modules)
+    return sorted(
+        (a, b)
+        for a, b in top | lazy
+        if _within(a, REPORT_FREE) and _within(b, ("sumo_ayss.report",))
+    )
+
+
+def test_the_stages_take_only_rendered_documents_from_the_report() -> None:
+    edges = report_imports(module_files())
+    assert [(a, b) for a, b in edges if b not in REPORT_DOCUMENTS] == []
+
+
+def script_report_imports(scripts: Path) -> list[str]:
+    """``scripts/<name>.py: <module>`` for every import of the report by a script."""
+    found = []
+    for path in sorted(scripts.glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = (
+                [node.module or ""]
+                if isinstance(node, ast.ImportFrom)
+                else [a.name for a in node.names]
+                if isinstance(node, ast.Import)
+                else []
+            )
+            found += [
+                f"scripts/{path.name}: {n}" for n in names if _within(n, ("sumo_ayss.report",))
+            ]
+    return found
+
+
+def test_no_script_imports_the_report(tmp_path: Path) -> None:
+    """A script that needs a report's figure or document runs a report entry point
+    (``python -m sumo_ayss.report...``)."""
+    assert script_report_imports(ROOT.parent / "scripts") == []
+    (tmp_path / "draw.py").write_text("from sumo_ayss.report.figures import reward_shapes_figure\n")
+    assert script_report_imports(tmp_path) == ["scripts/draw.py: sumo_ayss.report.figures"]
 
 
 def test_packages_counted_as_without_code_hold_only_a_docstring() -> None:

@@ -10,8 +10,10 @@ import yaml
 
 from sumo_ayss.config import PROJECT_ROOT
 from sumo_ayss.config.report import ReportOptions
+from sumo_ayss.modes.paper import paper_result
 from sumo_ayss.rank import analyse, main, order_check, ranking_rows, write_ranking
-from sumo_ayss.run_folder import read_order_check, read_ranking_csv, read_run
+from sumo_ayss.run_folder import read_run
+from sumo_ayss.run_folder.study import read_order_check, read_ranking_csv
 from tests.report.test_report import EXPOSURE, OFFSET, make_crossplay, make_run
 
 
@@ -166,7 +168,7 @@ def test_paper_rows_only_in_paper_mode_even_from_the_pipelines_analyses(tmp_path
     dirs = _three_vuts(tmp_path, monkeypatch)
     options = ReportOptions(mode="exposure", n_boot=200)
     full = analyse_cases(case_runs([read_run(d) for d in dirs]), options)  # paper mode computed
-    assert full[0].ranking
+    assert paper_result(full[0]).ranking
     assert ranking_rows(full) == ranking_rows(analyse(dirs, options))
     assert {r["mode"] for r in ranking_rows(full)} == {"exposure"}
 
@@ -242,7 +244,7 @@ def test_ranking_files_show_hazards_only_where_recorded(tmp_path: Path) -> None:
     where a study recorded them (a follower); a study without keeps its columns exactly."""
     from sumo_ayss.analysis.harm import VutOutcome
     from sumo_ayss.rank import _hazard_cells
-    from sumo_ayss.run_folder import RANKING_COLUMNS, RANKING_HAZARD_COLUMNS
+    from sumo_ayss.run_folder.study import RANKING_COLUMNS, RANKING_HAZARD_COLUMNS
 
     def row(rank: int, vut: str, o: VutOutcome | None) -> dict:
         cells = {c: "" for c in RANKING_COLUMNS}

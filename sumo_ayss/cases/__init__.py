@@ -36,6 +36,7 @@ from __future__ import annotations
 # The built-in cases, registered in import order (reports list cases in registry order).
 from sumo_ayss.cases.car_following import CAR_FOLLOWING
 from sumo_ayss.cases.cut_in import CUT_IN
+from sumo_ayss.cases.lead_and_cut_in import LEAD_AND_CUT_IN
 from sumo_ayss.cases.registry import (
     BASE_OBSERVATION,
     OUTCOME_COLUMNS,
@@ -46,6 +47,7 @@ from sumo_ayss.cases.registry import (
     case_info,
     case_names,
     case_of_indicator,
+    default_grid_cases,
     get_case,
     indicator_columns,
     register_case,
@@ -61,6 +63,7 @@ __all__ = [
     "CAR_FOLLOWING",
     "CUT_IN",
     "DEFAULT_CASE",
+    "LEAD_AND_CUT_IN",
     "OUTCOME_COLUMNS",
     "ROAD_EDGE",
     "Case",
@@ -69,6 +72,7 @@ __all__ = [
     "case_info",
     "case_names",
     "case_of_indicator",
+    "default_grid_cases",
     "get_case",
     "indicator_columns",
     "register_case",

@@ -26,6 +26,7 @@ __all__ = [
     "case_info",
     "case_names",
     "case_of_indicator",
+    "default_grid_cases",
     "get_case",
     "indicator_columns",
     "register_case",
@@ -141,6 +142,11 @@ class Case:
             case (results/ladders); otherwise the caution every exposure verdict carries.
         one_decision_note: Said by the discriminability section when responses were
             measured over one decision; empty: nothing to say.
+        vec_env: The env can run as a member of a
+            :class:`~sumo_ayss.envs.vec_env.PairVecEnv` (several pairs in one simulation);
+            False: ``train.n_envs`` must be 1 (the configuration refuses more).
+        default_grid: A pipeline whose ``grid`` names no cases runs this one
+            (:func:`default_grid_cases`); False: only where a grid names it.
     """
 
     name: str
@@ -164,6 +170,8 @@ class Case:
     paper_rows: tuple[PaperRow, ...] = ()
     exposure_caution: str = ""
     one_decision_note: str = ""
+    vec_env: bool = True
+    default_grid: bool = True
 
     def __post_init__(self) -> None:
         where = f"case {self.name!r}"
@@ -261,6 +269,11 @@ def case_names() -> tuple[str, ...]:
 def registered_cases() -> tuple[Case, ...]:
     """The registered cases, in registration order."""
     return _REGISTRY.records()
+
+
+def default_grid_cases() -> tuple[str, ...]:
+    """The cases of a pipeline grid that names none, in registration order."""
+    return tuple(c.name for c in _REGISTRY if c.default_grid)
 
 
 def case_info(name: str) -> Case:

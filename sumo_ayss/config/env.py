@@ -80,7 +80,7 @@ class SimConfig:
     ``MSVehicleType.cpp``: a type whose action step differs from the step switches the whole
     simulation to ballistic "to avoid collisions"), so runs written before this option keep
     their numbers; the testbed now passes the resolved method explicitly, and a run's
-    identity records it (:mod:`sumo_ayss.run_folder.identity`): a catalog holding one VUT
+    identity records it (:mod:`sumo_ayss.config.identity`): a catalog holding one VUT
     with a longer action step moves *every* vehicle of its studies ballistically."""
 
     def __post_init__(self) -> None:

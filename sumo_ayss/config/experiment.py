@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from sumo_ayss.agents.hparams import DQNHyperParams
+from sumo_ayss.cases import case_info
 from sumo_ayss.config.env import EnvConfig
 from sumo_ayss.config.mapping import build, to_dict
 from sumo_ayss.config.yaml_io import read_yaml
@@ -107,6 +108,11 @@ class ExperimentConfig:
             a.learning_starts < t.total_timesteps,
             f"agent.learning_starts ({a.learning_starts}) must be < train.total_timesteps "
             f"({t.total_timesteps}): otherwise the run never learns",
+        )
+        require(
+            t.n_envs == 1 or case_info(self.env.case).vec_env,
+            f"train.n_envs must be 1 for case {self.env.case!r} (its env cannot share a "
+            f"simulation with other pairs), got {t.n_envs}",
         )
 
     def with_vut(self, vut: str | None) -> ExperimentConfig:

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
-from sumo_ayss.cases import case_names
+from sumo_ayss.cases import case_names, default_grid_cases
 from sumo_ayss.config.ayss import AyssConfig
 from sumo_ayss.config.budget import BUDGETS, DEFAULT_BUDGET
 from sumo_ayss.config.env import PROJECT_ROOT, Case
@@ -36,8 +36,9 @@ class GridConfig:
 
     SECTION: ClassVar[str] = "grid"
 
-    cases: tuple[Case, ...] = field(default_factory=case_names)
-    """Registered cases (:mod:`sumo_ayss.cases`); default: all of them."""
+    cases: tuple[Case, ...] = field(default_factory=default_grid_cases)
+    """Registered cases (:mod:`sumo_ayss.cases`); default: those of the default grid (the
+    paper's two and any registered with ``default_grid``)."""
     vuts: tuple[str, ...] = ("pi1", "pi2")
     seeds: tuple[int, ...] | None = None
     """Training seeds, each run by every VUT; None (the default): the pipeline's budget

@@ -44,6 +44,7 @@ class CarFollowingEnv(PairEnv):
     OBS_LOW: ClassVar[tuple[float, ...]] = (0.0, 0.0, HEADWAY_LOW_M)
     OBS_HIGH: ClassVar[tuple[float, ...]] = (SPEED_HIGH_MPS, SPEED_HIGH_MPS, HEADWAY_HIGH_M)
     N_ACTIONS: ClassVar[int] = N_ACTIONS
+    ICS_STRATEGIES: ClassVar[dict[str, tuple[int, ...]]] = {"brake": (0,)}
 
     def _placement(self, ic: InitialCondition) -> PairPlacement:
         pov_front = VUT_START_POS_M + ic.gap_m + self._pov_length_m

@@ -172,6 +172,10 @@ class CutInEnv(PairEnv):
     OBS_HIGH: ClassVar[tuple[float, ...]] = (SPEED_HIGH_MPS, SPEED_HIGH_MPS, HEADWAY_HIGH_M, 1.0)
     N_ACTIONS: ClassVar[int] = N_ACTIONS
     IC_GAP_MIN_M: ClassVar[float] = HEADWAY_LOW_M  # side by side: the POV's rear behind
+    ICS_STRATEGIES: ClassVar[dict[str, tuple[int, ...]]] = {
+        "cut in, brake": (LANE_CHANGE, FIRST_SPEED_ACTION),
+        "cut in, hold speed": (LANE_CHANGE,),
+    }
 
     def __init__(
         self,

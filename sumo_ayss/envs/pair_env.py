@@ -121,6 +121,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
     N_ACTIONS: ClassVar[int]
     #: Smallest gap [m] a given initial condition may ask for (cut-in: side by side, < 0).
     IC_GAP_MIN_M: ClassVar[float] = 0.0
+    ICS_STRATEGIES: ClassVar[dict[str, tuple[int, ...]]]  # worst POV plays: scenarios/inevitable
 
     def __init__(
         self,
@@ -164,6 +165,11 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         self.initial_condition: InitialCondition | None = None
 
     # ------------------------------------------------------------------ case hooks
+
+    @classmethod
+    def ayss_start(cls, sample: InitialCondition) -> InitialCondition:
+        """The start of an AYSS sample's scenario (a case may fix more of the state)."""
+        return sample
 
     @abstractmethod
     def _placement(self, ic: InitialCondition) -> PairPlacement: ...
@@ -456,7 +462,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         cfg = self.config
         if self.sumo_seed is None:  # never seeded: fresh entropy, not the env's RNG
             self.sumo_seed = sumo_seed_of(int(np.random.SeedSequence().entropy))  # type: ignore[arg-type]
-        vtypes = session_vtypes(cfg)
+        vtypes = self._session_vtypes()
         network = cfg.network if cfg.network is not None else network_path(cfg.case)
         session = SumoSession(
             network, vtypes, cfg.sim, self.sumo_seed, owner=f"{type(self).__name__}({cfg.vut})"
@@ -473,6 +479,10 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             follower_type="follower" if cfg.follower.enabled else None,
         )
         return self._pair
+
+    def _session_vtypes(self) -> dict[str, VehicleType]:
+        """The vehicle types the env's simulation loads (a case may load more)."""
+        return session_vtypes(self.config)
 
     @staticmethod
     def _check_road(cfg: EnvConfig) -> None:

@@ -24,19 +24,18 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from sumo_ayss.config import PipelineConfig
+from sumo_ayss.config.identity import vut_key
 from sumo_ayss.grid.jobs import JobSpec
 from sumo_ayss.grid.progress import JobStatus
 from sumo_ayss.run_folder import (
     AdaptiveLook,
     AdaptiveRecord,
-    CaseFolder,
     RunRecord,
-    case_dir_for,
+    StudyFolder,
     find_run_dirs,
     read_adaptive,
     write_adaptive,
 )
-from sumo_ayss.run_folder.identity import vut_key
 from sumo_ayss.util.errors import AyssError
 
 if TYPE_CHECKING:
@@ -91,7 +90,7 @@ def stale_record(cfg: PipelineConfig, case: str) -> str | None:
     VUTs), as a sentence; None when there is no such record."""
     if not is_adaptive(cfg):
         return None
-    path = CaseFolder(case_dir_for(cfg.out, case)).adaptive_json
+    path = StudyFolder(cfg.out).case(case).adaptive_json
     try:
         record = read_adaptive(path) if path.is_file() else None
     except AyssError:
@@ -114,7 +113,7 @@ def read_record(cfg: PipelineConfig, case: str) -> AdaptiveRecord | None:
     """The case's record if it belongs to this configuration's schedule and VUTs, else None
     (no record, an unreadable one, one made with other seeds, cap or level, or a stale one:
     of other VUTs, :func:`stale_record`)."""
-    path = CaseFolder(case_dir_for(cfg.out, case)).adaptive_json
+    path = StudyFolder(cfg.out).case(case).adaptive_json
     if not path.is_file():
         return None
     try:
@@ -206,7 +205,7 @@ def run_adaptive(
         for case, record in grow:
             seed = cfg.added_seeds[len(record.seeds) - len(cfg.seeds)]
             # The record names the seed before its jobs start: a kill resumes with it.
-            path = CaseFolder(case_dir_for(cfg.out, case)).adaptive_json
+            path = StudyFolder(cfg.out).case(case).adaptive_json
             write_adaptive(path, dataclasses.replace(record, seeds=(*record.seeds, seed)))
             logger.info("adaptive seeding, %s: adding seed %d for every VUT", case, seed)
             new_jobs += plan(cfg, case, seed)
@@ -238,7 +237,7 @@ def _record_look(cfg: PipelineConfig, case: str, look: SettleCheck) -> AdaptiveR
     stored = AdaptiveLook(**dataclasses.asdict(look))
     looks = (*tuple(x for x in record.looks if x.n_seeds < look.n_seeds), stored)
     record = dataclasses.replace(record, looks=looks, vuts=grid_vuts(cfg, case))
-    write_adaptive(CaseFolder(case_dir_for(cfg.out, case)).adaptive_json, record)
+    write_adaptive(StudyFolder(cfg.out).case(case).adaptive_json, record)
     return record
 
 

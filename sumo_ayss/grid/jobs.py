@@ -15,15 +15,8 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.config import AyssConfig, ExperimentConfig
-from sumo_ayss.run_folder import (
-    EvaluateStage,
-    RunFolder,
-    TrainStage,
-    is_done,
-    read_run,
-    run_dir_for,
-    write_progress,
-)
+from sumo_ayss.run_folder import RunFolder, StudyFolder, read_run, write_progress
+from sumo_ayss.stages import EvaluateStage, TrainStage, is_done
 from sumo_ayss.util.errors import ControllerError, DiskFullError
 from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
 
@@ -71,7 +64,7 @@ class JobSpec:
 
     @property
     def run_dir(self) -> Path:
-        return run_dir_for(self.out, self.case, self.vut, self.seed)
+        return StudyFolder(Path(self.out)).run(self.case, self.vut, self.seed).path
 
     @property
     def folder(self) -> RunFolder:

@@ -26,7 +26,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
-from sumo_ayss.run_folder import RunFolder, read_eval_rows, read_latest, read_progress
+from sumo_ayss.run_folder import RunFolder, read_eval_table, read_progress
+from sumo_ayss.training.checkpoint_files import LATEST_JSON, read_latest
 from sumo_ayss.util.errors import CheckpointError
 
 STATES = ("queued", "running", "done", "failed", "interrupted", "cancelled")
@@ -99,7 +100,7 @@ def _finished_steps(folder: RunFolder, total: int) -> int:
     if folder.spcp_json.is_file():
         return total
     try:
-        return read_latest(folder.latest)[0]
+        return read_latest(folder.checkpoints / LATEST_JSON)[0]
     except CheckpointError:  # missing (no checkpoint yet) or being replaced
         return 0
 
@@ -107,7 +108,7 @@ def _finished_steps(folder: RunFolder, total: int) -> int:
 def _candidates(folder: RunFolder) -> list[tuple[int, str]]:
     """(step, mean evaluation reward to 2 decimals) of each SPCP candidate in ``eval.csv``."""
     try:
-        rows = read_eval_rows(folder.eval_table, skip_bad_rows=True)[0]
+        rows = read_eval_table(folder.eval_table, skip_bad_rows=True)
     except CheckpointError:
         return []
     return [(int(row["step"]), f"{row['mean_return']:.2f}") for row in rows]

@@ -3,7 +3,7 @@ reused, redefined VUTs' old runs set aside, and two names for one vehicle flagge
 
 A leaderboard grows in place: the same pipeline YAML and ``out:`` folder with a VUT added,
 dropped, redefined or renamed. Each run is identified by what made it
-(:mod:`sumo_ayss.run_folder.identity`: its own VUT's definition, case, seed, budget, agent
+(:mod:`sumo_ayss.config.identity`: its own VUT's definition, case, seed, budget, agent
 and env settings), so the runs of unchanged VUTs are skipped as done. Before any job,
 :func:`prepare_out` looks at the folder once:
 
@@ -35,16 +35,21 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from sumo_ayss.config import ExperimentConfig, PipelineConfig
-from sumo_ayss.grid.jobs import JobSpec
-from sumo_ayss.run_folder import RunConfig, RunFolder, read_run_config, write_run_config
-from sumo_ayss.run_folder.identity import (
+from sumo_ayss.config.identity import (
     OWN_VUT,
     identity_differences,
     is_redefinition,
     vut_key,
 )
+from sumo_ayss.grid.jobs import JobSpec
+from sumo_ayss.run_folder import (
+    RunConfig,
+    RunFolder,
+    read_run_config,
+    stored_experiment,
+    write_run_config,
+)
 from sumo_ayss.run_folder.jsonio import write_json
-from sumo_ayss.run_folder.stage import stored_experiment
 from sumo_ayss.util.errors import AyssError, ConfigError
 
 __all__ = [

@@ -69,10 +69,11 @@ __all__ = [
 HIGHWAY_ENV_VERSION = "1.8.2"
 
 #: The controller ``target`` of :class:`HighwayEnvIDM` (the catalog's ``hwenv_pi1`` /
-#: ``hwenv_pi2``): the module path it had at the package root, kept as its registered name
-#: because run folders' ``config.yaml`` store it;
-#: :data:`~sumo_ayss.vuts.controller_spec.TARGET_ALIASES` resolves it to this module.
-HIGHWAY_ENV_IDM_TARGET = "sumo_ayss.hwenv_laws:HighwayEnvIDM"
+#: ``hwenv_pi2``): its registered name
+#: (:data:`~sumo_ayss.vuts.controller_spec.CONTROLLERS`); run folders written before store
+#: the module path it had at the package root, ``sumo_ayss.hwenv_laws:HighwayEnvIDM``, which
+#: :data:`~sumo_ayss.vuts.controller_spec.TARGET_ALIASES` reads as this name.
+HIGHWAY_ENV_IDM_TARGET = "highway_env_idm"
 
 
 # ------------------------------------------------------------------ POV (ControlledVehicle)

@@ -28,7 +28,7 @@ below (rows of the modes follow in registry order).
 from __future__ import annotations
 
 # The built-in modes, registered in import order (ranking rows follow it).
-from sumo_ayss.modes.analyse import analyse_case, analyse_cases
+from sumo_ayss.modes.analyse import analyse_case, analyse_cases, input_problems
 from sumo_ayss.modes.crossplay import CROSSPLAY
 from sumo_ayss.modes.exposure import EXPOSURE
 from sumo_ayss.modes.paper import PAPER
@@ -61,6 +61,7 @@ __all__ = [
     "check_mode",
     "get_mode",
     "headline_text",
+    "input_problems",
     "missing_rows_line",
     "mode_names",
     "register_mode",

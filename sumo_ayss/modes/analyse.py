@@ -1,10 +1,13 @@
-"""A case's analysis with the verdict of the mode asked for (the analysis computes every
-mode's data; the mode gives the verdict, :attr:`~sumo_ayss.modes.registry.Mode.verdict`)."""
+"""A case's analysis: its data (:func:`sumo_ayss.analysis.case.analyse_case`), every
+registered mode's own result (:meth:`~sumo_ayss.modes.registry.Mode.compute`) and the
+verdict of the mode asked for (:meth:`~sumo_ayss.modes.registry.Mode.verdict`)."""
 
 from __future__ import annotations
 
+import contextlib
+import os
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 from sumo_ayss.modes.registry import get_mode, registered_modes
 
@@ -13,7 +16,7 @@ if TYPE_CHECKING:
     from sumo_ayss.analysis.crossplay import CrossplayInput
     from sumo_ayss.analysis.crossplay_scoring import CrossplayTablesLike
 
-__all__ = ["CaseInput", "analyse_case", "analyse_cases"]
+__all__ = ["CaseInput", "analyse_case", "analyse_cases", "input_problems"]
 
 R = TypeVar("R", bound="RunLike")
 
@@ -40,9 +43,13 @@ def analyse_case(
     crossplay: CrossplayInput | None = None,
     paper: bool = True,
 ) -> CaseAnalysis[R]:
-    """:func:`sumo_ayss.analysis.case.analyse_case` (same arguments), then every registered
-    mode's own result (:meth:`~sumo_ayss.modes.registry.Mode.compute`, in ``results``), and
-    the ``verdict`` given by the mode ``options.mode``.
+    """:func:`sumo_ayss.analysis.case.analyse_case` (same arguments: the case's data), then
+    every registered mode's own result in registry order
+    (:meth:`~sumo_ayss.modes.registry.Mode.compute`, in ``results``; the built-in modes'
+    :class:`~sumo_ayss.modes.crossplay.CrossplayResult`,
+    :class:`~sumo_ayss.modes.exposure.ExposureResult`,
+    :class:`~sumo_ayss.modes.paper.PaperResult`), and the ``verdict`` given by the mode
+    ``options.mode``.
 
     Raises:
         ConfigError: If ``options.mode`` is not a registered mode.
@@ -78,3 +85,28 @@ def analyse_cases(
         )
         for c in cases
     ]
+
+
+def input_problems(analyses: Sequence[CaseAnalysis[Any]]) -> list[str]:
+    """The problems of the analysed cases' input files, one console line each (the report,
+    ``rank`` and the pipeline print them; ``--strict`` makes them an error).
+
+    They are the lines of the report's "Missing or incomplete data" callouts
+    (:attr:`~sumo_ayss.analysis.case.CaseAnalysis.problems`), each naming its file: a run's
+    problem starts with the file's name (``eval.csv missing``) and is joined to the run
+    folder's path (its ``path``); a case's own problem (an unreadable cross-play table, which
+    names its file) is prefixed with the case.
+    """
+    from sumo_ayss.analysis.case import run_label
+
+    lines = []
+    for a in analyses:
+        own = list(a.problems)
+        for members in a.runs.values():
+            for run in members:
+                for problem in run.problems:
+                    lines.append(f"{run.path}{os.sep}{problem}")
+                    with contextlib.suppress(ValueError):
+                        own.remove(f"{run_label(run)}: {problem}")
+        lines += [p if p.startswith(os.sep) else f"{a.case}: {p}" for p in own]
+    return lines

@@ -12,11 +12,13 @@ from collections.abc import Sequence
 
 __all__ = [
     "MINUS",
+    "crash_text",
     "fmt_interval",
     "fmt_num",
     "fmt_p",
     "fmt_p_family",
     "fmt_prob",
+    "mobility_text",
     "rank_labels",
     "ranking_line",
     "seed_interval_text",
@@ -169,3 +171,16 @@ def rank_labels(significant_next: Sequence[bool]) -> list[str]:
         for i in g:
             labels[i] = text
     return labels
+
+
+def crash_text(crashes: int, episodes: int, lo: float, hi: float) -> str:
+    """``"11.6 % (10.2–13.2 %), 209/1800"``: a crash rate with its interval (fractions)."""
+    rate = crashes / episodes
+    return f"{100 * rate:.1f} % ({100 * lo:.1f}–{100 * hi:.1f} %), {crashes}/{episodes}"
+
+
+def mobility_text(mps: float, timid: bool) -> str:
+    """``"21.3 m/s"``, ``"4.2 m/s (TIMID)"`` or "not recorded" (NaN)."""
+    if not math.isfinite(mps):
+        return "not recorded"
+    return f"{mps:.1f} m/s" + (" (TIMID)" if timid else "")

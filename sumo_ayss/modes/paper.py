@@ -2,24 +2,29 @@
 adversarial-yet-safe states, condensed into a safety index over headway bins
 (:mod:`sumo_ayss.analysis.safety_index`; hierarchical bootstrap, the slow part).
 
-Its verdict is computed for every report (``CaseAnalysis.paper_verdict``); a ranking
-in this mode lists it only when it was asked for. The mode words its verdicts here: a
-pairwise verdict (:func:`verdict_sentence`), one under the report's significance rule
-(:func:`pair_sentence`, the rule itself: :func:`significance_rule`) and the headline.
+Its result (:class:`PaperResult`, :func:`compute_paper`: the safety indices, their
+ranking and pairwise verdicts, the premise check and the verdict) is computed for every
+report; a ranking in this mode lists it only when it was asked for. The mode words its
+verdicts here: a pairwise verdict (:func:`verdict_sentence`), one under the report's
+significance rule (:func:`pair_sentence`, the rule itself: :func:`significance_rule`) and
+the headline.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p
-from sumo_ayss.modes.registry import Mode, Standing, register_mode
+from sumo_ayss.modes.registry import Mode, Standing, mode_result, register_mode
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
     from sumo_ayss.analysis.case_verdict import CaseVerdict
+    from sumo_ayss.analysis.premise import Premise
+    from sumo_ayss.analysis.ranking import RankedVut, SafetyIndex
     from sumo_ayss.analysis.significance import PairVerdict, SignificanceOptions
     from sumo_ayss.analysis.verdict import Verdict
 
@@ -27,9 +32,12 @@ __all__ = [
     "MIN_SEEDS_FOR_INTERVAL",
     "PAPER",
     "PaperMode",
+    "PaperResult",
+    "compute_paper",
     "diff_interval",
     "pair_sentence",
     "paper_headline",
+    "paper_result",
     "significance_rule",
     "verdict_sentence",
 ]
@@ -46,6 +54,92 @@ _CONFOUNDED = (
     " Confounded: the SPCPs did not reach the same overall outcome (premise check), "
     "so this aggressiveness comparison does not isolate the VUTs' safety."
 )
+
+
+@dataclass(frozen=True)
+class PaperResult:
+    """The paper mode's result for one case.
+
+    Attributes:
+        verdict: The paper mode's verdict (also when another mode was asked for).
+        indices: ``{vut: safety index}`` for VUTs with AYSS samples (empty when the
+            analysis drew no bootstrap, :attr:`~sumo_ayss.analysis.case.CaseAnalysis.bootstrap`).
+        ranking: VUTs safest first (point estimate).
+        pairs: Verdicts of every pair, in ranking order (A ranked above B).
+        premise: Whether the SPCPs reached the same overall outcome (the premise of reading
+            their aggressiveness), or None.
+    """
+
+    verdict: CaseVerdict
+    indices: dict[str, SafetyIndex] = field(default_factory=dict)
+    ranking: list[RankedVut] = field(default_factory=list)
+    pairs: list[PairVerdict] = field(default_factory=list)
+    premise: Premise | None = None
+
+
+def compute_paper(a: CaseAnalysis[Any], name: str = "paper") -> PaperResult:
+    """Safety index per VUT from its runs' AYSS samples (the hierarchical bootstrap, when
+    ``a.bootstrap``), their ranking and pairwise verdicts under
+    :func:`~sumo_ayss.analysis.significance.pair_verdict` (Holm over the adjacent pairs), the
+    premise check over the runs' outcome summaries, and the verdict; a VUT without a safety
+    index and a pair that is not comparable get a line in ``a.problems``."""
+    from sumo_ayss.analysis.case import bootstrap_rng, vut_safety_index
+    from sumo_ayss.analysis.case_verdict import paper_verdict
+    from sumo_ayss.analysis.premise import premise_check
+    from sumo_ayss.analysis.ranking import rank
+    from sumo_ayss.analysis.significance import family_adjusted, pair_verdict
+    from sumo_ayss.util.errors import ConfigError
+
+    options = a.options
+    indices = {}
+    for vut, members in a.runs.items() if a.bootstrap else ():
+        idx = vut_safety_index(members, options, bootstrap_rng(options, a.case, vut))
+        if idx is not None:
+            indices[vut] = idx
+        else:
+            a.problems.append(
+                f"{vut}: no AYSS sample with h in [0, {options.h_max_m:g}] m, so no safety index"
+            )
+    ranking = rank(indices, level=options.level) if indices else []
+    order = [r.name for r in ranking]
+    pairs = []
+    for i, first in enumerate(order):
+        for second in order[i + 1 :]:
+            try:
+                pairs.append(
+                    pair_verdict(
+                        indices[first],
+                        indices[second],
+                        name_a=first,
+                        name_b=second,
+                        indicator=a.info.indicator,
+                        level=options.level,
+                        welch_alpha=options.welch_alpha,
+                    )
+                )
+            except ConfigError as exc:
+                a.problems.append(f"{first} vs {second}: not comparable ({exc})")
+    pairs = family_adjusted(pairs, order)
+    metrics: dict[str, dict[str, list[float]]] = {
+        "mean_return": {},
+        "crash_rate": {},
+        "mean_final_headway_m": {},
+    }
+    for vut, members in a.runs.items():
+        for r in members:
+            if r.outcome is None:
+                continue
+            for key in metrics:
+                metrics[key].setdefault(vut, []).append(getattr(r.outcome, key).value)
+    premise = premise_check(metrics, tolerances=options.premise_tolerances, level=options.level)
+    premise_met = premise is None or not premise.metrics or premise.met
+    verdict = paper_verdict(name, ranking, pairs, premise_met=premise_met)
+    return PaperResult(verdict, indices, ranking, pairs, premise)
+
+
+def paper_result(a: CaseAnalysis[Any], name: str = NAME) -> PaperResult:
+    """The paper result of a case (that of the mode ``name``, built from this record)."""
+    return mode_result(a, name, PaperResult)
 
 
 def _fmt_h_range(h_range: tuple[float, float]) -> str:
@@ -162,7 +256,8 @@ def paper_headline(a: CaseAnalysis[Any], v: CaseVerdict) -> str:
     if isinstance(v.top, PairVerdict):
         text = pair_sentence(v.top)
     elif v.missing == "one_vut":
-        only = a.ranking[0].name if a.ranking else "?"
+        ranking = paper_result(a).ranking
+        only = ranking[0].name if ranking else "?"
         text = f"No verdict yet: only {only} has AYSS samples; a verdict needs two VUTs."
     else:
         text = _NO_VERDICT.get(v.missing, _NO_VERDICT["not_comparable"])
@@ -170,11 +265,11 @@ def paper_headline(a: CaseAnalysis[Any], v: CaseVerdict) -> str:
     return text + _CONFOUNDED if v.caveat == "premise_not_met" else text
 
 
-def _standings(a: CaseAnalysis[Any]) -> list[Standing]:
-    pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
-    order = [r.name for r in a.ranking]
+def _standings(result: PaperResult) -> list[Standing]:
+    pairs = {(p.verdict.name_a, p.verdict.name_b): p for p in result.pairs}
+    order = [r.name for r in result.ranking]
     out = []
-    for i, ranked in enumerate(a.ranking):
+    for i, ranked in enumerate(result.ranking):
         nxt = order[i + 1] if i + 1 < len(order) else None
         pair = pairs.get((ranked.name, nxt)) if nxt else None
         out.append(
@@ -201,9 +296,9 @@ def _standings(a: CaseAnalysis[Any]) -> list[Standing]:
     return out
 
 
-def _ends(a: CaseAnalysis[Any], safest: str, least: str) -> tuple[bool, float]:
+def _ends(result: PaperResult, safest: str, least: str) -> tuple[bool, float]:
     pair = next(
-        (p for p in a.pairs if {p.verdict.name_a, p.verdict.name_b} == {safest, least}),
+        (p for p in result.pairs if {p.verdict.name_a, p.verdict.name_b} == {safest, least}),
         None,
     )
     return pair is not None and pair.safer == safest, math.nan
@@ -217,15 +312,18 @@ def _score_text(a: CaseAnalysis[Any], s: Standing) -> str:
 class PaperMode(Mode):
     """Paper mode: its ranking, verdict and words (see the module docstring)."""
 
+    def compute(self, a: CaseAnalysis[Any]) -> PaperResult:
+        return compute_paper(a, self.name)
+
     def available(self, a: CaseAnalysis[Any]) -> bool:
         # Ranked in paper mode only: the bootstrap is skipped in the other modes.
-        return bool(a.ranking) and a.mode == NAME
+        return bool(paper_result(a, self.name).ranking) and a.mode == NAME
 
     def standings(self, a: CaseAnalysis[Any]) -> list[Standing]:
-        return _standings(a)
+        return _standings(paper_result(a, self.name))
 
     def verdict(self, a: CaseAnalysis[Any]) -> CaseVerdict:
-        return a.paper_verdict  # computed first, for every report
+        return paper_result(a, self.name).verdict  # computed for every report
 
     def headline(self, a: CaseAnalysis[Any], v: CaseVerdict) -> str:
         return paper_headline(a, v)
@@ -234,7 +332,7 @@ class PaperMode(Mode):
         return f"{a.info.indicator.unit} (higher = safer)"
 
     def ends(self, a: CaseAnalysis[Any], safest: str, least: str) -> tuple[bool, float]:
-        return _ends(a, safest, least)
+        return _ends(paper_result(a, self.name), safest, least)
 
     def score_text(self, a: CaseAnalysis[Any], s: Standing) -> str:
         return _score_text(a, s)

@@ -10,15 +10,18 @@ from __future__ import annotations
 import abc
 import math
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
+from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.registry import Registry
 from sumo_ayss.util.validation import check_choice, require
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
     from sumo_ayss.analysis.case_verdict import CaseVerdict
+    from sumo_ayss.analysis.harm import VutOutcome
 
 __all__ = [
     "Mode",
@@ -28,12 +31,15 @@ __all__ = [
     "headline_text",
     "missing_rows_line",
     "mode_names",
+    "mode_result",
     "register_mode",
     "registered_modes",
     "unregister_mode",
 ]
 
 _NAME = re.compile(r"[a-z][a-z0-9_]*")
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -169,10 +175,18 @@ class Mode(abc.ABC):
         return []
 
     def compute(self, a: CaseAnalysis[Any]) -> object | None:
-        """The mode's own result from the case's data, kept in ``a.results[name]`` (by
-        :func:`~sumo_ayss.modes.analyse_case`, before any verdict); None (the default): the
-        mode reads what the analysis computed for every mode."""
+        """The mode's own result from the case's data (its runs, tables and settings), kept
+        in ``a.results[name]`` by :func:`~sumo_ayss.modes.analyse_case` (every registered
+        mode's in registry order, then the verdict: a mode may read an earlier one's result
+        in its methods, :func:`mode_result`); a line per missing or unreadable input goes
+        into ``a.problems``. None (the default): no result of its own."""
         return None
+
+    def outcomes(self, a: CaseAnalysis[Any]) -> Mapping[str, VutOutcome]:
+        """``{vut: crashes, mobility, hazards}`` over the episodes this mode scores, shown
+        beside its score (``ranking.csv``, the leaderboard); empty (the default): it reads
+        no outcomes."""
+        return {}
 
     def section(self, a: CaseAnalysis[Any]) -> tuple[str, list[str]] | None:
         """The report's section of this mode for a case, ``(title, paragraphs)``, after the
@@ -244,6 +258,22 @@ def missing_rows_line(a: CaseAnalysis[Any]) -> str | None:
         f"; the {a.ranking_mode}-mode rows stand in their place" if a.ranking_mode != a.mode else ""
     )
     return f"No {a.mode}-mode rows for {a.case}: {why}{instead}."
+
+
+def mode_result(a: CaseAnalysis[Any], name: str, kind: type[T]) -> T:
+    """The result mode ``name`` computed for the case (``a.results[name]``), of type ``kind``.
+
+    Raises:
+        ConfigError: If the case holds no such result (an analysis not made by
+            :func:`~sumo_ayss.modes.analyse_case`, or by another mode record of that name).
+    """
+    result = a.results.get(name)
+    if not isinstance(result, kind):
+        raise ConfigError(
+            f"case {a.case}: no {name}-mode result of type {kind.__name__} (got "
+            f"{type(result).__name__}; analyse it with sumo_ayss.modes.analyse_case)"
+        )
+    return result
 
 
 def mode_names() -> tuple[str, ...]:

@@ -173,7 +173,9 @@ def seed_score_text(a: CaseAnalysis[Any], s: Standing) -> str:
 
 def paper_verdict_lines(a: CaseAnalysis[Any]) -> list[str]:
     """The paper mode's verdict, closing the callout of a mode that is not the paper's."""
-    v = a.paper_verdict
+    from sumo_ayss.modes.paper import paper_result
+
+    v = paper_result(a).verdict
     line = get_mode(v.mode).headline(a, v)
     if v.order:
         line += f" Ranking ({v.mode} mode): {ranking_line(v.order, v.apart)}."

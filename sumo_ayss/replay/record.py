@@ -30,8 +30,6 @@ from sumo_ayss.replay.playback import (
 )
 from sumo_ayss.replay.source import Kind, initial_condition, load_policy, read_row, select_row
 from sumo_ayss.run_folder import (
-    AYSS_CSV,
-    OUTCOME_CSV,
     RunRecord,
     read_run,
 )
@@ -69,8 +67,13 @@ class ExportResult:
 # --------------------------------------------------------------------------- export
 
 
-def _vehicle_name(vtype: str) -> str:
-    return vtype if vtype in ("pov", "follower") else "vut"
+def _vehicle_name(vtype: str, vehicle: str = "") -> str:
+    """The replay's name of a vehicle: ``vut``, ``pov``, ``follower``; a further POV by its
+    id's tag (``<prefix>.<tag>.<episode>``, e.g. ``pov2``)."""
+    if vtype == "pov":
+        parts = vehicle.split(".")
+        return parts[1] if len(parts) == 3 and parts[1].startswith("pov") else "pov"
+    return vtype if vtype == "follower" else "vut"
 
 
 def _rename(points: Sequence[export.FcdPoint], time_of: dict[float, float]) -> list[Any]:
@@ -78,7 +81,8 @@ def _rename(points: Sequence[export.FcdPoint], time_of: dict[float, float]) -> l
     for p in points:
         t = time_of.get(round(p.time_s, 9))
         if t is not None:
-            out.append(dataclasses.replace(p, time_s=t, vehicle=_vehicle_name(p.vtype)))
+            name = _vehicle_name(p.vtype, p.vehicle)
+            out.append(dataclasses.replace(p, time_s=t, vehicle=name))
     return out
 
 
@@ -131,7 +135,10 @@ def _export(
     with tempfile.TemporaryDirectory(prefix="sumo_ayss_rec_") as tmp:
         recorded = Path(tmp) / "recorded.fcd.xml"
         rec = _record(env_cfg, run.config_seed, ic, pol, limit, recorded)
-        sumo_points = export.read_fcd(recorded)
+        # The episode's vehicles only: an env may simulate others after its last step (the
+        # online preventability replay of lead_and_cut_in after a crash).
+        ids = rec["vehicles"]
+        sumo_points = [p for p in export.read_fcd(recorded) if p.vehicle in ids]
     dt = env_cfg.sim.step_length_s
     # SUMO labels the state after the step starting at T with T; the initial state was
     # read at reset_time (the start of the first step): tau = T + dt - reset_time.
@@ -195,9 +202,10 @@ def _record(
     try:
         obs, info0 = base.reset(options={"initial_condition": ic})
         reset_time = export.simulation_time_s()
+        snapshot = export.snapshot(reset_time)
+        vehicles = {p.vehicle for p in snapshot}
         initial = [
-            dataclasses.replace(p, vehicle=_vehicle_name(p.vtype))
-            for p in export.snapshot(reset_time)
+            dataclasses.replace(p, vehicle=_vehicle_name(p.vtype, p.vehicle)) for p in snapshot
         ]
         insertion = export.insertion_points(initial, 0.0)
         if np.max(np.abs(obs[:3] - np.array(ic.as_tuple()))) > _RESET_TOL:
@@ -228,6 +236,7 @@ def _record(
         "reset_time_s": reset_time,
         "initial": initial,
         "insertion": insertion,
+        "vehicles": vehicles,
         "steps": steps,
         "ttc0": info0["ttc_s"],
     }
@@ -270,7 +279,7 @@ def _info(
     return {
         "source": {
             "run_dir": portable_path(run.path),
-            "table": AYSS_CSV if kind == "ayss" else OUTCOME_CSV,
+            "table": (run.folder.ayss_csv if kind == "ayss" else run.folder.outcome_csv).name,
             "row": index,
             "values": {k: _json_value(v) for k, v in row.items()},
             "spcp_step": run.spcp.step if run.spcp is not None else None,

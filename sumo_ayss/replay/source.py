@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from typing import Any, Literal
 
+from sumo_ayss.cases import get_case
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition, with_follower_at
 from sumo_ayss.run_folder import AYSS_SCHEMA, OUTCOME_SCHEMA, RunFolder, RunRecord, read_table
@@ -70,7 +71,10 @@ def initial_condition(
     start of an outcome row; an outcome row of a ``run`` with a follower (issue 33) gets the
     follower its episode had (scenario index and seed of the outcome stage)."""
     if kind == "ayss":
-        return InitialCondition(row["v_pov_mps"], row["v_vut_mps"], row["h_m"])
+        sample = InitialCondition(row["v_pov_mps"], row["v_vut_mps"], row["h_m"])
+        if run is None:
+            return sample
+        return get_case(run.experiment.env.case).env_class().ayss_start(sample)
     ic = InitialCondition(row["v_pov0_mps"], row["v_vut0_mps"], row["gap0_m"])
     if run is None or not run.experiment.env.follower.enabled:
         return ic

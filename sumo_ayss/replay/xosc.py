@@ -41,7 +41,13 @@ from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.replay.source import initial_condition, load_policy, read_row, select_row
 from sumo_ayss.run_folder import read_run
 from sumo_ayss.scenarios.rollout import Policy
-from sumo_ayss.scenarios.trajectory import body_width_m, follower_of, trajectory_from_infos
+from sumo_ayss.scenarios.trajectory import (
+    SecondPovTrack,
+    body_width_m,
+    follower_of,
+    second_pov_of,
+    trajectory_from_infos,
+)
 from sumo_ayss.sim.network import network_path
 from sumo_ayss.util.atomic import atomic_write_text, atomic_write_with
 from sumo_ayss.util.errors import ConfigError, SimulationError
@@ -171,6 +177,7 @@ def _xosc(
     path: Path,
     description: str,
     follower: tuple[np.ndarray, np.ndarray, float, float] | None = None,
+    pov2: SecondPovTrack | None = None,
 ) -> None:
     from scenariogeneration import xosc
 
@@ -193,6 +200,8 @@ def _xosc(
         fx, fv, f_len, f_wid = follower
         alive = int(np.isfinite(fx).sum())
         bodies["follower"] = (fx[:alive], y_vut[:alive], fv[:alive], f_len, f_wid)
+    if pov2 is not None:  # issue 39: the supporting POV, in the POV's body
+        bodies["pov2"] = (pov2.x_m, pov2.y_m, pov2.speed_mps, tr.pov_length_m, tr.pov_width_m)
     all_times = [float(t) for t in tr.time_s]
     for name, (x_front, y, speed, length, width) in bodies.items():
         times = all_times[: len(x_front)]
@@ -304,7 +313,8 @@ def export_xosc(
         f_type = env_cfg.follower.sumo_type
         f_len = float(f_type.params.get("length", 5.0))
         fol = (track.x_m, track.speed_mps, f_len, body_width_m(f_type))
-    _xosc(tr, road, y_vut, y_pov, out / XOSC_FILE, description, fol)
+    pov2 = second_pov_of(reset_info, infos)
+    _xosc(tr, road, y_vut, y_pov, out / XOSC_FILE, description, fol, pov2)
     collided = bool(infos[-1]["collision"])
     reproduced: dict[str, bool]
     if kind == "ayss":
@@ -328,6 +338,7 @@ def export_xosc(
         "bodies_m": {
             "ego": [tr.vut_length_m, body_width_m(env_cfg.vut_type)],
             "pov": [tr.pov_length_m, body_width_m(env_cfg.pov)],
+            **({"pov2": [tr.pov_length_m, body_width_m(env_cfg.pov)]} if pov2 else {}),
         },
         "axle_overhang_m": OVERHANG_M,
         "files": {"scenario": XOSC_FILE, "road": XODR_FILE},

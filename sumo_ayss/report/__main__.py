@@ -19,8 +19,7 @@ from pathlib import Path
 
 from sumo_ayss.cli import STRICT_HELP, prog
 from sumo_ayss.config import check_out_dir
-from sumo_ayss.modes import analyse_cases
-from sumo_ayss.report.checks import input_problems
+from sumo_ayss.modes import analyse_cases, input_problems
 from sumo_ayss.report.document import DEFAULT_TITLE, ReportOptions, write_report_for
 from sumo_ayss.run_folder import case_runs, load_runs
 from sumo_ayss.util.errors import AyssError

@@ -41,7 +41,6 @@ from sumo_ayss.report.blocks import (
     Report,
     Table,
 )
-from sumo_ayss.report.checks import budget_note, fewest_seeds, trust_warnings
 from sumo_ayss.report.figstyle import vut_colors
 from sumo_ayss.report.leaderboard import leaderboard_table
 from sumo_ayss.report.render import render_html, render_markdown
@@ -49,6 +48,7 @@ from sumo_ayss.report.sections.case import case_blocks, verdict_lines
 from sumo_ayss.report.sections.hazards import hazard_callout
 from sumo_ayss.report.sections.inputs import inputs_blocks
 from sumo_ayss.run_folder import RunRecord, case_runs, group_runs, load_runs
+from sumo_ayss.training.trust import budget_note, fewest_seeds, trust_warnings
 
 __all__ = [
     "DEFAULT_TITLE",

@@ -61,7 +61,7 @@ def reward_shapes_figure(reward: RewardConfig, path: Path, *, styled: bool = Tru
         reward: The runs' reward configuration.
         path: PNG file to write.
         styled: In the report's style (:func:`~.figstyle.style`); False: matplotlib's
-            defaults (``docs/reward_shapes.png``, ``scripts/reward_shapes.py``).
+            defaults (``docs/reward_shapes.png``, ``python -m sumo_ayss.report.reward_shapes``).
 
     Returns:
         ``path``.

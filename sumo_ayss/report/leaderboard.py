@@ -32,6 +32,7 @@ from sumo_ayss.modes import (
     headline_text,
     missing_rows_line,
 )
+from sumo_ayss.modes.crossplay import crossplay_result
 from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p, rank_labels
 from sumo_ayss.report.blocks import Table
 from sumo_ayss.report.sections.common import (
@@ -145,10 +146,14 @@ def leaderboard_rows(a: CaseAnalysis[RunRecord]) -> list[LeaderRow]:
     SPCPs' (exposure).
     """
     mode = get_mode(a.ranking_mode)
-    outcomes = a.outcomes.get(a.ranking_mode) or a.outcomes.get(EXPOSURE.name, {})
+    outcomes = mode.outcomes(a) or EXPOSURE.outcomes(a)
     standings = mode.standings(a)
     labels = rank_labels([bool(s.significant) for s in standings[:-1]]) if standings else []
-    human = a.references.get(CAREFUL_HUMAN) if a.ranking_mode == CROSSPLAY.name else None
+    human = (
+        crossplay_result(a).references.get(CAREFUL_HUMAN)
+        if a.ranking_mode == CROSSPLAY.name
+        else None
+    )
     against = {r.vut: r for r in human.rows} if human is not None else {}
     return [
         LeaderRow(

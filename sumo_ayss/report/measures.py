@@ -32,6 +32,8 @@ from sumo_ayss.analysis.measure_ranking import (
 )
 from sumo_ayss.analysis.r157 import R157_TIME_MARGIN_S, R157_TIME_S, must_avoid_column
 from sumo_ayss.modes import CROSSPLAY, EXPOSURE
+from sumo_ayss.modes.crossplay import crossplay_result
+from sumo_ayss.modes.exposure import exposure_result
 from sumo_ayss.run_folder import (
     CROSSPLAY_SCHEMA,
     RunRecord,
@@ -83,15 +85,17 @@ class CaseMeasures:
 
 
 def _primary(a: CaseAnalysis[RunRecord]) -> tuple[str, tuple[str, ...]]:
-    if a.crossplay_rows:
-        return CROSSPLAY.name, tuple(r.name for r in a.crossplay_rows)
-    return EXPOSURE.name, tuple(r.name for r in a.exposure_rows)
+    crossplay = crossplay_result(a).rows
+    if crossplay:
+        return CROSSPLAY.name, tuple(r.name for r in crossplay)
+    return EXPOSURE.name, tuple(r.name for r in exposure_result(a).rows)
 
 
 def _pool_columns(a: CaseAnalysis[RunRecord]) -> tuple[str, dict[str, np.ndarray]] | None:
     """The pool's episodes: vut, group (the bootstrap unit), collided and the measures."""
-    if a.crossplay_path is not None and a.crossplay_path.is_file():
-        t = read_table(a.crossplay_path, CROSSPLAY_SCHEMA)
+    pool = crossplay_result(a).path
+    if pool is not None and pool.is_file():
+        t = read_table(pool, CROSSPLAY_SCHEMA)
         group = np.char.add(
             np.char.add(t["opponent_vut"].astype(str), "/"), t["opponent_seed"].astype(str)
         )
@@ -191,7 +195,7 @@ def case_measures(
 def _primary_apart(a: CaseAnalysis[RunRecord], mode: str) -> tuple[bool, ...]:
     """Per adjacent pair of the primary ranking, whether its (family-adjusted) test
     separates them."""
-    rows = a.crossplay_rows if mode == CROSSPLAY.name else a.exposure_rows
+    rows = crossplay_result(a).rows if mode == CROSSPLAY.name else exposure_result(a).rows
     return tuple(bool(r.significant_vs_next) for r in rows[:-1])
 
 

@@ -5,20 +5,19 @@ when it resumes (the seeds already added are part of the grid) and by ``rank --n
 A look is stored as an :class:`AdaptiveLook`, the fields of the analysis's
 :class:`sumo_ayss.analysis.sequential.SettleCheck`. ``vuts`` names the VUTs looked at, each
 with its definition's key
-(:func:`~sumo_ayss.run_folder.identity.vut_key`): a grid whose VUTs are others (one added,
+(:func:`~sumo_ayss.config.identity.vut_key`): a grid whose VUTs are others (one added,
 dropped, redefined or renamed) ignores the record and starts over (records written before
 ``vuts`` existed are taken as they are).
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.jsonio import json_field, read_json, write_json
+from sumo_ayss.run_folder.jsonio import json_field, json_number, read_json, write_json
 from sumo_ayss.util.errors import TableError
 
 __all__ = ["ADAPTIVE_FORMAT", "AdaptiveLook", "AdaptiveRecord", "read_adaptive", "write_adaptive"]
@@ -103,11 +102,6 @@ def write_adaptive(path: str | Path, record: AdaptiveRecord) -> None:
 
 
 _NUMBER = (int, float)
-_NUMBER_OR_NULL = (int, float, type(None))
-
-
-def _float(value: Any) -> float:
-    return math.nan if value is None else float(value)
 
 
 def _ints(values: list[Any], key: str, where: str) -> list[int]:
@@ -134,11 +128,11 @@ def read_adaptive(path: str | Path) -> AdaptiveRecord:
         looks.append(
             AdaptiveLook(
                 n_seeds=json_field(x, "n_seeds", int, at),
-                omnibus_p=_float(json_field(x, "omnibus_p", _NUMBER_OR_NULL, at)),
+                omnibus_p=json_number(x, "omnibus_p", at),
                 gate_level=float(json_field(x, "gate_level", _NUMBER, at)),
                 safest=json_field(x, "safest", str, at),
                 least_safe=json_field(x, "least_safe", str, at),
-                ends_p=_float(json_field(x, "ends_p", _NUMBER_OR_NULL, at)),
+                ends_p=json_number(x, "ends_p", at),
                 alpha=float(json_field(x, "alpha", _NUMBER, at)),
                 settled=json_field(x, "settled", bool, at),
             )

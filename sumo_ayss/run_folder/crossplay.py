@@ -17,7 +17,7 @@ env, :mod:`sumo_ayss.scenarios.crossplay`) or ``"pairs"`` (many pairs in one sim
 how tables were made before issue 21; such a table is re-run). ``diagonal`` is the check
 that each SPCP, driven against its own VUT, reproduced its run's ``outcome.csv``: per run,
 how many of the ``n`` episodes were equal (absent in older records). ``vut_keys`` names the
-vehicle each VUT name stood for (:func:`~sumo_ayss.run_folder.identity.vut_key` of its
+vehicle each VUT name stood for (:func:`~sumo_ayss.config.identity.vut_key` of its
 definition; absent in older records): a study that adds, drops, redefines or renames a VUT
 keeps the cells whose VUT and opponent are unchanged (:mod:`.crossplay_cells`).
 

@@ -10,8 +10,8 @@ file, written atomically as soon as the cell is done::
     <out>/<case>/crossplay_reference.partial/cell_<16 hex>.csv  (the reference drivers')
 
 each one :data:`~.schemas.CROSSPLAY_SCHEMA` table of the cell's rows. The file name is the
-:func:`~.stage.fingerprint` of everything the cell's rows depend on (the VUT and its env
-config, the opponent and the SHA-256 of its ``spcp.zip``, the scenario set, the crash
+:func:`~sumo_ayss.util.fingerprint.fingerprint` of everything the cell's rows depend on (the VUT
+and its env config, the opponent and the SHA-256 of its ``spcp.zip``, the scenario set, the crash
 labeller), so a cell made with other inputs is never read back: it is simply not found. A
 rerun reads the cells it finds and drives only the others; the rows read back are the rows
 written (floats as ``repr``), so the finished table is byte-identical to an undisturbed
@@ -30,9 +30,9 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.run_folder.schemas import CROSSPLAY_SCHEMA
-from sumo_ayss.run_folder.stage import fingerprint
 from sumo_ayss.run_folder.table import read_table, table_from_rows, write_table
 from sumo_ayss.util.errors import TableError
+from sumo_ayss.util.fingerprint import fingerprint
 
 __all__ = ["CellStore"]
 

@@ -3,9 +3,9 @@
 They lie in the case folder ``<out>/<case>/`` (:class:`~.layout.CaseFolder`; the
 discriminability CLI writes them into its ``--out``). The JSON record is what
 :func:`sumo_ayss.discriminability.compute` returns: the case, the VUTs, the settings, the
-fingerprint of the inputs (the stage's done marker, :mod:`.stage`), and the comparison
-(``pairs`` with their shares by bin, ``h_edges_m`` in m, ``v_edges_mps`` in m/s,
-``mean_response_mps2`` per VUT in m/s²). The CSV is the same shares as a long table, one row
+fingerprint of the inputs (the stage's done marker, :mod:`sumo_ayss.stages.contract`), and the
+comparison (``pairs`` with their shares by bin, ``h_edges_m`` in m, ``v_edges_mps`` in
+m/s, ``mean_response_mps2`` per VUT in m/s²). The CSV is the same shares as a long table, one row
 per (VUT pair, dimension, bin). Imports neither SUMO nor torch.
 """
 
@@ -15,9 +15,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.csvio import write_csv_rows
 from sumo_ayss.run_folder.jsonio import read_json
 from sumo_ayss.run_folder.layout import CaseFolder
+from sumo_ayss.run_folder.table import write_rows
 from sumo_ayss.util.atomic import atomic_write_json
 from sumo_ayss.util.errors import TableError
 
@@ -64,9 +64,7 @@ def write_discriminability(folder: CaseFolder, record: Mapping[str, Any]) -> lis
     returns the two paths."""
     folder.path.mkdir(parents=True, exist_ok=True)
     atomic_write_json(folder.discriminability_json, dict(record))
-    write_csv_rows(
-        folder.discriminability_csv, DISCRIMINABILITY_COLUMNS, discriminability_rows(record)
-    )
+    write_rows(folder.discriminability_csv, DISCRIMINABILITY_COLUMNS, discriminability_rows(record))
     return [folder.discriminability_json, folder.discriminability_csv]
 
 

@@ -1,121 +1,58 @@
 """``eval.csv``: one row per SPCP candidate, written by training, read by everyone.
 
-Columns (:data:`EVAL_COLUMNS`, in file order):
-
-==========================  ======================================================================
-``step``                    training transitions when the candidate was stored (int)
-``mean_return``             mean undiscounted episode reward over the evaluation scenarios
-``std_return``              its standard deviation (NaN with one scenario)
-``crash_rate``              fraction of evaluation episodes with a collision, in [0, 1]
-``lane_change_rate``        fraction with a POV lane change (cut-in; 0 in car-following)
-``mean_final_headway_m``    mean headway after the last step, m
-``n_episodes``              evaluation episodes (int)
-``wall_s``                  wall time of the evaluation, s
-``checkpoint``              the candidate's model, relative to the run folder
-==========================  ======================================================================
-
-:func:`write_eval_table` is the one writer (atomic, whole file), :func:`read_eval_table` the
-one reader.
+Its schema is :data:`EVAL_SCHEMA` (``step`` and ``n_episodes`` ints, ``checkpoint`` text, the
+other columns finite floats but ``std_return``, NaN with one scenario). It is written by
+:func:`write_eval_table` and read by the one CSV reader (:func:`~.table.read_table`), raising
+:class:`~sumo_ayss.util.errors.CheckpointError` (a run's own record) naming the file, the
+column and the row.
 """
 
 from __future__ import annotations
 
-import csv
-import io
-import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.util.atomic import atomic_write_text
+from sumo_ayss.run_folder.table import Column, TableSchema, read_table, write_rows
 from sumo_ayss.util.errors import CheckpointError
 
-__all__ = ["EVAL_COLUMNS", "read_eval_rows", "read_eval_table", "write_eval_table"]
+__all__ = ["EVAL_SCHEMA", "read_eval_table", "write_eval_table"]
 
-EVAL_COLUMNS: tuple[str, ...] = (
-    "step",
-    "mean_return",
-    "std_return",
-    "crash_rate",
-    "lane_change_rate",
-    "mean_final_headway_m",
-    "n_episodes",
-    "wall_s",
-    "checkpoint",
+EVAL_SCHEMA = TableSchema(
+    "eval.csv",
+    (
+        Column("step", "int", "-", "training transitions when the candidate was stored"),
+        Column("mean_return", "float", "-", "mean episode reward over the evaluation scenarios"),
+        Column("std_return", "float", "-", "its standard deviation (NaN: one scenario)", True),
+        Column("crash_rate", "float", "-", "fraction of episodes with a collision, in [0, 1]"),
+        Column("lane_change_rate", "float", "-", "fraction with a POV lane change (cut-in)"),
+        Column("mean_final_headway_m", "float", "m", "mean headway after the last step"),
+        Column("n_episodes", "int", "-", "evaluation episodes"),
+        Column("wall_s", "float", "s", "wall time of the evaluation"),
+        Column("checkpoint", "str", "-", "the candidate's model, relative to the run folder"),
+    ),
 )
 """The columns of ``eval.csv``, in file order."""
 
-_INT_COLUMNS = ("step", "n_episodes")
-_MAY_BE_NAN = ("std_return",)
-
 
 def write_eval_table(path: Path, rows: Sequence[dict[str, Any]]) -> None:
-    """Write ``rows`` (dicts with exactly :data:`EVAL_COLUMNS`) as ``eval.csv``, atomically."""
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=list(EVAL_COLUMNS), lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    atomic_write_text(path, buf.getvalue())
+    """Write ``rows`` (dicts with exactly :data:`EVAL_SCHEMA`'s columns) as ``eval.csv``."""
+    write_rows(path, EVAL_SCHEMA.names, rows)
 
 
-def read_eval_table(path: Path) -> list[dict[str, Any]]:
+def read_eval_table(path: Path, *, skip_bad_rows: bool = False) -> list[dict[str, Any]]:
     """The rows of ``eval.csv`` in file order (none if it does not exist).
-
-    ``step`` and ``n_episodes`` are ints, ``checkpoint`` text, the other columns floats;
-    every number is finite except ``std_return``.
-
-    Raises:
-        CheckpointError: The file is unreadable, lacks a column, or has a bad cell; the
-            message names the file, the line and the column.
-    """
-    return read_eval_rows(path)[0]
-
-
-def read_eval_rows(path: Path, *, skip_bad_rows: bool = False) -> tuple[list[dict[str, Any]], int]:
-    """Parse ``eval.csv``: the rows (as :func:`read_eval_table`) and how many were skipped.
 
     Args:
         path: The file; a missing file has no rows.
-        skip_bad_rows: Skip a row with a bad cell (and count it) instead of raising; the
-            report shows the rest of a damaged table.
+        skip_bad_rows: Leave out a row with a bad cell instead of raising (the progress
+            display shows the rest of a damaged table).
 
     Raises:
-        CheckpointError: The file is unreadable or lacks a column; with ``skip_bad_rows``
-            false also for a bad cell (naming the file, the line and the column).
+        CheckpointError: The file is unreadable, lacks a column, or (unless
+            ``skip_bad_rows``) has a bad cell; the message names the file, column and row.
     """
     if not path.is_file():
-        return [], 0
-    try:
-        with path.open(encoding="utf-8", newline="") as f:
-            reader = csv.DictReader(f)
-            missing = [c for c in EVAL_COLUMNS if c not in (reader.fieldnames or [])]
-            if missing:
-                raise CheckpointError(f"{path}: not an eval table (missing columns {missing})")
-            rows = list(reader)
-    except (OSError, UnicodeDecodeError, csv.Error) as e:
-        raise CheckpointError(f"{path}: unreadable ({e})") from e
-    out: list[dict[str, Any]] = []
-    for line, row in enumerate(rows, start=2):
-        try:
-            out.append(_parse_row(row, f"{path}, line {line}"))
-        except CheckpointError:
-            if not skip_bad_rows:
-                raise
-    return out, len(rows) - len(out)
-
-
-def _parse_row(row: dict[str, Any], where: str) -> dict[str, Any]:
-    for key in EVAL_COLUMNS:
-        if key == "checkpoint":
-            continue
-        cell = row[key]
-        try:
-            value = int(cell) if key in _INT_COLUMNS else float(cell)
-        except (TypeError, ValueError):
-            raise CheckpointError(
-                f"{where}: column {key!r} must be a number, got {cell!r}"
-            ) from None
-        if key not in _MAY_BE_NAN and not math.isfinite(value):
-            raise CheckpointError(f"{where}: column {key!r} must be finite, got {cell!r}")
-        row[key] = value
-    return row
+        return []
+    table = read_table(path, EVAL_SCHEMA, error=CheckpointError, skip_bad_rows=skip_bad_rows)
+    return list(table.rows())

@@ -24,7 +24,7 @@ import numpy as np
 from sumo_ayss.util.atomic import atomic_write_text
 from sumo_ayss.util.errors import StoredFileError, TableError
 
-__all__ = ["json_field", "read_json", "write_json"]
+__all__ = ["json_field", "json_number", "read_json", "write_json"]
 
 
 def _jsonable(obj: Any) -> Any:
@@ -115,3 +115,12 @@ def json_field(
         names = " or ".join(k.__name__ for k in kinds)
         raise error(f"{where}: {key}: expected {names}, got {value!r}")
     return value
+
+
+def json_number(
+    data: Mapping[str, Any], key: str, where: str, *, error: type[StoredFileError] = TableError
+) -> float:
+    """``data[key]`` as a float: a JSON number, or NaN for ``null`` (how :func:`write_json`
+    writes a non-finite float); checked as :func:`json_field`."""
+    value = json_field(data, key, (int, float, type(None)), where, error=error)
+    return math.nan if value is None else float(value)

@@ -12,6 +12,7 @@ import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, overload
 
 from sumo_ayss.util.errors import ConfigError
 
@@ -30,22 +31,17 @@ __all__ = [
     "EVALUATE_DONE_JSON",
     "EVAL_CSV",
     "JOB_LOG",
-    "LATEST_JSON",
     "MODEL_ZIP",
     "OUTCOME_CSV",
     "OUTCOME_JSON",
     "PROGRESS_JSON",
-    "REPLAY_PKL",
-    "RESUME_FILES",
-    "RESUME_MODEL_ZIP",
     "SEEDS_JSON",
     "SPCP_JSON",
     "SPCP_ZIP",
-    "STATE_JSON",
     "TB_DIR",
-    "TORCH_RNG_PT",
     "VERSIONS_JSON",
     "CaseFolder",
+    "FolderFile",
     "RunFolder",
     "case_dir_for",
     "find_run_dirs",
@@ -74,21 +70,10 @@ PROGRESS_JSON = "progress.json"
 TB_DIR = "tb"
 """TensorBoard logs."""
 CHECKPOINTS_DIR = "checkpoints"
-"""``step_XXXXXXXXX/`` per candidate and ``latest.json``."""
-LATEST_JSON = "latest.json"
-"""In ``checkpoints/``: names the latest complete checkpoint (written last)."""
+"""``step_XXXXXXXXX/`` per candidate and ``latest.json`` (the checkpoints' own files are
+the trainer's: :mod:`sumo_ayss.training.checkpoint_files`)."""
 MODEL_ZIP = "model.zip"
 """In a checkpoint: the candidate's model."""
-RESUME_MODEL_ZIP = "resume_model.zip"
-"""In the latest checkpoint: the full model for a resume."""
-REPLAY_PKL = "replay.pkl"
-"""In the latest checkpoint: the replay buffer."""
-STATE_JSON = "state.json"
-"""In the latest checkpoint: counters, env state and RNG states."""
-TORCH_RNG_PT = "torch_rng.pt"
-"""In the latest checkpoint: torch's RNG state."""
-RESUME_FILES = (REPLAY_PKL, RESUME_MODEL_ZIP)
-"""Files of a checkpoint that only the latest keeps (what a resume needs beyond model.zip)."""
 
 # -- written by evaluate and the pipeline ------------------------------------------------------
 OUTCOME_CSV = "outcome.csv"
@@ -147,6 +132,28 @@ def seed_of_dir(path: Path) -> int | None:
     return int(match.group(1)) if match else None
 
 
+class FolderFile:
+    """A file of a folder record (:class:`RunFolder`, :class:`CaseFolder`, a study's), named
+    once: on a folder the attribute is the file's path, ``folder.path / name``; on the class
+    it is this descriptor, whose :attr:`name` is the file's name (``RunFolder.outcome_json.name``
+    is ``"outcome.json"``)."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+
+    @overload
+    def __get__(self, folder: None, owner: type | None = None) -> FolderFile: ...
+
+    @overload
+    def __get__(self, folder: object, owner: type | None = None) -> Path: ...
+
+    def __get__(self, folder: Any, owner: type | None = None) -> Path | FolderFile:
+        if folder is None:
+            return self
+        path: Path = folder.path / self.name
+        return path
+
+
 @dataclass(frozen=True)
 class RunFolder:
     """The paths of one run folder's files.
@@ -160,94 +167,30 @@ class RunFolder:
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
 
-    @property
-    def config(self) -> Path:
-        """``config.yaml``."""
-        return self.path / CONFIG_YAML
-
-    @property
-    def command(self) -> Path:
-        """``command.txt``."""
-        return self.path / COMMAND_TXT
-
-    @property
-    def versions(self) -> Path:
-        """``versions.json``."""
-        return self.path / VERSIONS_JSON
-
-    @property
-    def seeds(self) -> Path:
-        """``seeds.json``."""
-        return self.path / SEEDS_JSON
-
-    @property
-    def eval_table(self) -> Path:
-        """``eval.csv``."""
-        return self.path / EVAL_CSV
-
-    @property
-    def spcp_json(self) -> Path:
-        """``spcp.json``."""
-        return self.path / SPCP_JSON
-
-    @property
-    def spcp_zip(self) -> Path:
-        """``spcp.zip``."""
-        return self.path / SPCP_ZIP
-
-    @property
-    def progress(self) -> Path:
-        """``progress.json``."""
-        return self.path / PROGRESS_JSON
-
-    @property
-    def tb(self) -> Path:
-        """``tb/``."""
-        return self.path / TB_DIR
-
-    @property
-    def checkpoints(self) -> Path:
-        """``checkpoints/``."""
-        return self.path / CHECKPOINTS_DIR
-
-    @property
-    def latest(self) -> Path:
-        """``checkpoints/latest.json``."""
-        return self.path / CHECKPOINTS_DIR / LATEST_JSON
-
-    @property
-    def outcome_csv(self) -> Path:
-        """``outcome.csv``."""
-        return self.path / OUTCOME_CSV
-
-    @property
-    def outcome_json(self) -> Path:
-        """``outcome.json``."""
-        return self.path / OUTCOME_JSON
-
-    @property
-    def ayss_csv(self) -> Path:
-        """``ayss.csv``."""
-        return self.path / AYSS_CSV
-
-    @property
-    def ayss_json(self) -> Path:
-        """``ayss.json``."""
-        return self.path / AYSS_JSON
-
-    @property
-    def evaluate_done(self) -> Path:
-        """``evaluate.done.json``."""
-        return self.path / EVALUATE_DONE_JSON
-
-    @property
-    def job_log(self) -> Path:
-        """``job.log``."""
-        return self.path / JOB_LOG
+    config = FolderFile(CONFIG_YAML)
+    command = FolderFile(COMMAND_TXT)
+    versions = FolderFile(VERSIONS_JSON)
+    seeds = FolderFile(SEEDS_JSON)
+    eval_table = FolderFile(EVAL_CSV)
+    spcp_json = FolderFile(SPCP_JSON)
+    spcp_zip = FolderFile(SPCP_ZIP)
+    progress = FolderFile(PROGRESS_JSON)
+    tb = FolderFile(TB_DIR)
+    checkpoints = FolderFile(CHECKPOINTS_DIR)
+    outcome_csv = FolderFile(OUTCOME_CSV)
+    outcome_json = FolderFile(OUTCOME_JSON)
+    ayss_csv = FolderFile(AYSS_CSV)
+    ayss_json = FolderFile(AYSS_JSON)
+    evaluate_done = FolderFile(EVALUATE_DONE_JSON)
+    job_log = FolderFile(JOB_LOG)
 
     def step_dir(self, step: int) -> Path:
         """The checkpoint folder of the candidate at training step ``step``."""
         return self.checkpoints / f"step_{step:09d}"
+
+    def candidate_model(self, step: int) -> Path:
+        """The model of the candidate at training step ``step``."""
+        return self.step_dir(step) / MODEL_ZIP
 
     def checkpoint_model(self, step_dir: Path) -> str:
         """``checkpoints/step_XXXXXXXXX/model.zip`` relative to the run folder, as written
@@ -269,57 +212,23 @@ class CaseFolder:
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
 
-    @property
-    def crossplay_csv(self) -> Path:
-        """``crossplay.csv``."""
-        return self.path / CROSSPLAY_CSV
-
-    @property
-    def crossplay_json(self) -> Path:
-        """``crossplay.json``."""
-        return self.path / CROSSPLAY_JSON
-
-    @property
-    def inevitable_json(self) -> Path:
-        """``inevitable.json``: the scenarios no braking survives (:func:`read_inevitable`)."""
-        return self.path / INEVITABLE_JSON
-
-    @property
-    def crossplay_partial(self) -> Path:
-        """``crossplay.partial/``: the finished cells of a cross-play table not yet written
-        whole (:class:`~.crossplay_partial.CellStore`)."""
-        return self.path / CROSSPLAY_PARTIAL
-
-    @property
-    def crossplay_reference_partial(self) -> Path:
-        """``crossplay_reference.partial/``: the same for ``crossplay_reference.csv``."""
-        return self.path / CROSSPLAY_REFERENCE_PARTIAL
-
-    @property
-    def crossplay_reference_csv(self) -> Path:
-        """``crossplay_reference.csv``: the reference drivers against the same opponents
-        and scenarios (:data:`~.schemas.CROSSPLAY_SCHEMA`; they have no SPCPs of their own)."""
-        return self.path / CROSSPLAY_REFERENCE_CSV
-
-    @property
-    def adaptive_json(self) -> Path:
-        """``adaptive.json`` (adaptive seeding's looks, :mod:`.adaptive`)."""
-        return self.path / ADAPTIVE_JSON
-
-    @property
-    def discriminability_json(self) -> Path:
-        """``discriminability.json``."""
-        return self.path / DISCRIMINABILITY_JSON
-
-    @property
-    def discriminability_csv(self) -> Path:
-        """``discriminability.csv``."""
-        return self.path / DISCRIMINABILITY_CSV
-
-    @property
-    def discriminability_png(self) -> Path:
-        """``discriminability.png``."""
-        return self.path / DISCRIMINABILITY_PNG
+    crossplay_csv = FolderFile(CROSSPLAY_CSV)
+    crossplay_json = FolderFile(CROSSPLAY_JSON)
+    #: ``inevitable.json``: the scenarios no braking survives (:func:`read_inevitable`).
+    inevitable_json = FolderFile(INEVITABLE_JSON)
+    #: ``crossplay.partial/``: the finished cells of a cross-play table not yet written whole
+    #: (:class:`~.crossplay_partial.CellStore`).
+    crossplay_partial = FolderFile(CROSSPLAY_PARTIAL)
+    #: ``crossplay_reference.partial/``: the same for ``crossplay_reference.csv``.
+    crossplay_reference_partial = FolderFile(CROSSPLAY_REFERENCE_PARTIAL)
+    #: ``crossplay_reference.csv``: the reference drivers against the same opponents and scenarios
+    #: (:data:`~.schemas.CROSSPLAY_SCHEMA`; they have no SPCPs of their own).
+    crossplay_reference_csv = FolderFile(CROSSPLAY_REFERENCE_CSV)
+    #: ``adaptive.json`` (adaptive seeding's looks, :mod:`.adaptive`).
+    adaptive_json = FolderFile(ADAPTIVE_JSON)
+    discriminability_json = FolderFile(DISCRIMINABILITY_JSON)
+    discriminability_csv = FolderFile(DISCRIMINABILITY_CSV)
+    discriminability_png = FolderFile(DISCRIMINABILITY_PNG)
 
 
 def is_run_dir(path: Path) -> bool:

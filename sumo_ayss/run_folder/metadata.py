@@ -6,12 +6,13 @@
 ``versions.json``           :func:`write_versions` / :func:`read_versions`
 ``seeds.json``              :func:`write_seeds` / :func:`read_seeds`
 ``spcp.json``               :func:`write_spcp` / :func:`read_spcp`
-``checkpoints/latest.json`` :func:`write_latest` / :func:`read_latest`
-``<checkpoint>/state.json`` :func:`write_checkpoint_state` / :func:`read_checkpoint_state`
 ``progress.json``           :func:`write_progress` / :func:`read_progress`
+``evaluate.done.json``      :func:`write_done_marker` / :func:`read_done_marker`
 ==========================  =============================================================
 
-Readers raise :class:`~sumo_ayss.util.errors.CheckpointError` naming the file and the field;
+The checkpoints' own files (``latest.json``, ``state.json``) are the trainer's
+(:mod:`sumo_ayss.training.checkpoint_files`). Readers raise
+:class:`~sumo_ayss.util.errors.CheckpointError` naming the file and the field;
 callers that tolerate a missing or broken file (the report, the progress display) catch it.
 Imports neither SUMO nor torch.
 """
@@ -28,9 +29,16 @@ from typing import Any
 
 import yaml
 
-from sumo_ayss.config import EnvConfig, check_seed, safe_load_yaml, write_yaml
+from sumo_ayss.config import (
+    EnvConfig,
+    ExperimentConfig,
+    check_seed,
+    experiment_from_dict,
+    safe_load_yaml,
+    write_yaml,
+)
 from sumo_ayss.run_folder.jsonio import json_field, read_json
-from sumo_ayss.run_folder.layout import PROGRESS_JSON
+from sumo_ayss.run_folder.layout import PROGRESS_JSON, RunFolder
 from sumo_ayss.util.atomic import atomic_write_json, atomic_write_text
 from sumo_ayss.util.errors import CheckpointError, ConfigError
 
@@ -38,18 +46,18 @@ __all__ = [
     "RunConfig",
     "Seeds",
     "SpcpChoice",
-    "read_checkpoint_state",
     "read_command",
-    "read_latest",
+    "read_done_marker",
     "read_progress",
     "read_run_config",
     "read_seeds",
     "read_spcp",
     "read_versions",
-    "write_checkpoint_state",
+    "stored_experiment",
     "write_command",
-    "write_latest",
+    "write_done_marker",
     "write_progress",
+    "write_provenance",
     "write_run_config",
     "write_seeds",
     "write_spcp",
@@ -123,6 +131,19 @@ def read_run_config(path: Path) -> RunConfig:
     except (ConfigError, KeyError, OSError, UnicodeDecodeError, yaml.YAMLError) as e:
         raise CheckpointError(f"{path}: unreadable run configuration ({e})") from e
     return RunConfig(vut, seed, data)
+
+
+def stored_experiment(folder: RunFolder) -> tuple[ExperimentConfig, int]:
+    """The experiment and seed a run folder's ``config.yaml`` records.
+
+    Raises:
+        CheckpointError: If the file is missing or unreadable, naming it.
+    """
+    stored = read_run_config(folder.config)
+    try:
+        return experiment_from_dict(stored.experiment, folder.path), stored.seed
+    except ConfigError as e:
+        raise CheckpointError(f"{folder.config}: unreadable run configuration ({e})") from e
 
 
 # --------------------------------------------------------------------------- command.txt
@@ -200,6 +221,17 @@ def read_seeds(path: Path) -> Seeds:
     )
 
 
+def write_provenance(
+    folder: RunFolder, command: str, versions: Mapping[str, str], seeds: Seeds
+) -> None:
+    """Write what records how a run was made, beside its ``config.yaml``: ``command.txt``,
+    ``versions.json`` and ``seeds.json`` (:func:`write_command`, :func:`write_versions`,
+    :func:`write_seeds`)."""
+    write_command(folder.command, command)
+    write_versions(folder.versions, versions)
+    write_seeds(folder.seeds, seeds)
+
+
 # --------------------------------------------------------------------------- spcp.json
 
 
@@ -257,46 +289,6 @@ def read_spcp(path: Path) -> SpcpChoice:
     )
 
 
-# --------------------------------------------------------------------------- checkpoints
-
-
-def write_latest(path: Path, step_dir: Path) -> None:
-    """Write ``checkpoints/latest.json``: ``{"step": 80016, "dir": "step_000080016"}``."""
-    atomic_write_json(path, {"step": int(step_dir.name.split("_")[1]), "dir": step_dir.name})
-
-
-def read_latest(path: Path) -> tuple[int, str]:
-    """Read ``checkpoints/latest.json``: ``(step, folder name)``.
-
-    Raises:
-        CheckpointError: The file is unreadable, ``dir`` does not name a ``step_*`` folder
-            (no path), or ``step`` is not an integer.
-    """
-    data = read_json(path, error=CheckpointError)
-    name = data.get("dir")
-    if not isinstance(name, str) or Path(name).name != name or not name.startswith("step_"):
-        raise CheckpointError(f"{path}: 'dir' must name a step_* folder, got {name!r}")
-    step = json_field(data, "step", int, str(path), error=CheckpointError)
-    return step, name
-
-
-def write_checkpoint_state(path: Path, state: Mapping[str, Any]) -> None:
-    """Write a checkpoint's ``state.json`` (counters, env state, RNG states)."""
-    atomic_write_json(path, dict(state))
-
-
-def read_checkpoint_state(path: Path) -> dict[str, Any]:
-    """Read a checkpoint's ``state.json``; it must hold ``num_timesteps`` and ``next_eval``.
-
-    Raises:
-        CheckpointError: The file is unreadable or not a checkpoint state.
-    """
-    data = read_json(path, error=CheckpointError)
-    for key in ("num_timesteps", "next_eval"):
-        json_field(data, key, object, f"{path}: not a checkpoint state", error=CheckpointError)
-    return data
-
-
 def write_progress(run_dir: Path, stage: str, **fields: Any) -> None:
     """Atomically (re)write ``<run_dir>/progress.json``: ``stage``, ``time`` plus ``fields``.
 
@@ -313,3 +305,20 @@ def read_progress(run_dir: Path) -> dict[str, Any] | None:
         return read_json(run_dir / PROGRESS_JSON, error=CheckpointError)
     except CheckpointError:
         return None
+
+
+def write_done_marker(path: Path, key: str) -> None:
+    """Write a stand-alone done marker (``evaluate.done.json``): ``{"inputs": key}``."""
+    atomic_write_json(path, {"inputs": key})
+
+
+def read_done_marker(path: Path) -> str | None:
+    """The fingerprint a stand-alone done marker records; None when the file is missing.
+
+    Raises:
+        CheckpointError: The file exists but is unreadable or not a JSON object.
+    """
+    if not path.is_file():
+        return None
+    inputs = read_json(path, error=CheckpointError).get("inputs")
+    return inputs if isinstance(inputs, str) else None

@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 
 from sumo_ayss.cases import case_of_indicator
 from sumo_ayss.config import EnvConfig, ExperimentConfig, RewardConfig, build, experiment_from_dict
-from sumo_ayss.run_folder.eval_table import read_eval_rows
+from sumo_ayss.run_folder.eval_table import EVAL_SCHEMA
 from sumo_ayss.run_folder.layout import AYSS_CSV, CONFIG_YAML, EVAL_CSV, RunFolder, seed_of_dir
 from sumo_ayss.run_folder.metadata import RunConfig, SpcpChoice, read_run_config, read_spcp
 from sumo_ayss.run_folder.metadata import read_versions as _read_versions
@@ -322,6 +322,10 @@ def _eval_curve(rows: Sequence[Mapping[str, Any]], n_dropped: int) -> EvalCurve:
     )
 
 
+def _eval_rows(path: Path) -> Table:
+    return read_table(path, EVAL_SCHEMA, error=CheckpointError, skip_bad_rows=True)
+
+
 def _ayss_samples(path: Path) -> AyssSamples:
     table = read_table(path, AYSS_SCHEMA)
     names = Counter(str(n) for n in table["indicator_name"])
@@ -410,10 +414,10 @@ def read_run(path: str | Path) -> RunRecord:
             except (ConfigError, TypeError, ValueError, ArithmeticError) as exc:
                 r.problems.append(f"{CONFIG_YAML}: episode timing invalid ({exc})")
 
-    rows_read = r.attempt(folder.eval_table, lambda p: read_eval_rows(p, skip_bad_rows=True))
-    rows, n_dropped = rows_read if rows_read is not None else ([], 0)
+    evals = r.attempt(folder.eval_table, _eval_rows)
+    rows, n_dropped = (list(evals.rows()), evals.n_dropped) if evals is not None else ([], 0)
     rows.sort(key=lambda row: row["step"])
-    curve = _eval_curve(rows, n_dropped) if rows_read is not None else None
+    curve = _eval_curve(rows, n_dropped) if evals is not None else None
     if n_dropped:
         r.problems.append(
             f"{EVAL_CSV}: {n_dropped} candidate row(s) without a finite step or mean_return dropped"

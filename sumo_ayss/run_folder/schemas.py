@@ -16,15 +16,13 @@ Written and read with :func:`~sumo_ayss.run_folder.table.write_table` /
 
 from __future__ import annotations
 
-from sumo_ayss.cases import CAR_FOLLOWING, CUT_IN, indicator_columns
+from sumo_ayss.cases import indicator_columns
 from sumo_ayss.run_folder.measure_columns import EPISODE_HAZARD_COLUMNS, EPISODE_MEASURE_COLUMNS
 from sumo_ayss.run_folder.table import Column, TableSchema
 
 __all__ = [
     "AYSS_SCHEMA",
     "CROSSPLAY_SCHEMA",
-    "INDICATOR_ACCEL",
-    "INDICATOR_DELTA_V_BAR",
     "OUTCOME_SCHEMA",
 ]
 
@@ -101,10 +99,6 @@ OUTCOME_SCHEMA = TableSchema(
     ),
 )
 
-#: Aggressiveness indicator of car-following: POV acceleration [m/s²], < 0 brakes.
-INDICATOR_ACCEL = CAR_FOLLOWING.indicator_column
-#: Aggressiveness indicator of cut-in: Δv̄ [m/s], < 0 closes in.
-INDICATOR_DELTA_V_BAR = CUT_IN.indicator_column
 
 #: ``<run>/ayss.csv``: one row per kept adversarial-yet-safe sample (paper Fig. 4 and 6).
 AYSS_SCHEMA = TableSchema(

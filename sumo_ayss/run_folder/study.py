@@ -17,8 +17,9 @@ file                    writer / reader                   what
 ``report/``             (the report)                      ``report.html``, ``summary.md``
 ======================  ================================  ====================================
 
-Every file is written atomically. The CSV readers return the cells as written (strings):
-a script that writes a file back (``scripts/keep_paper_rows.py``) keeps every digit.
+Every file is written atomically. The CSV files are read by the one CSV reader
+(:func:`~.table.read_table`) with a schema of text columns: the cells as written, so a script
+that writes a file back (``scripts/keep_paper_rows.py``) keeps every digit.
 Imports neither SUMO nor torch.
 """
 
@@ -30,9 +31,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.csvio import read_csv_rows, write_csv_rows
 from sumo_ayss.run_folder.jsonio import json_field, read_json
-from sumo_ayss.run_folder.layout import CaseFolder, case_dir_for
+from sumo_ayss.run_folder.layout import (
+    CaseFolder,
+    FolderFile,
+    RunFolder,
+    case_dir_for,
+    run_dir_for,
+)
+from sumo_ayss.run_folder.table import read_table, text_schema, write_rows
 from sumo_ayss.util.atomic import atomic_write_json
 from sumo_ayss.util.errors import TableError
 
@@ -169,39 +176,20 @@ class StudyFolder:
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
 
-    @property
-    def pipeline_json(self) -> Path:
-        """``pipeline.json``."""
-        return self.path / PIPELINE_JSON
-
-    @property
-    def ranking_csv(self) -> Path:
-        """``ranking.csv``."""
-        return self.path / RANKING_CSV
-
-    @property
-    def ranking_md(self) -> Path:
-        """``ranking.md``."""
-        return self.path / RANKING_MD
-
-    @property
-    def order_check_json(self) -> Path:
-        """``order_check.json``."""
-        return self.path / ORDER_CHECK_JSON
-
-    @property
-    def measures_csv(self) -> Path:
-        """``measures.csv``."""
-        return self.path / MEASURES_CSV
-
-    @property
-    def report_dir(self) -> Path:
-        """``report/``."""
-        return self.path / REPORT_DIR
+    pipeline_json = FolderFile(PIPELINE_JSON)
+    ranking_csv = FolderFile(RANKING_CSV)
+    ranking_md = FolderFile(RANKING_MD)
+    order_check_json = FolderFile(ORDER_CHECK_JSON)
+    measures_csv = FolderFile(MEASURES_CSV)
+    report_dir = FolderFile(REPORT_DIR)
 
     def case(self, case: str) -> CaseFolder:
         """The case folder ``<out>/<case>/``."""
         return CaseFolder(case_dir_for(self.path, case))
+
+    def run(self, case: str, vut: str, seed: int) -> RunFolder:
+        """The run folder ``<out>/<case>/<vut>/seed_<seed>/``."""
+        return RunFolder(run_dir_for(self.path, case, vut, seed))
 
 
 # --------------------------------------------------------------------------- pipeline.json
@@ -228,10 +216,10 @@ def write_ranking_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
     """Write ``ranking.csv`` (:data:`RANKING_COLUMNS`, then :data:`RANKING_HAZARD_COLUMNS`
     where a row has one; a missing cell is written empty)."""
     if any(r.get(c, "") != "" for r in rows for c in RANKING_HAZARD_COLUMNS):
-        write_csv_rows(path, RANKING_COLUMNS + RANKING_HAZARD_COLUMNS, rows)
+        write_rows(path, RANKING_COLUMNS + RANKING_HAZARD_COLUMNS, rows)
         return
     bare = [{k: v for k, v in r.items() if k not in RANKING_HAZARD_COLUMNS} for r in rows]
-    write_csv_rows(path, RANKING_COLUMNS, bare)
+    write_rows(path, RANKING_COLUMNS, bare)
 
 
 def read_ranking_csv(path: Path) -> list[dict[str, str]]:
@@ -242,19 +230,17 @@ def read_ranking_csv(path: Path) -> list[dict[str, str]]:
 
     Raises:
         TableError: The file is missing or unreadable, lacks a column of
-            :data:`RANKING_COLUMNS` up to ``vs_next``, or has a short row (naming the file
-            and the line).
+            :data:`RANKING_COLUMNS` up to ``vs_next`` or has one of none, or has a row of
+            the wrong length (naming the file and the row).
     """
-    return read_csv_rows(
-        path,
-        RANKING_COLUMNS + RANKING_HAZARD_COLUMNS,
-        optional=_RANKING_ADDED + RANKING_HAZARD_COLUMNS,
-    )
+    columns = RANKING_COLUMNS + RANKING_HAZARD_COLUMNS
+    added = _RANKING_ADDED + RANKING_HAZARD_COLUMNS
+    return list(read_table(path, text_schema(RANKING_CSV, columns, added)).rows())
 
 
 def write_measures_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
     """Write ``measures.csv`` (:data:`MEASURES_COLUMNS`)."""
-    write_csv_rows(path, MEASURES_COLUMNS, rows)
+    write_rows(path, MEASURES_COLUMNS, rows)
 
 
 def read_measures_csv(path: Path) -> list[dict[str, str]]:
@@ -263,7 +249,7 @@ def read_measures_csv(path: Path) -> list[dict[str, str]]:
     Raises:
         TableError: As :func:`read_ranking_csv`, for :data:`MEASURES_COLUMNS`.
     """
-    return read_csv_rows(path, MEASURES_COLUMNS)
+    return list(read_table(path, text_schema(MEASURES_CSV, MEASURES_COLUMNS)).rows())
 
 
 # --------------------------------------------------------------------------- order_check.json

@@ -32,8 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.jsonio import json_field, read_json, write_json
-from sumo_ayss.util.errors import TableError
+from sumo_ayss.run_folder.jsonio import json_field, json_number, read_json, write_json
 
 __all__ = [
     "AyssRecord",
@@ -175,6 +174,7 @@ def write_outcome_json(
     odd: Mapping[str, Any],
     summary: Mapping[str, Any],
     wall_s: float,
+    extra: Mapping[str, Any] | None = None,
 ) -> None:
     """Write ``outcome.json``.
 
@@ -185,6 +185,7 @@ def write_outcome_json(
         odd: The run's ODD (``to_dict(EnvConfig.odd)``).
         summary: ``OutcomeSummary.as_dict()``.
         wall_s: Wall time of the rollouts, s.
+        extra: Further sections of a case (e.g. ``supporting_pov``); None: none.
     """
     record = {
         **header.as_dict("outcome"),
@@ -192,6 +193,7 @@ def write_outcome_json(
         "odd": dict(odd),
         "summary": dict(summary),
         "wall_s": round(wall_s, 3),
+        **(extra or {}),
     }
     write_json(path, record)
 
@@ -207,35 +209,12 @@ def write_ayss_json(
 # --------------------------------------------------------------------------- readers
 
 
-def _number(value: Any, where: str) -> float:
-    """A JSON number, or NaN for ``null`` (how NaN is written)."""
-    if value is None:
-        return math.nan
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise TableError(f"{where}: expected a number or null, got {value!r}")
-    return float(value)
-
-
-def _count(value: Any, where: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise TableError(f"{where}: expected an integer, got {value!r}")
-    return value
-
-
-def _object(value: Any, where: str) -> Mapping[str, Any]:
-    if not isinstance(value, Mapping):
-        raise TableError(f"{where}: expected an object, got {value!r}")
-    return value
-
-
 def _estimate(data: Mapping[str, Any], key: str, point: str, where: str) -> Estimate:
     """A proportion (``point="value"``) or a mean (``point="mean"``) of the summary."""
-    where = f"{where}.{key}"
-    item = _object(json_field(data, key, object, where.rsplit(".", 1)[0]), where)
+    item = json_field(data, key, dict, where)
+    at = f"{where}.{key}"
     return Estimate(
-        _number(json_field(item, point, object, where), f"{where}.{point}"),
-        _number(json_field(item, "lo", object, where), f"{where}.lo"),
-        _number(json_field(item, "hi", object, where), f"{where}.hi"),
+        json_number(item, point, at), json_number(item, "lo", at), json_number(item, "hi", at)
     )
 
 
@@ -248,15 +227,14 @@ def read_outcome_json(path: Path) -> OutcomeRecord:
     """
     data = read_json(path)
     where = f"{path}: summary"
-    summary = _object(json_field(data, "summary", object, str(path)), where)
+    summary = json_field(data, "summary", dict, str(path))
     lc = summary.get("lane_change_rate")
     lc_return = summary.get("lc_no_collision_return")
     subset = None
     if lc_return is not None:
         subset = OutcomeSubset(
-            n=_count(
-                json_field(_object(lc_return, where), "n", object, where),
-                f"{where}.lc_no_collision_return.n",
+            n=json_field(
+                json_field(summary, "lc_no_collision_return", dict, where), "n", int, where
             ),
             mean_return=_estimate(summary, "lc_no_collision_return", "mean", where),
             mean_final_headway_m=_estimate(
@@ -264,7 +242,7 @@ def read_outcome_json(path: Path) -> OutcomeRecord:
             ),
         )
     outcome = Outcome(
-        n=_count(json_field(summary, "n_episodes", object, where), f"{where}.n_episodes"),
+        n=json_field(summary, "n_episodes", int, where),
         crash_rate=_estimate(summary, "crash_rate", "value", where),
         lane_change_rate=None
         if lc is None
@@ -275,9 +253,7 @@ def read_outcome_json(path: Path) -> OutcomeRecord:
     )
     step = data.get("spcp_step")
     return OutcomeRecord(
-        settings=dict(
-            _object(json_field(data, "settings", object, str(path)), f"{path}: settings")
-        ),
+        settings=dict(json_field(data, "settings", dict, str(path))),
         outcome=outcome,
         spcp_step=step if isinstance(step, int) and not isinstance(step, bool) else None,
     )
@@ -293,9 +269,7 @@ def read_ayss_json(path: Path) -> AyssRecord:
     data = read_json(path)
     name = json_field(data, "indicator_name", str, str(path))
     return AyssRecord(
-        settings=dict(
-            _object(json_field(data, "settings", object, str(path)), f"{path}: settings")
-        ),
+        settings=dict(json_field(data, "settings", dict, str(path))),
         indicator_name=name,
-        counts=dict(_object(json_field(data, "counts", object, str(path)), f"{path}: counts")),
+        counts=dict(json_field(data, "counts", dict, str(path))),
     )

@@ -9,12 +9,18 @@ Every column has a name, a dtype, a unit and a meaning (:class:`Column`);
   when ``nullable`` (an empty cell then also reads as NaN) and ±inf only when ``allow_inf``.
 * ``int``: decimal integer. ``bool``: ``0`` / ``1`` (``true`` / ``false`` accepted on read).
 * ``str``: the text; ``choices`` restricts it to a set (fixed, or a function's current
-  answer: the ``ayss.csv`` indicator names follow the case registry).
+  answer: the ``ayss.csv`` indicator names follow the case registry). A table of ``str``
+  columns (:func:`text_schema`: ``ranking.csv``, ``measures.csv``) reads every cell as
+  written, so a script that writes one back keeps every digit.
 
 :func:`write_table` writes atomically (temporary file in the same folder, then
-:func:`os.replace`), so a reader never sees half a table. :func:`read_table` checks the header
-(missing and extra columns), every cell's dtype, NaN / inf where they are not allowed, and
-the choices, and raises :class:`~sumo_ayss.util.errors.TableError` naming the file, column and row.
+:func:`os.replace`), so a reader never sees half a table; :func:`write_rows` writes rows of
+Python values under a header (the study files, ``eval.csv``, ``discriminability.csv``).
+:func:`read_table` is the one CSV reader of the run folder: it checks the header (missing and
+extra columns), every cell's dtype, NaN / inf where they are not allowed, and the choices,
+and raises a :class:`~sumo_ayss.util.errors.StoredFileError` (:class:`TableError` unless the
+caller names another, e.g. ``eval.csv``'s :class:`CheckpointError`) naming the file, column
+and row.
 
 The schemas of the run folder's tables are in :mod:`sumo_ayss.run_folder.schemas`.
 """
@@ -33,7 +39,7 @@ import numpy as np
 import numpy.typing as npt
 
 from sumo_ayss.util.atomic import atomic_write_text
-from sumo_ayss.util.errors import TableError
+from sumo_ayss.util.errors import StoredFileError, TableError
 
 __all__ = [
     "Column",
@@ -42,6 +48,8 @@ __all__ = [
     "read_table",
     "schema_markdown",
     "table_from_rows",
+    "text_schema",
+    "write_rows",
     "write_table",
 ]
 
@@ -68,9 +76,10 @@ class Column:
         allow_inf: ±inf allowed (float columns only).
         choices: Allowed values of a ``str`` column, or a function returning them (asked at
             each check); ``None`` = any text.
-        since: A column added after files were written (``nullable`` float only): a file
-            without it reads as all-NaN (the writer's version predates it, and the reader
-            says "not recorded"); one *with* it is checked like any other column.
+        since: A column added after files were written (a ``nullable`` float or a ``str``
+            column): a file without it reads as all-NaN, or all empty text (the writer's
+            version predates it, and the reader says "not recorded"); one *with* it is
+            checked like any other column.
     """
 
     name: str
@@ -83,8 +92,12 @@ class Column:
     since: bool = False
 
     def __post_init__(self) -> None:
-        if self.since and not (self.dtype == "float" and self.nullable):
-            raise ValueError(f"column {self.name}: 'since' needs a nullable float column")
+        if self.since and not ((self.dtype == "float" and self.nullable) or self.dtype == "str"):
+            raise ValueError(f"column {self.name}: 'since' needs a nullable float or str column")
+
+    def missing(self, n: int) -> npt.NDArray[Any]:
+        """The column of a table written before it existed: NaN, or empty text."""
+        return np.full(n, "", dtype=str) if self.dtype == "str" else np.full(n, math.nan)
 
     def allowed(self) -> tuple[str, ...] | None:
         """The allowed values now (:attr:`choices`, called when it is a function)."""
@@ -109,6 +122,12 @@ class TableSchema:
     def names(self) -> list[str]:
         """Column names in file order."""
         return [c.name for c in self.columns]
+
+
+def text_schema(name: str, columns: Sequence[str], added: Sequence[str] = ()) -> TableSchema:
+    """A schema of ``str`` columns (cells read as written); ``added`` are the columns a file
+    written before them lacks (read as empty)."""
+    return TableSchema(name, tuple(Column(c, "str", "-", c, since=c in added) for c in columns))
 
 
 def schema_markdown(schema: TableSchema) -> str:
@@ -138,10 +157,13 @@ class Table:
         schema: The schema the columns follow.
         columns: ``name -> array``, all the same length. Any array-like is accepted and
             stored as a numpy array of the column's dtype (int64, float64, bool or str).
+        n_dropped: Rows of the file left out because a cell was bad (a
+            :func:`read_table` with ``skip_bad_rows``; else 0).
     """
 
     schema: TableSchema
     columns: Mapping[str, Any]
+    n_dropped: int = 0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "columns", _coerce_columns(self.schema, self.columns))
@@ -150,7 +172,8 @@ class Table:
         return len(next(iter(self.columns.values()))) if self.columns else 0
 
     def __getitem__(self, name: str) -> npt.NDArray[Any]:
-        return self.columns[name]
+        column: npt.NDArray[Any] = self.columns[name]
+        return column
 
     def rows(self) -> Iterator[dict[str, Any]]:
         """Rows as dicts of Python scalars, in order."""
@@ -180,11 +203,16 @@ def table_from_rows(schema: TableSchema, rows: Sequence[Mapping[str, Any]]) -> T
         _check_names(schema, [*row, *(n for n in late if n not in row)], f"{schema.name} row {i}")
     return Table(
         schema,
-        {c.name: [row.get(c.name, math.nan) for row in rows] for c in schema.columns},
+        {
+            c.name: [row.get(c.name, "" if c.dtype == "str" else math.nan) for row in rows]
+            for c in schema.columns
+        },
     )
 
 
-def _check_names(schema: TableSchema, names: Sequence[str], where: str) -> None:
+def _check_names(
+    schema: TableSchema, names: Sequence[str], where: str, error: type[StoredFileError] = TableError
+) -> None:
     missing = [n for n in schema.names if n not in names]
     extra = [n for n in names if n not in schema.by_name]
     if missing or extra:
@@ -193,16 +221,16 @@ def _check_names(schema: TableSchema, names: Sequence[str], where: str) -> None:
             parts.append(f"missing column(s) {missing}")
         if extra:
             parts.append(f"unexpected column(s) {extra}")
-        raise TableError(f"{where}: {'; '.join(parts)} (schema {schema.name}: {schema.names})")
+        raise error(f"{where}: {'; '.join(parts)} (schema {schema.name}: {schema.names})")
 
 
 def _coerce_columns(schema: TableSchema, columns: Mapping[str, Any]) -> dict[str, npt.NDArray[Any]]:
     """Arrays of the schema's dtypes, checked for length, NaN, inf and choices; a column
     marked ``since`` that is left out is NaN throughout (not recorded), as in a file."""
-    late = [c.name for c in schema.columns if c.since and c.name not in columns]
+    late = [c for c in schema.columns if c.since and c.name not in columns]
     if late and columns:
         n = len(next(iter(columns.values())))
-        columns = {**columns, **{name: np.full(n, math.nan) for name in late}}
+        columns = {**columns, **{c.name: c.missing(n) for c in late}}
     _check_names(schema, list(columns), f"table {schema.name}")
     out: dict[str, npt.NDArray[Any]] = {}
     for col in schema.columns:
@@ -239,20 +267,22 @@ def _coerce_column(col: Column, values: Any, table: str) -> npt.NDArray[Any]:
     return arr.astype(_NUMPY_DTYPE[col.dtype])
 
 
-def _check_values(col: Column, arr: npt.NDArray[Any], where: str) -> None:
+def _check_values(
+    col: Column, arr: npt.NDArray[Any], where: str, error: type[StoredFileError] = TableError
+) -> None:
     """NaN / inf / choices rules of ``col`` on the already typed ``arr``."""
     if col.dtype == "float":
         bad_nan = np.flatnonzero(np.isnan(arr)) if not col.nullable else np.array([], int)
         if bad_nan.size:
-            raise TableError(f"{where}, column {col.name!r}, row {bad_nan[0]}: NaN not allowed")
+            raise error(f"{where}, column {col.name!r}, row {bad_nan[0]}: NaN not allowed")
         bad_inf = np.flatnonzero(np.isinf(arr)) if not col.allow_inf else np.array([], int)
         if bad_inf.size:
-            raise TableError(f"{where}, column {col.name!r}, row {bad_inf[0]}: inf not allowed")
+            raise error(f"{where}, column {col.name!r}, row {bad_inf[0]}: inf not allowed")
     allowed = col.allowed()
     if allowed is not None:
         bad = np.flatnonzero(~np.isin(arr, allowed))
         if bad.size:
-            raise TableError(
+            raise error(
                 f"{where}, column {col.name!r}, row {bad[0]}: {str(arr[bad[0]])!r} is not one of "
                 f"{list(allowed)}"
             )
@@ -291,55 +321,112 @@ def write_table(path: str | Path, table: Table) -> None:
 # --------------------------------------------------------------------------- reading
 
 
-def read_table(path: str | Path, schema: TableSchema) -> Table:
-    """Read a CSV written by :func:`write_table` and validate it against ``schema``.
+def write_rows(path: Path, columns: Sequence[str], rows: Sequence[Mapping[str, Any]]) -> None:
+    """Write ``rows`` under the header ``columns``, each cell as ``str()`` of its value (a
+    missing cell is written empty), atomically.
+
+    Raises:
+        ValueError: A row holds a column the file does not have.
+    """
+    unknown = sorted({k for r in rows for k in r} - set(columns))
+    if unknown:
+        raise ValueError(f"{path.name}: rows hold columns it does not have: {unknown}")
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=list(columns), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    atomic_write_text(path, buf.getvalue())
+
+
+# --------------------------------------------------------------------------- reading
+
+
+def read_table(
+    path: str | Path,
+    schema: TableSchema,
+    *,
+    error: type[StoredFileError] = TableError,
+    skip_bad_rows: bool = False,
+) -> Table:
+    """Read a CSV file of the run folder and validate it against ``schema``: the one reader.
 
     Args:
         path: The CSV file.
         schema: The schema it must follow (column order may differ; the set may not).
+        error: The :class:`~sumo_ayss.util.errors.StoredFileError` to raise (``eval.csv``,
+            a run's own record, raises :class:`CheckpointError`).
+        skip_bad_rows: Leave out a row with the wrong number of cells or a bad cell instead
+            of raising (counted in :attr:`Table.n_dropped`): a damaged learning curve is shown
+            without its bad rows.
 
     Returns:
         The validated :class:`Table` (columns in schema order).
 
     Raises:
-        TableError: If the file is missing, empty or not UTF-8 text, a column is missing or
-            unexpected, a row has the wrong number of cells, a cell does not parse as its
-            column's dtype, or a value breaks the column's NaN / inf / choices rules. The
-            message names the file, the column and the (0-based data) row.
+        StoredFileError: (``error``) If the file is missing, empty or not UTF-8 text, a column
+            is missing or unexpected, a row has the wrong number of cells, a cell does not
+            parse as its column's dtype, or a value breaks the column's NaN / inf / choices
+            rules. The message names the file, the column and the (0-based data) row.
     """
     path = Path(path)
     if not path.is_file():
-        raise TableError(f"{path}: table file not found")
+        raise error(f"{path}: table file not found")
     try:
         with path.open(newline="", encoding="utf-8") as f:
             rows = list(csv.reader(f))
     except UnicodeDecodeError as e:
-        raise TableError(f"{path}: not UTF-8 text, not a table ({e})") from None
+        raise error(f"{path}: not UTF-8 text, not a table ({e})") from None
     except (OSError, csv.Error) as e:
-        raise TableError(f"{path}: cannot read the table ({e})") from None
+        raise error(f"{path}: cannot read the table ({e})") from None
     if not rows:
-        raise TableError(f"{path}: empty file, expected a header with {schema.names}")
+        raise error(f"{path}: empty file, expected a header with {schema.names}")
     header, body = rows[0], rows[1:]
-    late = [c.name for c in schema.columns if c.since and c.name not in header]
-    _check_names(schema, header + late, str(path))
+    late = [c for c in schema.columns if c.since and c.name not in header]
+    _check_names(schema, header + [c.name for c in late], str(path), error)
     if len(set(header)) != len(header):
-        raise TableError(f"{path}: duplicate column names in header {header}")
-    for i, row in enumerate(body):
+        raise error(f"{path}: duplicate column names in header {header}")
+    kept = [row for row in body if _row_ok(schema, header, row, path)] if skip_bad_rows else body
+    for i, row in enumerate(kept):
         if len(row) != len(header):
-            raise TableError(f"{path}: row {i} has {len(row)} cells, header has {len(header)}")
+            raise error(f"{path}: row {i} has {len(row)} cells, header has {len(header)}")
+    columns = _typed_columns(schema, header, kept, path, error)
+    for col in late:  # written before the column existed
+        columns[col.name] = col.missing(len(kept))
+    table = {name: columns[name] for name in schema.names}
+    return Table(schema, table, n_dropped=len(body) - len(kept))
+
+
+def _typed_columns(
+    schema: TableSchema,
+    header: Sequence[str],
+    body: Sequence[Sequence[str]],
+    path: Path,
+    error: type[StoredFileError],
+) -> dict[str, npt.NDArray[Any]]:
     cells = list(zip(*body, strict=True)) if body else [() for _ in header]
     columns = {}
     for j, name in enumerate(header):
         col = schema.by_name[name]
-        arr = _parse_column(col, cells[j], path)
-        _check_values(col, arr, str(path))
+        arr = _parse_column(col, cells[j], path, error)
+        _check_values(col, arr, str(path), error)
         columns[name] = arr
-    for name in late:  # written before the column existed
-        columns[name] = np.full(len(body), np.nan)
-    return Table(schema, {name: columns[name] for name in schema.names})
+    return columns
 
 
-def _parse_column(col: Column, texts: Sequence[str], path: Path) -> npt.NDArray[Any]:
+def _row_ok(schema: TableSchema, header: Sequence[str], row: Sequence[str], path: Path) -> bool:
+    """Whether one row has its cells and every cell is valid."""
+    if len(row) != len(header):
+        return False
+    try:
+        _typed_columns(schema, header, [row], path, TableError)
+    except TableError:
+        return False
+    return True
+
+
+def _parse_column(
+    col: Column, texts: Sequence[str], path: Path, error: type[StoredFileError]
+) -> npt.NDArray[Any]:
     """Parse one column's cells, naming the first bad cell on failure."""
     if col.dtype == "str":
         return np.array(texts, dtype=str)
@@ -351,7 +438,7 @@ def _parse_column(col: Column, texts: Sequence[str], path: Path) -> npt.NDArray[
             elif t in _FALSE:
                 out[i] = False
             else:
-                raise _cell_error(path, col, i, t)
+                raise _cell_error(path, col, i, t, error)
         return out
     if col.dtype == "float" and col.nullable:
         texts = ["nan" if t.strip() == "" else t for t in texts]
@@ -364,9 +451,11 @@ def _parse_column(col: Column, texts: Sequence[str], path: Path) -> npt.NDArray[
         try:
             parse(t)
         except (TypeError, ValueError, OverflowError):
-            raise _cell_error(path, col, i, t) from None
-    raise TableError(f"{path}: column {col.name!r}: values do not parse as {col.dtype}")
+            raise _cell_error(path, col, i, t, error) from None
+    raise error(f"{path}: column {col.name!r}: values do not parse as {col.dtype}")
 
 
-def _cell_error(path: Path, col: Column, row: int, text: str) -> TableError:
-    return TableError(f"{path}: column {col.name!r}, row {row}: expected {col.dtype}, got {text!r}")
+def _cell_error(
+    path: Path, col: Column, row: int, text: str, error: type[StoredFileError]
+) -> StoredFileError:
+    return error(f"{path}: column {col.name!r}, row {row}: expected {col.dtype}, got {text!r}")

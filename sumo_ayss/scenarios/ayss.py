@@ -50,28 +50,29 @@ import numpy.typing as npt
 from tqdm import tqdm
 
 from sumo_ayss.analysis.metrics import ttc_longitudinal
-from sumo_ayss.cases import get_case
+from sumo_ayss.cases import CAR_FOLLOWING, CUT_IN, get_case
 from sumo_ayss.config import ActuatorConfig, AyssConfig
 from sumo_ayss.envs.car_following import target_speed_mps as cf_target_speed_mps
 from sumo_ayss.envs.cut_in import LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.run_folder import (
-    AYSS_SCHEMA,
-    INDICATOR_ACCEL,
-    INDICATOR_DELTA_V_BAR,
-    Table,
-)
+from sumo_ayss.run_folder import AYSS_SCHEMA, Table
 from sumo_ayss.scenarios.outcome import MeanInterval
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.sim.actuator import pov_acceleration
 from sumo_ayss.util.errors import ActionError, SimulationError
+
+#: Aggressiveness indicator of car-following: POV acceleration [m/s²], < 0 brakes.
+INDICATOR_ACCEL = CAR_FOLLOWING.indicator_column
+#: Aggressiveness indicator of cut-in: Δv̄ [m/s], < 0 closes in.
+INDICATOR_DELTA_V_BAR = CUT_IN.indicator_column
 
 __all__ = [
     "INDICATOR_ACCEL",
     "INDICATOR_DELTA_V_BAR",
     "AyssResult",
     "CutInStepResult",
+    "ayss_rows_table",
     "car_following_indicator",
     "car_following_rows",
     "cut_in_mask",
@@ -345,7 +346,7 @@ def _action_counts(actions: IntArray) -> dict[str, int]:
     return {str(int(v)): int(c) for v, c in zip(values, counts, strict=True)}
 
 
-def _rows(
+def ayss_rows_table(
     sample: IntArray,
     obs: npt.NDArray[np.float32],
     actions: IntArray,
@@ -356,6 +357,9 @@ def _rows(
     h_after: FloatArray,
     dvb_before: FloatArray,
 ) -> Table:
+    """The ``ayss.csv`` table of kept samples (indices ``sample`` into the draws; ``obs``,
+    ``actions``, ... one entry per kept sample); ``same_lane`` is the observation's 4th
+    column in cut-in, else 1."""
     n = len(sample)
     same_lane = obs[:, 3].astype(np.int64) if obs.shape[1] == 4 else np.ones(n, dtype=np.int64)
     return Table(
@@ -405,7 +409,7 @@ def car_following_rows(
         kept_obs[:, 0].astype(np.float64), actions, env.config.actuator
     )
     nan = np.full(len(critical), np.nan)
-    table = _rows(
+    table = ayss_rows_table(
         critical, kept_obs, actions, target, ttc[critical], INDICATOR_ACCEL, accel, nan, nan
     )
     return table, 0.0
@@ -434,7 +438,7 @@ def cut_in_rows(
         kept_obs[:, 2].astype(np.float64),
         progress=progress,
     )
-    table = _rows(
+    table = ayss_rows_table(
         idx,
         kept_obs,
         actions[keep],

@@ -9,7 +9,10 @@ the POV's actuator and its limits, exactly as the episodes are driven):
 
 * car-following: brake as hard as the actuator allows (target speed 0);
 * cut-in: change lane at once, then brake as hard as the actuator allows (target 0), or
-  change lane at once and hold the speed it has.
+  change lane at once and hold the speed it has;
+* lead-and-cut-in: the lead brakes as hard as it can, or the cut-in POV cuts in at once
+  and brakes or holds its speed, the other POV holding its speed (only the primary's
+  contact counts).
 
 A POV behind the VUT that drives into its rear is excluded (only contacts where the POV's
 centre was ahead of the VUT's at the decision before count): the VUT cannot be asked to
@@ -41,7 +44,7 @@ FULL_BRAKING = VehicleType(
     params={"length": 5.0, "width": 1.8, "minGap": 0.0},
     description="brakes at 0.85 g from the first step",
     controller=ControllerSpec(
-        target="sumo_ayss.vuts.reference:FullBraking",
+        target="full_braking",
         params={},
         max_accel_mps2=3.0,
         max_decel_mps2=0.85 * 9.81,
@@ -52,15 +55,9 @@ FULL_BRAKING = VehicleType(
 
 def pov_strategies(case: str) -> dict[str, tuple[int, ...]]:
     """The POV's worst plain behaviours of ``case``: name -> the first actions (the last
-    is held)."""
-    if get_case(case).lane_change:
-        from sumo_ayss.envs.cut_in import FIRST_SPEED_ACTION, LANE_CHANGE
-
-        return {
-            "cut in, brake": (LANE_CHANGE, FIRST_SPEED_ACTION),
-            "cut in, hold speed": (LANE_CHANGE,),
-        }
-    return {"brake": (0,)}
+    is held); the case's env's :attr:`~sumo_ayss.envs.pair_env.PairEnv.ICS_STRATEGIES`."""
+    env_class: type[PairEnv] = get_case(case).env_class()
+    return dict(env_class.ICS_STRATEGIES)
 
 
 def _collides(env: PairEnv, ic: InitialCondition, actions: Sequence[int]) -> bool:
@@ -72,8 +69,8 @@ def _collides(env: PairEnv, ic: InitialCondition, actions: Sequence[int]) -> boo
     while True:
         _o, _r, term, trunc, info = env.step(actions[min(k, len(actions) - 1)])
         k += 1
-        if term:
-            return before > -half_lengths
+        if term:  # a case with several POVs: the primary's contact only
+            return bool(info["collision"]) and before > -half_lengths
         if trunc:
             return False
         before = float(info["headway_m"])

@@ -263,3 +263,28 @@ def run_outcome(
     table = outcome_table(scenarios, episodes)
     summary = summarize_outcome(table, base.config.case, level)
     return OutcomeResult(table, summary, seed, n, wall, tuple(scenarios), tuple(episodes))
+
+
+def supporting_pov_summary(episodes: Sequence[EpisodeResult]) -> dict[str, Any] | None:
+    """``outcome.json``'s ``supporting_pov`` section of a case with a second POV
+    (``lead_and_cut_in``), else None: the share of episodes the POVs ended by a forbidden
+    contact, and per safety measure against the supporting POV its median and smallest
+    value over the episodes (finite values only; None where there is none)."""
+    support = [e.support_measures for e in episodes if e.support_measures is not None]
+    if not support:
+        return None
+    rows = [m.as_row() for m in support]
+    measures: dict[str, dict[str, float | None]] = {}
+    for name in rows[0]:
+        values = np.array([r[name] for r in rows], dtype=np.float64)
+        finite = values[np.isfinite(values)]
+        measures[name] = {
+            "median": float(np.median(finite)) if finite.size else None,
+            "min": float(finite.min()) if finite.size else None,
+            "n_finite": int(finite.size),
+        }
+    return {
+        "n": len(episodes),
+        "pov_failure_rate": float(np.mean([e.pov_failure for e in episodes])),
+        "measures": measures,
+    }

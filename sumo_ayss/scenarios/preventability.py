@@ -31,7 +31,6 @@ between would shift SUMO's per-vehicle random streams of stochastic VUTs).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -41,9 +40,9 @@ import numpy as np
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
+from sumo_ayss.envs.reference import reference_config
 from sumo_ayss.util.errors import ConfigError
-from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE, REFERENCE_VUTS
-from sumo_ayss.vuts.vtype_params import CONTROLLED_BODY_PARAMS
+from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
 
 __all__ = [
     "DEFAULT_REFERENCE",
@@ -57,37 +56,6 @@ __all__ = [
 #: Label values of the ``crash_preventable`` column (NaN: no crash, or not labelled).
 LABEL_PREVENTABLE = 1.0
 LABEL_UNPREVENTABLE = 0.0
-
-
-def reference_config(
-    config: EnvConfig,
-    reference: str,
-    *,
-    own_body: bool = False,
-    params: Mapping[str, Any] | None = None,
-) -> EnvConfig:
-    """``config`` with the reference driver ``reference`` in the VUT's place and body.
-
-    The reference's catalog entry (:data:`~sumo_ayss.vuts.reference_types.REFERENCE_VUTS`) keeps its
-    controller; its body (length, width, ...) is the VUT's where the VUT gives one, so that
-    the replay's geometry is the original's (``own_body``: the reference's own 5 m x 1.8 m
-    body instead, for its own row in cross-play). Entered into the catalog under
-    ``reference``.
-    """
-    if reference not in REFERENCE_VUTS:
-        raise ConfigError(
-            f"reference driver must be one of {sorted(REFERENCE_VUTS)}, got {reference!r}"
-        )
-    ref = REFERENCE_VUTS[reference]
-    body = {k: v for k, v in config.vut_type.params.items() if k in CONTROLLED_BODY_PARAMS}
-    if own_body:
-        body = {}
-    vt = dataclasses.replace(ref, params={**ref.params, **body})
-    if params and vt.controller is not None:
-        controller = dataclasses.replace(vt.controller, params={**vt.controller.params, **params})
-        vt = dataclasses.replace(vt, controller=controller)
-    vuts = {**config.vuts, reference: vt}
-    return dataclasses.replace(config, vuts=vuts, vut=reference)
 
 
 def counterfactual_collides(env: PairEnv, ic: InitialCondition, actions: Sequence[int]) -> bool:
@@ -104,7 +72,8 @@ def counterfactual_collides(env: PairEnv, ic: InitialCondition, actions: Sequenc
         _obs, _r, terminated, truncated, info = base.step(action)
         k += 1
         if terminated or truncated:
-            return bool(info["collision"])
+            # A case with several POVs says whether the VUT touched any of them.
+            return bool(info.get("vut_contact", info["collision"]))
 
 
 def label_crashes(

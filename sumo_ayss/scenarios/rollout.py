@@ -20,7 +20,7 @@ from sumo_ayss.analysis.hazards import HAZARD_NAMES, HazardMeasures
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES, EpisodeMeasures
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.scenarios.trajectory import hazards_of, measures_of
+from sumo_ayss.scenarios.trajectory import hazards_of, measures_of, support_measures_of
 
 Policy = Callable[[npt.NDArray[np.float32]], npt.NDArray[np.integer]]
 
@@ -46,6 +46,10 @@ class EpisodeResult:
             (:mod:`sumo_ayss.scenarios.preventability`).
         hazards: What the VUT did to the traffic behind it (:mod:`sumo_ayss.analysis.
             hazards`; ``None`` where not recorded).
+        support_measures: The measures against a case's second (supporting) POV
+            (``lead_and_cut_in``); ``None`` in a case with one POV or where not recorded.
+        pov_failure: The episode ended by a contact the POVs were not allowed (a supporting
+            POV touching the VUT, or two POVs touching); always False with one POV.
     """
 
     episode_return: float
@@ -59,6 +63,8 @@ class EpisodeResult:
     measures: EpisodeMeasures | None = field(default=None, compare=False)
     actions: tuple[int, ...] = field(default=(), compare=False)
     hazards: HazardMeasures | None = field(default=None, compare=False)
+    support_measures: EpisodeMeasures | None = field(default=None, compare=False)
+    pov_failure: bool = field(default=False, compare=False)
 
     def measure_row(self) -> dict[str, float]:
         """The measures as table columns (NaN throughout when not recorded)."""
@@ -113,7 +119,14 @@ def run_episode(env: PairEnv, policy: Policy, ic: InitialCondition) -> EpisodeRe
     result = episode_result(rewards, infos)
     measures = measures_of(base.config, reset_info, infos)
     hazards = hazards_of(base.config, reset_info, infos)
-    return dataclasses.replace(result, measures=measures, actions=tuple(actions), hazards=hazards)
+    return dataclasses.replace(
+        result,
+        measures=measures,
+        actions=tuple(actions),
+        hazards=hazards,
+        support_measures=support_measures_of(base.config, reset_info, infos),
+        pov_failure=bool(infos[-1].get("pov_failure", False)),
+    )
 
 
 def episode_result(rewards: Sequence[float], infos: Sequence[Mapping[str, Any]]) -> EpisodeResult:
@@ -126,7 +139,7 @@ def episode_result(rewards: Sequence[float], infos: Sequence[Mapping[str, Any]])
     changed = False
     for reward, info in zip(rewards, infos, strict=True):
         total += float(reward)
-        if not info["collision"]:
+        if not info.get("contact", info["collision"]):  # a case with several POVs: any
             pay += float(reward)
         speed_sum += float(info["vut_speed_mps"])
         changed = changed or bool(info.get("lane_change_started", False))

@@ -22,8 +22,9 @@ Body widths come from the vehicle types, SUMO's default 1.8 m where a type gives
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -117,3 +118,47 @@ def hazards_of(
     (:func:`~sumo_ayss.analysis.hazards.episode_hazards`)."""
     tr = trajectory_from_infos(config, reset_info, infos)
     return episode_hazards(tr, follower_of(reset_info, infos))
+
+
+class SecondPovTrack(NamedTuple):
+    """A second POV's samples over one episode (case ``lead_and_cut_in``): front-bumper
+    lane position [m], world y of the front bumper's centre [m], speed [m/s]."""
+
+    x_m: np.ndarray
+    y_m: np.ndarray
+    speed_mps: np.ndarray
+
+
+def second_pov_of(
+    reset_info: Mapping[str, Any], infos: Sequence[Mapping[str, Any]]
+) -> SecondPovTrack | None:
+    """The second (supporting) POV's samples of one episode, or None when it had none."""
+    if "support_pos_m" not in reset_info:
+        return None
+    samples = [reset_info, *infos]
+
+    def col(key: str) -> np.ndarray:
+        return np.array([float(s[key]) for s in samples])
+
+    return SecondPovTrack(col("support_pos_m"), col("support_y_m"), col("support_speed_mps"))
+
+
+def support_measures_of(
+    config: EnvConfig, reset_info: Mapping[str, Any], infos: Sequence[Mapping[str, Any]]
+) -> EpisodeMeasures | None:
+    """The safety measures of the VUT against the supporting POV (the case's second POV,
+    in the POV's body), or None in a case with one POV: the measures per POV (issue 39)."""
+    track = second_pov_of(reset_info, infos)
+    if track is None:
+        return None
+    samples = [reset_info, *infos]
+    lateral = np.array([float(s.get("support_lateral_speed_mps", 0.0)) for s in samples])
+    tr = dataclasses.replace(
+        trajectory_from_infos(config, reset_info, infos),
+        pov_x_m=track.x_m,
+        pov_y_m=track.y_m,
+        pov_speed_mps=track.speed_mps,
+        pov_lat_speed_mps=lateral,
+        collided=bool(infos[-1].get("support_vut_contact", False)) if infos else False,
+    )
+    return episode_measures(tr)

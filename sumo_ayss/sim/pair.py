@@ -17,12 +17,12 @@ import contextlib
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import libsumo
 from libsumo import _libsumo
 
 from sumo_ayss.sim.follower import VUT_INSERT_POS_WITH_FOLLOWER_M, Follower
+from sumo_ayss.sim.sensing import SensedObject, VutSensing, sense_extra_povs
 from sumo_ayss.sim.session import SUMO_ERRORS, SumoSession
 from sumo_ayss.util.errors import SimulationError
 
@@ -105,6 +105,9 @@ class VehiclePair:
         self._follower_type = follower_type
         #: This episode's follower, or None (no follower in this episode).
         self.follower: Follower | None = None
+        #: Ids of further POVs beside the pair (:mod:`sumo_ayss.sim.second_pov`), which a
+        #: controller VUT's sensors see like the POV; empty in the one-POV cases.
+        self.extra_povs: tuple[str, ...] = ()
 
     # ------------------------------------------------------------------ episode set-up
 
@@ -422,9 +425,14 @@ class VehiclePair:
             objects = (
                 SensedObject(gap, offset, pov_speed - vut_speed, lateral, pov_length, pov_width),
             )
+        leader = (math.inf, math.nan)
         if abs(d) < reach and pov_pos > vut_pos and gap <= range_m:
-            return VutSensing(time_s, vut_speed, vut_lane, gap, pov_speed, objects, lane_width)
-        return VutSensing(time_s, vut_speed, vut_lane, math.inf, math.nan, objects, lane_width)
+            leader = (gap, pov_speed)
+        if self.extra_povs:
+            leader, objects = sense_extra_povs(
+                self.extra_povs, self.vut, range_m, (centres, widths), leader, objects
+            )
+        return VutSensing(time_s, vut_speed, vut_lane, leader[0], leader[1], objects, lane_width)
 
     def _lane_geometry(self) -> tuple[list[float], list[float]]:
         """Lateral centre of each lane of the edge from lane 0's centre [m] (+ left), widths."""
@@ -445,49 +453,3 @@ _get_lateral_speed = _libsumo.vehicle_getLateralSpeed
 _get_lateral_lane_pos = _libsumo.vehicle_getLateralLanePosition
 _move_to_xy = libsumo.vehicle.moveToXY
 _set_previous_speed = libsumo.vehicle.setPreviousSpeed
-
-
-class VutSensing(NamedTuple):
-    """A reading of the VUT's own sensors (:meth:`VehiclePair.vut_sensing`).
-
-    Attributes:
-        time_s: Simulation time of the reading [s] (SUMO's time after the last step).
-        speed_mps: The VUT's speed [m/s].
-        lane_index: The VUT's lane (0 = rightmost).
-        gap_m: Bumper-to-bumper gap to the leader [m], leader rear minus VUT front;
-            ``inf`` without a leader.
-        leader_speed_mps: The leader's speed [m/s]; NaN without a leader.
-        objects: The other vehicles within sensor range, in any lane (an object list).
-        lane_width_m: Width of the VUT's lane [m]; NaN where unknown.
-    """
-
-    time_s: float
-    speed_mps: float
-    lane_index: int
-    gap_m: float
-    leader_speed_mps: float
-    objects: tuple[SensedObject, ...] = ()
-    lane_width_m: float = math.nan
-
-
-class SensedObject(NamedTuple):
-    """One vehicle of the VUT's object list, in the VUT's road frame.
-
-    Attributes:
-        gap_m: Longitudinal gap [m], the object's rear bumper minus the VUT's front bumper:
-            > 0 ahead; <= 0 while the object is beside (or behind) the VUT's front.
-        lateral_offset_m: The object's centre line from the centre line of the VUT's lane
-            [m], + = left (0: centred in the VUT's lane; about one lane width: centred in
-            the next lane).
-        rel_speed_mps: Object's longitudinal speed minus the VUT's [m/s]; < 0 closing in.
-        lateral_speed_mps: Object's lateral speed relative to the VUT [m/s], + = left.
-        length_m: Object's length [m].
-        width_m: Object's width [m].
-    """
-
-    gap_m: float
-    lateral_offset_m: float
-    rel_speed_mps: float
-    lateral_speed_mps: float
-    length_m: float
-    width_m: float

@@ -2,14 +2,16 @@
 
 ``checkpoints/step_XXXXXXXXX/`` holds the candidate's ``model.zip`` (a plain SB3 zip, the
 policy that evaluation and selection use). The *latest* checkpoint also holds what a resume
-needs (:data:`~sumo_ayss.run_folder.RESUME_FILES`, ``state.json``, ``torch_rng.pt``): the
+needs (:data:`~sumo_ayss.training.checkpoint_files.RESUME_FILES`, ``state.json``,
+``torch_rng.pt``): the
 full model with its optimizer, the replay buffer, the counters, the episode anchor (the env
 state at the candidate plus the actions taken since) and every RNG. ``latest.json`` points at
 it and is written last, so a kill at any moment leaves a resumable folder.
 
-The file names, ``state.json``, ``latest.json`` and ``eval.csv`` are
-:mod:`sumo_ayss.run_folder`'s (their one writer and reader); this module holds what goes into
-them and the SB3/torch serialisation of the model, the buffer and torch's RNG.
+The file names, ``state.json`` and ``latest.json`` are
+:mod:`sumo_ayss.training.checkpoint_files`'s (their one writer and reader), ``eval.csv``
+:mod:`sumo_ayss.run_folder`'s; this module holds what goes into them and the SB3/torch
+serialisation of the model, the buffer and torch's RNG.
 """
 
 from __future__ import annotations
@@ -26,15 +28,14 @@ from stable_baselines3.common.vec_env import VecEnv
 
 from sumo_ayss.agents.dqn import AyssDQN
 from sumo_ayss.agents.weights import read_policy_state
-from sumo_ayss.run_folder import (
-    CHECKPOINTS_DIR,
+from sumo_ayss.run_folder import RunFolder, read_eval_table
+from sumo_ayss.training.checkpoint_files import (
     LATEST_JSON,
     REPLAY_PKL,
     RESUME_FILES,
     RESUME_MODEL_ZIP,
     STATE_JSON,
     TORCH_RNG_PT,
-    read_eval_table,
     read_latest,
     write_checkpoint_state,
 )
@@ -161,7 +162,11 @@ def earlier_candidates(run_dir: Path, eval_path: Path, step: int) -> list[dict[s
     rows = [r for r in read_eval_table(eval_path) if r["step"] <= step]
     for row in rows:  # every earlier candidate must still be a readable policy
         ckpt = Path(str(row["checkpoint"]))
-        if ckpt.is_absolute() or ".." in ckpt.parts or ckpt.parts[:1] != (CHECKPOINTS_DIR,):
+        if (
+            ckpt.is_absolute()
+            or ".." in ckpt.parts
+            or ckpt.parts[:1] != (RunFolder(run_dir).checkpoints.name,)
+        ):
             raise CheckpointError(
                 f"{eval_path}: step {row['step']}: checkpoint must be a path "
                 f"under checkpoints/, got {str(ckpt)!r}"

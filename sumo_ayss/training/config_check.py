@@ -1,7 +1,7 @@
 """Whether a run folder may be resumed with a requested configuration.
 
 A resume must compute what the run started to compute: the run's identity
-(:func:`~sumo_ayss.run_folder.identity.run_identity`: every field of the experiment, the
+(:func:`~sumo_ayss.config.identity.run_identity`: every field of the experiment, the
 seed and the run's own VUT's definition; not the other VUTs of the study's catalog, not the
 VUT's name, not display options such as the progress bar) must match: the training stage's
 inputs (:class:`~sumo_ayss.run_folder.TrainStage`). A refusal names each differing field
@@ -11,8 +11,8 @@ with its stored and requested value.
 from __future__ import annotations
 
 from sumo_ayss.config import ExperimentConfig
+from sumo_ayss.config.identity import identity_differences
 from sumo_ayss.run_folder import RunFolder, stored_experiment
-from sumo_ayss.run_folder.identity import identity_differences
 from sumo_ayss.util.errors import CheckpointError
 
 __all__ = ["check_same_config", "config_differences", "stored_differences"]

@@ -17,10 +17,8 @@ from sumo_ayss.run_folder import (
     RunConfig,
     RunFolder,
     Seeds,
-    write_command,
+    write_provenance,
     write_run_config,
-    write_seeds,
-    write_versions,
 )
 from sumo_ayss.util.paths import portable_python
 
@@ -64,6 +62,5 @@ def write_metadata(
     # (the pipeline resumes a folder with config.yaml; checkpoints/ alone is refused).
     write_run_config(folder.config, RunConfig(cfg.env.vut, seed, cfg.to_dict()))
     folder.checkpoints.mkdir(exist_ok=True)
-    write_command(folder.command, shlex.join([portable_python(), "-m", ENTRY_MODULE, *argv]))
-    write_versions(folder.versions, versions())
-    write_seeds(folder.seeds, Seeds(seed, seed, cfg.train.eval_seed))
+    command = shlex.join([portable_python(), "-m", ENTRY_MODULE, *argv])
+    write_provenance(folder, command, versions(), Seeds(seed, seed, cfg.train.eval_seed))

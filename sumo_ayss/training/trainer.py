@@ -61,20 +61,16 @@ from sumo_ayss.config import (
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.envs.vec_env import PairVecEnv
-from sumo_ayss.run_folder import (
-    EVAL_COLUMNS,
-    MODEL_ZIP,
-    STATE_JSON,
-    RunFolder,
-    read_checkpoint_state,
-    run_dir_for,
-    write_eval_table,
-    write_latest,
-    write_spcp,
-)
+from sumo_ayss.run_folder import EVAL_SCHEMA, RunFolder, StudyFolder, write_eval_table, write_spcp
 from sumo_ayss.scenarios.rollout import summarize
 from sumo_ayss.training import checkpoint
 from sumo_ayss.training.callback import CandidateCallback
+from sumo_ayss.training.checkpoint_files import (
+    LATEST_JSON,
+    STATE_JSON,
+    read_checkpoint_state,
+    write_latest,
+)
 from sumo_ayss.training.collectors import (
     Collector,
     PairsCollector,
@@ -202,7 +198,7 @@ class Trainer:
         step = model.num_timesteps
         step_dir = self.folder.step_dir(step)
         step_dir.mkdir(parents=True, exist_ok=True)
-        checkpoint.atomic_model_save(model, step_dir / MODEL_ZIP)
+        checkpoint.atomic_model_save(model, self.folder.candidate_model(step))
 
         results, wall = self.collector.evaluate(model, self.scenarios, rollout)
         env_state = self.collector.anchor()
@@ -210,7 +206,7 @@ class Trainer:
 
         row: dict[str, Any] = {"step": step, **summary.as_dict(), "wall_s": round(wall, 3)}
         row["checkpoint"] = self.folder.checkpoint_model(step_dir)
-        row = {k: row[k] for k in EVAL_COLUMNS}
+        row = {k: row[k] for k in EVAL_SCHEMA.names}
         self.rows.append(row)
         model.logger.record("eval/mean_return", summary.mean_return)
         model.logger.record("eval/crash_rate", summary.crash_rate)
@@ -256,7 +252,7 @@ class Trainer:
         checkpoint.save_resume_state(
             model, step_dir, self.next_eval, self._anchor, self._actions_since_anchor
         )
-        write_latest(self.folder.latest, step_dir)
+        write_latest(self.folder.checkpoints / LATEST_JSON, step_dir)
         self._pending_dir = None
         checkpoint.prune_resume_files(self.ckpt_dir, step_dir)
 
@@ -378,7 +374,7 @@ def train(
     check_device(cfg.train.device)  # before the run folder exists
     seed = check_seed(seed, "--seed")
     check_out_dir(Path(out), "--out")
-    folder = RunFolder(run_dir_for(out, cfg.env.case, cfg.env.vut, seed))
+    folder = StudyFolder(out).run(cfg.env.case, cfg.env.vut, seed)
     run_dir = folder.path
     if resume:
         if not folder.config.is_file():

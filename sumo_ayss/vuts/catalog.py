@@ -222,7 +222,7 @@ def _paper_idm(min_gap_m: float, spacing_m: float) -> VehicleType:
 
 
 def _hwenv_idm(distance_wanted_m: float) -> VehicleType:
-    # highway-env's own IDMVehicle law (sumo_ayss.hwenv_laws), not SUMO's IDM: centre-to-
+    # highway-env's own IDMVehicle law (sumo_ayss.laws.hwenv), not SUMO's IDM: centre-to-
     # centre distance, no zero clamp in the desired gap, +-6 m/s^2 clip, v0 = speed at the
     # episode start (clipped to 30 m/s), 15 Hz Euler. Body: highway-env's 5 m x 2 m.
     return VehicleType(
@@ -233,7 +233,7 @@ def _hwenv_idm(distance_wanted_m: float) -> VehicleType:
             "(centre to centre; the paper's s0)"
         ),
         controller=ControllerSpec(
-            target="sumo_ayss.hwenv_laws:HighwayEnvIDM",
+            target="highway_env_idm",
             params={"distance_wanted_m": distance_wanted_m},
             max_accel_mps2=6.0,
             max_decel_mps2=6.0,

@@ -27,24 +27,72 @@ from typing import Any, ClassVar
 
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.frozen import FrozenMap
+from sumo_ayss.util.registry import Registry
 from sumo_ayss.util.validation import check_keys
 from sumo_ayss.vuts.vtype_params import as_number
 
 __all__ = [
+    "CONTROLLERS",
     "DEFAULT_CALL_DEADLINE_S",
     "TARGET_ALIASES",
     "ControllerSpec",
     "check_imports_allowed",
     "controller_imports",
+    "identity_target",
+    "registered_target",
 ]
 
-#: Controller targets stored under a name that is no longer a module path -> the class they
-#: name now. Run folders' ``config.yaml`` keep the name they were written with (it is part of
-#: the run's identity and fingerprints), so a moved class keeps its old name here instead of
-#: a module left behind at the old path: ``sumo_ayss.hwenv_laws`` moved into ``laws/``.
+#: The package's own controllers by registered name -> the class each names
+#: (``"module:attr"``). A configuration (and so every run folder's ``config.yaml`` written
+#: from now) names one of them by this name as its ``controller.target``, never by a module
+#: path: a class may move without the stored configs changing.
+CONTROLLERS: Registry[str] = Registry("controller")
+for _name, _path in (
+    ("highway_env_idm", "sumo_ayss.laws.hwenv:HighwayEnvIDM"),
+    ("careful_driver", "sumo_ayss.vuts.reference:CarefulDriver"),
+    ("fuzzy_safety_driver", "sumo_ayss.vuts.reference:FuzzySafetyDriver"),
+    ("rss_driver", "sumo_ayss.vuts.reference:RssDriver"),
+    ("full_braking", "sumo_ayss.vuts.reference:FullBraking"),
+    ("over_braker", "sumo_ayss.vuts.overbraking:OverBraker"),
+):
+    CONTROLLERS.register(_name, _path)
+
+#: Targets stored by run folders written before the registered names (module paths, one of
+#: them, ``sumo_ayss.hwenv_laws``, no longer a module) -> the registered name they mean.
+#: A :class:`ControllerSpec` read with one of them holds the registered name; the first path
+#: of each name is also the form run identities and definition keys are computed over
+#: (:func:`identity_target`), so records written before keep matching.
 TARGET_ALIASES: Mapping[str, str] = FrozenMap(
-    {"sumo_ayss.hwenv_laws:HighwayEnvIDM": "sumo_ayss.laws.hwenv:HighwayEnvIDM"}
+    {
+        "sumo_ayss.hwenv_laws:HighwayEnvIDM": "highway_env_idm",
+        "sumo_ayss.laws.hwenv:HighwayEnvIDM": "highway_env_idm",
+        "sumo_ayss.vuts.reference:CarefulDriver": "careful_driver",
+        "sumo_ayss.vuts.reference:FuzzySafetyDriver": "fuzzy_safety_driver",
+        "sumo_ayss.vuts.reference:RssDriver": "rss_driver",
+        "sumo_ayss.vuts.reference:FullBraking": "full_braking",
+        "sumo_ayss.vuts.overbraking:OverBraker": "over_braker",
+    }
 )
+
+_KEYED_AS: dict[str, str] = {}  # registered name -> the first path it was stored as
+for _path, _name in TARGET_ALIASES.items():
+    _KEYED_AS.setdefault(_name, _path)
+
+
+def registered_target(target: str) -> str:
+    """A stored ``controller.target`` as a configuration names it now: an old module path
+    of a registered controller (:data:`TARGET_ALIASES`) -> its registered name; anything
+    else (a registered name, a user's ``module:attr`` or ``file.py:attr``) unchanged."""
+    return TARGET_ALIASES.get(target, target) if isinstance(target, str) else target
+
+
+def identity_target(target: str) -> str:
+    """The form of ``target`` that run identities and VUT definition keys are computed over
+    (:mod:`sumo_ayss.run_folder.identity`): a registered name that run folders stored as a
+    module path before keeps that path's form, so their fingerprints, ``crossplay.json``'s
+    ``vut_keys`` and ``adaptive.json`` still match; any other target as it is."""
+    return _KEYED_AS.get(target, target)
+
 
 #: Default per-call deadline of every VUT kind [s] (``call_deadline_s``): a VUT that takes
 #: longer than this for one step stops the run with a :class:`ControllerError`.
@@ -73,11 +121,13 @@ class ControllerSpec:
             max_decel_mps2: 6.0
 
     Attributes:
-        target: ``"package.module:attr"`` (imported with :mod:`importlib`; the module must be
-            importable, e.g. from the working directory or an installed package) or
-            ``"path/to/file.py:attr"`` (a file; relative to the YAML file that names it).
-            ``attr`` may be dotted (``module:Outer.Inner``); it must name a class with an
-            ``acceleration(state)`` method, checked before the class is instantiated.
+        target: A registered controller of the package (:data:`CONTROLLERS`, e.g.
+            ``"highway_env_idm"``; an old module path of one, :data:`TARGET_ALIASES`, is read
+            as its name), ``"package.module:attr"`` (imported with :mod:`importlib`; the
+            module must be importable, e.g. from the working directory or an installed
+            package) or ``"path/to/file.py:attr"`` (a file; relative to the YAML file that
+            names it). ``attr`` may be dotted (``module:Outer.Inner``); it must name a class
+            with an ``acceleration(state)`` method, checked before the class is instantiated.
         max_accel_mps2: Largest acceleration the vehicle can realise [m/s²], > 0.
         max_decel_mps2: Largest deceleration the vehicle can realise [m/s²], a positive
             number (commands below ``-max_decel_mps2`` are clipped to it).
@@ -103,6 +153,7 @@ class ControllerSpec:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", FrozenMap(dict(self.params)))
+        object.__setattr__(self, "target", registered_target(self.target))
 
     @property
     def label(self) -> str:
@@ -141,10 +192,11 @@ class ControllerSpec:
         built from ``params``, when an env that drives this VUT is built (:meth:`build`,
         at the start of a run, so a wrong target or parameter still fails before training).
         """
-        if not isinstance(self.target, str) or ":" not in self.target:
+        registered = isinstance(self.target, str) and CONTROLLERS.find(self.target) is not None
+        if not registered and (not isinstance(self.target, str) or ":" not in self.target):
             raise ConfigError(
-                f"{where}.target must be 'package.module:attr' or 'file.py:attr', "
-                f"got {self.target!r}"
+                f"{where}.target must be a registered controller {list(CONTROLLERS.names())}, "
+                f"'package.module:attr' or 'file.py:attr', got {self.target!r}"
             )
         self.check_limits(where)
         if not isinstance(self.params, Mapping):
@@ -158,13 +210,14 @@ class ControllerSpec:
                 (``controller_imports(False)``: a run folder opened untrusted), or it is not
                 a class with a callable ``acceleration`` (``subprocess:getoutput`` is not).
         """
-        if not self.target.startswith("sumo_ayss."):  # the package's own is always allowed
+        path = CONTROLLERS.find(self.target) or self.target  # a registered name: its class
+        if not path.startswith("sumo_ayss."):  # the package's own is always allowed
             check_imports_allowed(
                 f"{where}.target {self.target!r}",
                 "a user controller, and importing it",
                 " (the package's own, sumo_ayss.*, is always allowed)",
             )
-        module_part, _, attr_part = TARGET_ALIASES.get(self.target, self.target).rpartition(":")
+        module_part, _, attr_part = path.rpartition(":")
         try:
             module = _import(module_part)
         except Exception as e:  # any error while importing user code

@@ -16,13 +16,14 @@ __all__ = ["DEFAULT_REFERENCE", "OVERBRAKER_VUT", "REFERENCE_VUTS"]
 
 
 def _reference(target: str, description: str, max_decel_mps2: float) -> VehicleType:
+    # ``target``: the controller's registered name (sumo_ayss.vuts.controller_spec.CONTROLLERS).
     # A reference driver of sumo_ayss.vuts.reference in SUMO's passenger body (5 m x 1.8 m).
     return VehicleType(
         model="IDM",
         params={"length": 5.0, "width": 1.8, "minGap": 0.0},
         description=description,
         controller=ControllerSpec(
-            target=f"sumo_ayss.vuts.reference:{target}",
+            target=target,
             params={},
             max_accel_mps2=3.0,
             max_decel_mps2=max_decel_mps2,
@@ -40,15 +41,15 @@ def _reference(target: str, description: str, max_decel_mps2: float) -> VehicleT
 REFERENCE_VUTS: Mapping[str, VehicleType] = FrozenMap(
     {
         "cc_driver": _reference(
-            "CarefulDriver",
+            "careful_driver",
             "R157 competent and careful human driver (reaction 0.75 s, 0.774 g in 0.6 s, AEB)",
             0.85 * 9.81,
         ),
         "fsm": _reference(
-            "FuzzySafetyDriver", "JRC Fuzzy Safety Model (Mattas et al. 2020)", 0.774 * 9.81
+            "fuzzy_safety_driver", "JRC Fuzzy Safety Model (Mattas et al. 2020)", 0.774 * 9.81
         ),
         "rss": _reference(
-            "RssDriver", "RSS longitudinal proper response (rho 1 s, b_min 4 m/s²)", 8.0
+            "rss_driver", "RSS longitudinal proper response (rho 1 s, b_min 4 m/s²)", 8.0
         ),
     }
 )
@@ -63,7 +64,7 @@ OVERBRAKER_VUT = VehicleType(
     params={"length": 5.0, "width": 1.8, "minGap": 0.0},
     description="brakes at 6 m/s² whenever a leader is within 2 s (issue 33's over-braker)",
     controller=ControllerSpec(
-        target="sumo_ayss.vuts.overbraking:OverBraker",
+        target="over_braker",
         params={},
         max_accel_mps2=2.0,
         max_decel_mps2=6.0,

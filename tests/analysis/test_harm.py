@@ -198,7 +198,7 @@ def test_the_braking_ladder_in_cut_in_ranks_d9_d6_d45() -> None:
     """The committed cut-in cross-play table of the braking ladder (issue 22): harm ranks
     d9 > d6 > d45 (more braking authority is safer)."""
     from sumo_ayss.analysis.crossplay_scoring import score_crossplay
-    from sumo_ayss.run_folder import read_crossplay_table
+    from sumo_ayss.run_folder.crossplay import read_crossplay_table
 
     table = read_crossplay_table(Path(BRAKING_CUT_IN))
     m = score_crossplay(table.columns, HarmScale(MAX_PAY, ALPHA_C))

@@ -36,7 +36,7 @@ from sumo_ayss.config import (
 from sumo_ayss.run_folder import AYSS_SCHEMA, RunFolder, Table, write_table
 from sumo_ayss.util.errors import ConfigError
 
-BUILTIN = ("car_following", "cut_in")
+BUILTIN = ("car_following", "cut_in", "lead_and_cut_in")
 
 TOY = Case(
     name="toy_merge",
@@ -75,7 +75,11 @@ def toy() -> Iterator[Case]:
 def test_builtin_cases_are_registered_in_order() -> None:
     assert case_names() == BUILTIN
     assert [c.name for c in registered_cases()] == list(BUILTIN)
-    assert indicator_columns() == ("pov_accel_mps2", "delta_v_bar_mps")
+    assert indicator_columns() == (
+        "pov_accel_mps2",
+        "delta_v_bar_mps",
+        "delta_v_bar_primary_mps",
+    )
     assert case_of_indicator("delta_v_bar_mps") == "cut_in" and case_of_indicator("x") is None
 
 
@@ -92,6 +96,7 @@ def test_the_case_package_is_a_leaf() -> None:
         "sumo_ayss.cases",
         "sumo_ayss.cases.car_following",
         "sumo_ayss.cases.cut_in",
+        "sumo_ayss.cases.lead_and_cut_in",
         "sumo_ayss.cases.registry",
         "sumo_ayss.util",  # a docstring only (tests/test_layers.py checks it)
         "sumo_ayss.util.registry",  # the registry type, shared with the ranking modes
@@ -104,7 +109,9 @@ def test_get_case_names_the_registered_cases() -> None:
     assert get_case("cut_in").lanes == 2
     with pytest.raises(ConfigError, match=r"unknown case 'cut-in' \(did you mean 'cut_in'\?\); "):
         get_case("cut-in")
-    with pytest.raises(ConfigError, match=r"allowed: \['car_following', 'cut_in'\]"):
+    with pytest.raises(
+        ConfigError, match=r"allowed: \['car_following', 'cut_in', 'lead_and_cut_in'\]"
+    ):
         get_case("merge")
 
 
@@ -165,7 +172,9 @@ def test_builtin_cases_match_their_envs() -> None:
 
 def test_configuration_accepts_a_registered_case(toy: Case) -> None:
     assert EnvConfig(case=toy.name).case == toy.name
-    with pytest.raises(ConfigError, match=r"\['car_following', 'cut_in', 'toy_merge'\]"):
+    with pytest.raises(
+        ConfigError, match=r"\['car_following', 'cut_in', 'lead_and_cut_in', 'toy_merge'\]"
+    ):
         EnvConfig(case="toy")
     with pytest.raises(ConfigError, match=r"highway_env in toy_merge: the POV's free lateral"):
         EnvConfig(case=toy.name, actuator=ActuatorConfig(mode="highway_env"))
@@ -175,8 +184,8 @@ def test_configuration_accepts_a_registered_case(toy: Case) -> None:
         sim=SimConfig(lateral_resolution_m=0.1),
     )
     assert GridConfig(cases=(toy.name,)).cases == (toy.name,)
-    pipeline = PipelineConfig()  # the default grid runs every registered case
-    assert pipeline.grid.cases == (*BUILTIN, toy.name)
+    pipeline = PipelineConfig()  # the default grid: every registered case but the opt-in
+    assert pipeline.grid.cases == ("car_following", "cut_in", toy.name)
     assert pipeline.experiments[toy.name].name == "toy_merge.yaml"
 
 

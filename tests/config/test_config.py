@@ -57,7 +57,10 @@ def test_round_trip_through_plain_dict(tmp_path: Path) -> None:
         ({"rewrd": {}}, r"unknown key 'rewrd' \(did you mean 'reward'\?\)"),
         ({"odd": {"gap_m": [10, 2]}}, r"env\.odd\.gap_m must have min <= max"),
         ({"odd": {"gap_m": [1, 2, 3]}}, r"env\.odd\.gap_m must have 2 items"),
-        ({"case": "merge"}, r"env\.case must be one of \['car_following', 'cut_in'\]"),
+        (
+            {"case": "merge"},
+            r"env\.case must be one of \['car_following', 'cut_in', 'lead_and_cut_in'\]",
+        ),
         (
             {"vut": "pi3"},
             r"env\.vut must be one of \['hwenv_pi1', 'hwenv_pi2', 'pi1', 'pi2'\], got 'pi3'",

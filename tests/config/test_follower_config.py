@@ -47,13 +47,7 @@ def test_bad_follower_input_is_named(section, message) -> None:  # type: ignore[
 
 def test_a_controller_is_not_a_follower() -> None:
     with pytest.raises(ConfigError, match=r"env\.follower\.vtype"):
-        env_config_from_mapping(
-            {
-                "follower": {
-                    "vtype": {"controller": {"target": "sumo_ayss.vuts.reference:FullBraking"}}
-                }
-            }
-        )
+        env_config_from_mapping({"follower": {"vtype": {"controller": {"target": "full_braking"}}}})
 
 
 def test_direct_construction_checks_too() -> None:

@@ -42,4 +42,4 @@ def test_a_grid_may_name_a_reference_driver(tmp_path: Path) -> None:
     jobs = plan_jobs(load_pipeline(path))
     cc = [j for j in jobs if j.vut == "cc_driver"]
     assert cc and cc[0].experiment.env.vut_type.controller is not None
-    assert cc[0].experiment.env.vut_type.controller.target.endswith(":CarefulDriver")
+    assert cc[0].experiment.env.vut_type.controller.target == "careful_driver"

@@ -11,13 +11,8 @@ import pytest
 
 from sumo_ayss.config import ExperimentConfig, TrainConfig
 from sumo_ayss.grid.progress import GridProgress, JobStatus, format_duration
-from sumo_ayss.run_folder import (
-    PROGRESS_JSON,
-    RunFolder,
-    read_run,
-    write_eval_table,
-    write_progress,
-)
+from sumo_ayss.run_folder import RunFolder, read_run, write_eval_table, write_progress
+from sumo_ayss.run_folder.layout import PROGRESS_JSON
 
 
 @dataclass(frozen=True)

@@ -122,4 +122,4 @@ def test_paper_fidelity_pipeline_plans_the_grid() -> None:
         assert env.actuator.mode == "highway_env"
         assert env.odd.vut_speed_mps == (0.0, 40.0)
         controller = env.vuts[job.vut].controller
-        assert controller is not None and controller.target.endswith(":HighwayEnvIDM")
+        assert controller is not None and controller.target == "highway_env_idm"

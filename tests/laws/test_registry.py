@@ -63,14 +63,15 @@ def test_the_catalogs_highway_env_vuts_are_integrated() -> None:
 
 def test_the_target_committed_run_folders_store_still_resolves() -> None:
     """``results/*/config.yaml`` name highway-env's IDM by its old root path; the module
-    moved into ``laws/`` and the alias table resolves the stored name to its class."""
+    moved into ``laws/``, a configuration names it by its registered name, and the alias
+    table reads the stored path as that name."""
     stored = "sumo_ayss.hwenv_laws:HighwayEnvIDM"
-    assert stored == HIGHWAY_ENV_IDM_TARGET
+    assert HIGHWAY_ENV_IDM_TARGET == "highway_env_idm"
     root = Path(__file__).resolve().parents[2]
     assert stored in (root / "results/paper/cut_in/pi1/seed_0/config.yaml").read_text()
     assert not (root / "sumo_ayss/hwenv_laws.py").exists()
     spec = ControllerSpec(stored, 3.0, 6.0, params={})
-    assert spec.resolve() is HighwayEnvIDM
+    assert spec.target == HIGHWAY_ENV_IDM_TARGET and spec.resolve() is HighwayEnvIDM
 
 
 def test_controllers_are_built_fresh_per_env_from_their_params() -> None:

@@ -19,6 +19,7 @@ from sumo_ayss.analysis.ranking import (
 from sumo_ayss.analysis.significance import PairVerdict
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes.paper import (
+    PaperResult,
     pair_sentence,
     paper_headline,
     significance_rule,
@@ -150,21 +151,28 @@ def test_significance_rule_names_the_level_and_alpha() -> None:
 
 def test_paper_headline_words_the_verdict_record() -> None:
     pair = PairVerdict(_verdict(True, 0.01), True, "A", 0.05)
-    a = SimpleNamespace(ranking=[_ranked("A", 1), _ranked("B", 2)])
-    v = paper_verdict("paper", a.ranking, [pair])
+    ranking = [_ranked("A", 1), _ranked("B", 2)]
+    v = paper_verdict("paper", ranking, [pair])
+    a = _analysis(PaperResult(v, ranking=ranking, pairs=[pair]))
     assert paper_headline(a, v) == "[paper mode] " + pair_sentence(pair)
-    v = paper_verdict("paper", a.ranking, [pair], premise_met=False)
+    v = paper_verdict("paper", ranking, [pair], premise_met=False)
     assert paper_headline(a, v).endswith("does not isolate the VUTs' safety.")
-    one = SimpleNamespace(ranking=[_ranked("A", 1)])
-    assert paper_headline(one, paper_verdict("paper", one.ranking, [])) == (
+    only = [_ranked("A", 1)]
+    one = _analysis(PaperResult(paper_verdict("paper", only, []), ranking=only))
+    assert paper_headline(one, paper_verdict("paper", only, [])) == (
         "[paper mode] No verdict yet: only A has AYSS samples; a verdict needs two VUTs."
     )
     assert paper_headline(a, CaseVerdict("paper", "warning", missing="no_samples")) == (
         "[paper mode] No verdict yet: no VUT of this case has AYSS samples (ayss.csv)."
     )
-    assert paper_headline(a, paper_verdict("paper", a.ranking, [])).startswith(
+    assert paper_headline(a, paper_verdict("paper", ranking, [])).startswith(
         "[paper mode] No verdict: the safety indices of the top two VUTs are not comparable."
     )
+
+
+def _analysis(result: PaperResult) -> SimpleNamespace:
+    """As much of a case's analysis as the headline reads: the paper mode's result."""
+    return SimpleNamespace(case="car_following", results={"paper": result})
 
 
 def _ranked(name: str, rank: int) -> RankedVut:

@@ -8,7 +8,6 @@ import sys
 
 import pytest
 
-from sumo_ayss.analysis.case import CROSSPLAY_MODE, EXPOSURE_MODE, PAPER_MODE
 from sumo_ayss.config.report import DEFAULT_MODE as CONFIG_DEFAULT_MODE
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import (
@@ -32,11 +31,6 @@ from tests.report.test_report import make_run
 def test_built_in_modes_in_registry_order_with_the_default_first() -> None:
     assert mode_names()[:3] == ("crossplay", "exposure", "paper")
     assert DEFAULT_MODE == CROSSPLAY.name == ReportOptions().mode == CONFIG_DEFAULT_MODE
-    assert (CROSSPLAY.name, EXPOSURE.name, PAPER.name) == (
-        CROSSPLAY_MODE,
-        EXPOSURE_MODE,
-        PAPER_MODE,
-    )
     assert get_mode("paper") is PAPER
     assert CROSSPLAY.runs_crossplay and not EXPOSURE.runs_crossplay
     assert PAPER.needs_safety_index and not CROSSPLAY.needs_safety_index
@@ -88,6 +82,31 @@ def test_a_new_mode_is_one_record_that_config_and_rank_pick_up(tmp_path) -> None
     finally:
         unregister_mode("own_harm")
     assert "own_harm" not in mode_names()
+
+
+def test_the_case_analysis_holds_the_cases_data_and_one_result_per_mode(tmp_path) -> None:
+    """No field of :class:`CaseAnalysis` is one mode's: each built-in mode keeps its own
+    result (its own type, in ``modes/``) under its name in ``results``."""
+    from sumo_ayss.analysis.case import CaseAnalysis
+    from sumo_ayss.modes.crossplay import CrossplayResult, crossplay_result
+    from sumo_ayss.modes.exposure import ExposureResult
+    from sumo_ayss.modes.paper import PaperResult
+
+    names = {f.name for f in dataclasses.fields(CaseAnalysis)}
+    assert names == {
+        *("case", "info", "runs", "options", "tables", "bootstrap"),  # the case's data
+        *("verdict", "problems", "mode", "results"),
+    }
+    assert not any(n.startswith(m) for n in names for m in mode_names())
+    dirs = [make_run(tmp_path, "car_following", v, s) for v in ("pi1", "pi2") for s in (0, 1)]
+    (a,) = analyse(dirs, ReportOptions(mode="exposure", n_boot=50))
+    assert list(a.results) == list(mode_names())
+    kinds = {"crossplay": CrossplayResult, "exposure": ExposureResult, "paper": PaperResult}
+    assert all(isinstance(a.results[name], kind) for name, kind in kinds.items())
+    assert crossplay_result(a).gap is not None  # no cross-play table handed in
+    a.results.pop("crossplay")
+    with pytest.raises(ConfigError, match="no crossplay-mode result"):
+        crossplay_result(a)
 
 
 def test_the_registry_loads_without_the_analysis() -> None:

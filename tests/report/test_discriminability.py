@@ -16,7 +16,8 @@ from sumo_ayss.report.sections.discriminability import (
     pair_summary,
     read_record,
 )
-from sumo_ayss.run_folder import DISCRIMINABILITY_JSON, CaseFolder
+from sumo_ayss.run_folder import CaseFolder
+from sumo_ayss.run_folder.layout import DISCRIMINABILITY_JSON
 from tests.report.test_report import FAST, make_run
 
 

@@ -11,14 +11,8 @@ from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.rank import analyse
 from sumo_ayss.report import write_report
 from sumo_ayss.report.measures import write_measures
-from sumo_ayss.run_folder import (
-    CROSSPLAY_SCHEMA,
-    MEASURES_CSV,
-    OUTCOME_SCHEMA,
-    Table,
-    read_table,
-    write_table,
-)
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA, Table, read_table, write_table
+from sumo_ayss.run_folder.study import MEASURES_CSV
 from tests.report.test_report import FAST, make_crossplay, make_run
 
 

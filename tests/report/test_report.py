@@ -18,7 +18,7 @@ from sumo_ayss.analysis.ranking import POV_ACCELERATION, SafetyIndex
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.config import RewardConfig, to_dict
 from sumo_ayss.modes import headline_text
-from sumo_ayss.modes.crossplay import crossplay_gap_text
+from sumo_ayss.modes.crossplay import crossplay_gap_text, crossplay_result
 from sumo_ayss.modes.paper import pair_sentence
 from sumo_ayss.report import (
     ReportOptions,
@@ -28,11 +28,8 @@ from sumo_ayss.report import (
 )
 from sumo_ayss.report.__main__ import main
 from sumo_ayss.run_folder import (
-    AYSS_CSV,
     AYSS_SCHEMA,
     CROSSPLAY_SCHEMA,
-    EVAL_CSV,
-    OUTCOME_JSON,
     OUTCOME_SCHEMA,
     CaseFolder,
     RunConfig,
@@ -40,15 +37,16 @@ from sumo_ayss.run_folder import (
     StageHeader,
     Table,
     find_run_dirs,
-    load_crossplay,
     read_run,
     write_eval_table,
     write_outcome_json,
     write_run_config,
     write_spcp,
     write_table,
-    write_versions,
 )
+from sumo_ayss.run_folder.crossplay import load_crossplay
+from sumo_ayss.run_folder.layout import AYSS_CSV, EVAL_CSV, OUTCOME_JSON
+from sumo_ayss.run_folder.metadata import write_versions
 from sumo_ayss.scenarios.outcome import MeanInterval, OutcomeSummary, Proportion
 from sumo_ayss.training.selection import Selection
 from sumo_ayss.vuts.catalog import BUILTIN_VUTS
@@ -483,20 +481,23 @@ def test_crossplay_needs_two_vuts_and_a_table_of_these_runs(tmp_path: Path) -> N
     root = tmp_path / "runs"
     dirs = [make_run(root, "cut_in", "pi1", s) for s in range(2)]
     one = analyse_case("cut_in", group_runs([read_run(d) for d in dirs])["cut_in"], FAST)
-    assert one.crossplay_gap == CrossplayGap("one_vut", vut="pi1") and not one.crossplay_rows
-    assert "one VUT only (pi1)" in crossplay_gap_text(one.crossplay_gap)
+    gap = crossplay_result(one).gap
+    assert gap == CrossplayGap("one_vut", vut="pi1") and not crossplay_result(one).rows
+    assert "one VUT only (pi1)" in crossplay_gap_text(gap)
     assert headline_text(one).startswith("[crossplay mode] no cross-play for this case")
     assert one.ranking_mode == "exposure" and one.verdict.kind == "warning"
     dirs += [make_run(root, "cut_in", "pi2", s) for s in range(2)]
     make_crossplay(root / "cut_in", ["pi1", "pi2"], range(3))  # a seed these runs lack
     runs = group_runs([read_run(d) for d in dirs])["cut_in"]
     stale = analyse_case("cut_in", runs, FAST, crossplay=scored_crossplay(runs))
-    assert stale.crossplay_gap is not None and stale.ranking_mode == "exposure"
-    assert (stale.crossplay_gap.reason, stale.crossplay_gap.n_runs) == ("not_these_runs", 4)
-    assert "is not of these runs" in crossplay_gap_text(stale.crossplay_gap)
+    gap = crossplay_result(stale).gap
+    assert gap is not None and stale.ranking_mode == "exposure"
+    assert (gap.reason, gap.n_runs) == ("not_these_runs", 4)
+    assert "is not of these runs" in crossplay_gap_text(gap)
     without = analyse_case("cut_in", runs, FAST)  # no table handed in
-    assert without.crossplay_gap == CrossplayGap("not_found")
-    assert "no cross-play table for this case" in crossplay_gap_text(without.crossplay_gap)
+    gap = crossplay_result(without).gap
+    assert gap == CrossplayGap("not_found")
+    assert "no cross-play table for this case" in crossplay_gap_text(gap)
 
 
 def test_the_loader_hands_analysis_the_crossplay_table_or_why_there_is_none(tmp_path: Path) -> None:
@@ -514,13 +515,15 @@ def test_the_loader_hands_analysis_the_crossplay_table_or_why_there_is_none(tmp_
     found = scored_crossplay(runs)
     assert found.matrix is not None and found.path == path and found.matrix.vuts == ("pi1", "pi2")
     a = analyse_case("cut_in", runs, FAST, crossplay=found)
-    assert a.crossplay is found.matrix and a.crossplay_path == path and a.crossplay_rows
+    result = crossplay_result(a)
+    assert result.matrix is found.matrix and result.path == path and result.rows
     path.write_text("vut,opponent_vut\npi1,pi1\n")
     broken = scored_crossplay(runs)
     assert broken.matrix is None and "unreadable" in broken.missing
     a = analyse_case("cut_in", runs, FAST, crossplay=broken)
-    assert a.crossplay_gap == CrossplayGap("not_found", loader=broken.missing)
-    assert crossplay_gap_text(a.crossplay_gap) == broken.missing and broken.problem in a.problems
+    gap = crossplay_result(a).gap
+    assert gap == CrossplayGap("not_found", loader=broken.missing)
+    assert crossplay_gap_text(gap) == broken.missing and broken.problem in a.problems
     other = make_run(tmp_path / "elsewhere", "cut_in", "pi2", 5)
     mixed = group_runs([read_run(d) for d in [*dirs, other]])["cut_in"]
     assert "several case folders" in scored_crossplay(mixed).missing

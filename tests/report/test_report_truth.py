@@ -12,12 +12,15 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from sumo_ayss.modes import analyse_case
+from sumo_ayss.modes.crossplay import crossplay_result
 from sumo_ayss.modes.formatting import fmt_num
+from sumo_ayss.modes.paper import paper_result
 from sumo_ayss.report import write_report
 from sumo_ayss.report.crossplay_figure import crossplay_lines
 from sumo_ayss.report.figstyle import set_wrapped_title, style
 from sumo_ayss.report.leaderboard import leaderboard_rows, leaderboard_table, leaderboard_text
-from sumo_ayss.run_folder import load_crossplay, read_run
+from sumo_ayss.run_folder import read_run
+from sumo_ayss.run_folder.crossplay import load_crossplay
 from tests.report.test_report import FAST, make_crossplay, make_run
 
 
@@ -51,10 +54,11 @@ def test_crossplay_caption_claim_matches_the_plotted_lines(tmp_path: Path) -> No
     runs = _runs(tmp_path, "car_following", ("pi1", "pi2"), range(3))
     make_crossplay(tmp_path / "car_following", ["pi1", "pi2"], range(3))
     a = analyse_case("car_following", runs, FAST, crossplay=scored_crossplay(runs))
-    assert a.crossplay is not None and a.crossplay_rows[0].vs_next is not None
-    assert a.crossplay_rows[0].vs_next.significant  # the ranking is a finding here
-    order = [r.name for r in a.crossplay_rows]
-    lines = crossplay_lines(order, a.crossplay.harm, a.crossplay.vuts)
+    result = crossplay_result(a)
+    assert result.matrix is not None and result.rows[0].vs_next is not None
+    assert result.rows[0].vs_next.significant  # the ranking is a finding here
+    order = [r.name for r in result.rows]
+    lines = crossplay_lines(order, result.matrix.harm, result.matrix.vuts)
     # What the figure draws, left to right: safest first, so the mean over opponents rises.
     assert np.all(np.diff(lines.mean(axis=0)) > 0)
     rising = int(np.sum(np.all(np.diff(lines, axis=1) > 0, axis=1)))
@@ -158,8 +162,9 @@ def test_paper_mode_leaderboard_reads_the_safety_index(tmp_path: Path) -> None:
     a = analyse_case("car_following", runs, ReportOptions(mode="paper", n_boot=300))
     rows = leaderboard_rows(a)
     assert a.ranking_mode == "paper"
-    assert [r.vut for r in rows] == [r.name for r in a.ranking]
-    assert rows[0].score == fmt_num(a.ranking[0].point)
+    ranking = paper_result(a).ranking
+    assert [r.vut for r in rows] == [r.name for r in ranking]
+    assert rows[0].score == fmt_num(ranking[0].point)
     table = leaderboard_table(a, 0.95)
     assert table is not None and "m/s²" in table.headers[3]  # the unit, in the score's header
     assert "Welch t, p" in rows[0].vs_next and rows[-1].vs_next == "—"

@@ -11,7 +11,8 @@ import pytest
 import yaml
 
 from sumo_ayss.analysis.harm import harm_scale_of, run_episodes
-from sumo_ayss.run_folder import OUTCOME_CSV, RunRecord, read_run
+from sumo_ayss.run_folder import RunRecord, read_run
+from sumo_ayss.run_folder.layout import OUTCOME_CSV
 from sumo_ayss.util.errors import CheckpointError
 from tests.report.test_report import make_run
 

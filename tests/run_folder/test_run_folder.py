@@ -25,40 +25,42 @@ from sumo_ayss.run_folder import (
     Seeds,
     StageHeader,
     Table,
-    case_dir_for,
     find_run_dirs,
     read_ayss_json,
-    read_checkpoint_state,
-    read_command,
     read_crossplay_json,
     read_done_marker,
     read_eval_table,
-    read_latest,
     read_outcome_json,
     read_progress,
     read_run,
     read_run_config,
-    read_seeds,
-    read_spcp,
     read_table,
-    read_versions,
-    run_dir_for,
     write_ayss_json,
-    write_checkpoint_state,
-    write_command,
     write_crossplay_json,
     write_done_marker,
     write_eval_table,
-    write_latest,
     write_outcome_json,
     write_progress,
+    write_provenance,
     write_run_config,
-    write_seeds,
     write_spcp,
     write_table,
-    write_versions,
+)
+from sumo_ayss.run_folder.layout import case_dir_for, run_dir_for
+from sumo_ayss.run_folder.metadata import (
+    read_command,
+    read_seeds,
+    read_spcp,
+    read_versions,
 )
 from sumo_ayss.scenarios.outcome import MeanInterval, OutcomeSummary, Proportion
+from sumo_ayss.training.checkpoint_files import (
+    LATEST_JSON,
+    read_checkpoint_state,
+    read_latest,
+    write_checkpoint_state,
+    write_latest,
+)
 from sumo_ayss.training.selection import Selection
 from sumo_ayss.util.errors import CheckpointError, TableError
 from sumo_ayss.vuts.catalog import BUILTIN_VUTS
@@ -128,14 +130,13 @@ def run_folder(tmp_path: Path) -> RunFolder:
     }
     train = {"total_timesteps": 10000, "eval_every": 5000}
     write_run_config(folder.config, RunConfig("pi2", 3, {"env": env, "train": train}))
-    write_command(folder.command, "python -m sumo_ayss.train --seed 3")
-    write_versions(folder.versions, {"python": "3.11.2", "numpy": "2.0.0"})
-    write_seeds(folder.seeds, Seeds(3, 3, 2024))
+    command, versions = "python -m sumo_ayss.train --seed 3", {"python": "3.11.2", "numpy": "2.0.0"}
+    write_provenance(folder, command, versions, Seeds(3, 3, 2024))
     rows = _eval_rows(folder)
     write_eval_table(folder.eval_table, rows)
     step_dir = folder.step_dir(10000)
     step_dir.mkdir()
-    write_latest(folder.latest, step_dir)
+    write_latest(folder.checkpoints / LATEST_JSON, step_dir)
     write_checkpoint_state(step_dir / "state.json", {"num_timesteps": 10000, "next_eval": 15000})
     choice = Selection(1, 10000, 11.0, "mean_reward", "the best")
     write_spcp(folder.spcp_json, choice, str(rows[1]["checkpoint"]), rows[1])
@@ -186,7 +187,7 @@ def test_every_file_reads_back_as_written(run_folder: RunFolder) -> None:
     assert {k: v for k, v in rows[0].items() if k != "std_return"} == {
         k: v for k, v in expected[0].items() if k != "std_return"
     }
-    assert read_latest(f.latest) == (10000, "step_000010000")
+    assert read_latest(f.checkpoints / LATEST_JSON) == (10000, "step_000010000")
     assert read_checkpoint_state(f.step_dir(10000) / "state.json")["next_eval"] == 15000
     spcp = read_spcp(f.spcp_json)
     assert (spcp.step, spcp.score, spcp.criterion, spcp.reason) == (
@@ -246,6 +247,11 @@ def test_readers_name_the_file_and_field(run_folder: RunFolder) -> None:
     f.outcome_json.write_text('{"settings": {}, "summary": {"n_episodes": 2}}')
     with pytest.raises(TableError, match=r"outcome\.json: summary: missing field 'crash_rate'"):
         read_outcome_json(f.outcome_json)
+    f.outcome_json.write_text(
+        '{"settings": {}, "summary": {"n_episodes": 2, "crash_rate": {"value": "x"}}}'
+    )
+    with pytest.raises(TableError, match=r"summary\.crash_rate: value: expected int or float"):
+        read_outcome_json(f.outcome_json)
     f.seeds.write_text('{"train_seed": 1, "sumo_seed": "x", "eval_seed": 2}')
     with pytest.raises(CheckpointError, match=r"seeds\.json: sumo_seed: expected int, got 'x'"):
         read_seeds(f.seeds)
@@ -262,7 +268,7 @@ def test_one_json_reader_one_error_family(tmp_path: Path) -> None:
     message whichever reader meets it, as a ``StoredFileError`` (the base of the
     ``TableError`` of summaries and the ``CheckpointError`` of a run's own records)."""
     from sumo_ayss.run_folder.adaptive import read_adaptive
-    from sumo_ayss.run_folder.metadata import read_checkpoint_state, read_latest
+    from sumo_ayss.training.checkpoint_files import read_checkpoint_state, read_latest
     from sumo_ayss.util.errors import StoredFileError
 
     readers = [read_outcome_json, read_seeds, read_spcp, read_latest, read_checkpoint_state]
@@ -289,6 +295,37 @@ def test_one_json_reader_one_error_family(tmp_path: Path) -> None:
     bad.write_text('{"format": 1, "looks": [{"n_seeds": true}]}')
     with pytest.raises(TableError, match=r"adaptive\.json: looks\[0\]: n_seeds: expected int"):
         read_adaptive(bad)
+
+
+def test_one_csv_reader_one_error_family(run_folder: RunFolder, tmp_path: Path) -> None:
+    """Every stored CSV file (the episode tables, ``eval.csv``, the study's ``ranking.csv``
+    and ``measures.csv``) is read by ``table.read_table``: the same messages, naming the file,
+    the column and the row, as a ``StoredFileError`` (``eval.csv``, a run's own record,
+    raises ``CheckpointError``; the others ``TableError``)."""
+    from sumo_ayss.run_folder.study import read_measures_csv, read_ranking_csv
+    from sumo_ayss.util.errors import StoredFileError
+
+    f = run_folder
+    rows = read_eval_table(f.eval_table)
+    lines = f.eval_table.read_text().splitlines()
+    f.eval_table.write_text("\n".join([*lines, lines[2].replace(",100,", ",two,")]) + "\n")
+    with pytest.raises(CheckpointError, match=r"eval\.csv: column 'n_episodes', row 2: expected"):
+        read_eval_table(f.eval_table)
+    kept = read_eval_table(f.eval_table, skip_bad_rows=True)
+    assert [r["step"] for r in kept] == [r["step"] for r in rows] == [5000, 10000]
+    curve = read_run(f.path).eval_curve
+    assert curve is not None and curve.n_dropped == 1 and len(curve) == 2
+    f.eval_table.write_text("\n".join([*lines, lines[2].replace(",3.25,", ",inf,")]) + "\n")
+    with pytest.raises(CheckpointError, match=r"eval\.csv, column 'wall_s', row 2: inf not"):
+        read_eval_table(f.eval_table)
+    assert read_eval_table(tmp_path / "eval.csv") == []  # not written yet: no candidate
+    for reader in (read_ranking_csv, read_measures_csv):
+        path = tmp_path / "study.csv"
+        path.write_text("case\n")
+        with pytest.raises(TableError, match=r"study\.csv: missing column\(s\) \['"):
+            reader(path)
+        with pytest.raises(StoredFileError, match=r"x\.csv: table file not found"):
+            reader(tmp_path / "x.csv")
 
 
 def test_config_yaml_holds_the_vut_once_and_legacy_folders_still_read(tmp_path: Path) -> None:
@@ -368,3 +405,12 @@ def test_adaptive_record_round_trips_and_refuses_another_layout(tmp_path: Path) 
     path.write_text('{"format": 1, "looks": "x"}')
     with pytest.raises(TableError, match=r"adaptive\.json: looks: expected list, got .x."):
         read_adaptive(path)
+
+
+def test_each_file_of_a_folder_is_named_once(tmp_path: Path) -> None:
+    """A folder record's attribute is the file's path on a folder and, on the class, the
+    descriptor that names it (what a help text or a heading quotes)."""
+    folder = RunFolder(tmp_path)
+    assert folder.outcome_json == tmp_path / "outcome.json"
+    assert RunFolder.outcome_json.name == folder.outcome_json.name == "outcome.json"
+    assert CaseFolder.crossplay_csv.name == "crossplay.csv"

@@ -9,22 +9,24 @@ from pathlib import Path
 import pytest
 
 from sumo_ayss.run_folder import (
-    MEASURES_COLUMNS,
-    RANKING_COLUMNS,
     CaseFolder,
     OrderCheck,
     OrderChecks,
     StudyFolder,
     read_discriminability_json,
-    read_measures_csv,
-    read_order_check,
-    read_pipeline_json,
-    read_ranking_csv,
     write_discriminability,
     write_measures_csv,
     write_order_check,
     write_pipeline_json,
     write_ranking_csv,
+)
+from sumo_ayss.run_folder.study import (
+    MEASURES_COLUMNS,
+    RANKING_COLUMNS,
+    read_measures_csv,
+    read_order_check,
+    read_pipeline_json,
+    read_ranking_csv,
 )
 from sumo_ayss.util.errors import TableError
 
@@ -81,12 +83,12 @@ def test_ranking_csv_of_older_studies_and_broken_files(tmp_path: Path) -> None:
     assert rows and rows[0]["vut"] == "pi2" and rows[0]["crash_rate"] == rows[0]["timid"] == ""
     path = tmp_path / "ranking.csv"
     path.write_text("case,mode,rank\ncut_in,crossplay,1\n")
-    with pytest.raises(TableError, match=r"ranking\.csv: missing columns \['vut'"):
+    with pytest.raises(TableError, match=r"ranking\.csv: missing column\(s\) \['vut'"):
         read_ranking_csv(path)
     path.write_text(",".join(RANKING_COLUMNS) + "\ncut_in,crossplay\n")
-    with pytest.raises(TableError, match=r"ranking\.csv, line 2: expected 23 cells"):
+    with pytest.raises(TableError, match=r"ranking\.csv: row 0 has 2 cells, header has 23"):
         read_ranking_csv(path)
-    with pytest.raises(TableError, match="unreadable"):
+    with pytest.raises(TableError, match=r"missing\.csv: table file not found"):
         read_ranking_csv(tmp_path / "missing.csv")
 
 

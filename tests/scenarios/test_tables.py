@@ -15,13 +15,12 @@ from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     OUTCOME_SCHEMA,
     Table,
-    read_json,
     read_table,
-    schema_markdown,
     table_from_rows,
-    write_json,
     write_table,
 )
+from sumo_ayss.run_folder.jsonio import read_json, write_json
+from sumo_ayss.run_folder.table import schema_markdown
 from sumo_ayss.util.errors import AyssError, TableError
 
 

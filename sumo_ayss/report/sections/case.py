@@ -16,9 +16,9 @@ from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import get_mode, headline_text, registered_modes
 from sumo_ayss.modes.formatting import fmt_num, ranking_line
+from sumo_ayss.modes.paper import paper_result
 from sumo_ayss.report import figures
 from sumo_ayss.report.blocks import Block, Callout, FigureBlock, Heading, Paragraph, Table
-from sumo_ayss.report.checks import training_status
 from sumo_ayss.report.sections.common import display_path
 from sumo_ayss.report.sections.crossplay import crossplay_blocks
 from sumo_ayss.report.sections.discriminability import discriminability_blocks
@@ -32,6 +32,7 @@ from sumo_ayss.report.sections.outcome import (
 from sumo_ayss.report.sections.paper import paper_blocks
 from sumo_ayss.report.sections.reference import reference_blocks
 from sumo_ayss.run_folder import RunRecord
+from sumo_ayss.training.trust import training_status
 
 __all__ = ["case_blocks", "verdict_lines"]
 
@@ -73,7 +74,7 @@ def verdict_lines(a: CaseAnalysis[RunRecord], options: ReportOptions) -> tuple[s
     if v.order:
         lines.append(f"Ranking ({v.mode} mode), safest first: {ranking_line(v.order, v.apart)}")
     lines += get_mode(a.ranking_mode).companion_lines(a)
-    lines.append(premise_sentence(a.premise, options))
+    lines.append(premise_sentence(paper_result(a).premise, options))
     lines += get_mode(a.mode).closing_lines(a)
     return tuple(lines)
 

@@ -8,7 +8,14 @@ from collections.abc import Sequence
 from sumo_ayss.analysis.harm import VutOutcome
 from sumo_ayss.analysis.ranking import SafetyIndex
 from sumo_ayss.analysis.seeds import SeedComparison
-from sumo_ayss.modes.formatting import fmt_interval, fmt_num, fmt_p, fmt_prob
+from sumo_ayss.modes.formatting import (
+    crash_text,
+    fmt_interval,
+    fmt_num,
+    fmt_p,
+    fmt_prob,
+    mobility_text,
+)
 from sumo_ayss.report.blocks import Table
 from sumo_ayss.run_folder import Estimate, RunRecord
 from sumo_ayss.util.paths import display_path
@@ -138,19 +145,6 @@ def unjustified_cell(o: VutOutcome | None) -> str:
         f"{100 * h['unjustified_braking']:.0f} % of episodes, "
         f"{h['unjustified_dv_mps']:.1f} m/s shed{flag}"
     )
-
-
-def crash_text(crashes: int, episodes: int, lo: float, hi: float) -> str:
-    """``"11.6 % (10.2–13.2 %), 209/1800"``: a crash rate with its interval (fractions)."""
-    rate = crashes / episodes
-    return f"{100 * rate:.1f} % ({100 * lo:.1f}–{100 * hi:.1f} %), {crashes}/{episodes}"
-
-
-def mobility_text(mps: float, timid: bool) -> str:
-    """``"21.3 m/s"``, ``"4.2 m/s (TIMID)"`` or "not recorded" (NaN)."""
-    if not math.isfinite(mps):
-        return "not recorded"
-    return f"{mps:.1f} m/s" + (" (TIMID)" if timid else "")
 
 
 def crash_cell(o: VutOutcome | None) -> str:

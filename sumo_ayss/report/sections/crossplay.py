@@ -7,8 +7,7 @@ from pathlib import Path
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.config.report import ReportOptions
-from sumo_ayss.modes import CROSSPLAY
-from sumo_ayss.modes.crossplay import crossplay_gap_text, crossplay_sentence
+from sumo_ayss.modes.crossplay import crossplay_gap_text, crossplay_result, crossplay_sentence
 from sumo_ayss.modes.formatting import fmt_num, fmt_p, seed_interval_text
 from sumo_ayss.report.blocks import (
     Block,
@@ -43,6 +42,7 @@ def crossplay_blocks(
     a: CaseAnalysis[RunRecord], colors: Mapping[str, str], out_dir: Path, options: ReportOptions
 ) -> list[Block]:
     """(i) Explanation, ranking table, pairwise comparisons and the per-opponent figure."""
+    result = crossplay_result(a)
     blocks: list[Block] = [Heading("(i) Cross-play ranking", 3)]
     blocks.append(
         Paragraph(
@@ -54,14 +54,14 @@ def crossplay_blocks(
             "collision is never the VUT's gain. Because every opponent meets every VUT, a "
             "difference between two VUTs is read within each opponent. Two VUTs are compared "
             "by a paired t-test over "
-            f"{BLOCK_WORDS.get(a.crossplay_blocks, a.crossplay_blocks)}."
+            f"{BLOCK_WORDS.get(result.blocks, result.blocks)}."
         )
     )
     blocks.append(_diagonal_block(a))
     blocks += _adaptive_blocks(a)
-    m = a.crossplay
-    if m is None or not a.crossplay_rows:
-        gap = a.crossplay_gap
+    m = result.matrix
+    if m is None or not result.rows:
+        gap = result.gap
         reason = crossplay_gap_text(gap) if gap is not None else "no cross-play ranking"
         return [
             *blocks,
@@ -70,7 +70,7 @@ def crossplay_blocks(
             ),
         ]
     pct = f"{100 * options.level:g} %"
-    order = [r.name for r in a.crossplay_rows]
+    order = [r.name for r in result.rows]
     path = crossplay_figure(
         order,
         m.opponents,
@@ -80,7 +80,7 @@ def crossplay_blocks(
         out_dir / f"{a.case}_crossplay_by_opponent.png",
         title=f"{a.info.title}: cross-play, harm per opponent (lower = safer)",
     )
-    where = display_path(a.crossplay_path, out_dir) if a.crossplay_path is not None else ""
+    where = display_path(result.path, out_dir) if result.path is not None else ""
     blocks.append(
         FigureBlock(
             path,
@@ -91,9 +91,9 @@ def crossplay_blocks(
             f"ranking. Table: {where}.",
         )
     )
-    outcomes = a.outcomes.get(CROSSPLAY.name, {})
+    outcomes = result.outcomes
     rows = []
-    for r in a.crossplay_rows:
+    for r in result.rows:
         nxt = r.vs_next
         ci = seed_interval_text(r.lo, r.hi, r.n_seeds, 3)
         o = outcomes.get(r.name)
@@ -129,12 +129,12 @@ def crossplay_blocks(
     )
     if any(o.timid for o in outcomes.values()):
         blocks.append(Callout("Timid VUT", (TIMID_NOTE,), "warning"))
-    blocks.append(pairs_table(a.crossplay_pairs, "H", pct, options.welch_alpha))
+    blocks.append(pairs_table(result.pairs, "H", pct, options.welch_alpha))
     blocks.append(
         BulletList(
             tuple(
-                crossplay_sentence(r.vs_next, a.crossplay_blocks)
-                for r in a.crossplay_rows
+                crossplay_sentence(r.vs_next, result.blocks)
+                for r in result.rows
                 if r.vs_next is not None
             ),
         )
@@ -144,7 +144,7 @@ def crossplay_blocks(
 
 def _diagonal_block(a: CaseAnalysis[RunRecord]) -> Block:
     """The diagonal check: every SPCP against its own VUT reproduced its outcome table."""
-    checks = a.crossplay_diagonal
+    checks = crossplay_result(a).diagonal
     if not checks:
         return Callout(
             "Diagonal not checked",
@@ -168,9 +168,10 @@ def _diagonal_block(a: CaseAnalysis[RunRecord]) -> Block:
 def _adaptive_blocks(a: CaseAnalysis[RunRecord]) -> list[Block]:
     """Adaptive seeding's looks at this case (``adaptive.json`` beside the cross-play table),
     when the pipeline added seeds adaptively; nothing for a fixed grid."""
-    if a.crossplay_path is None:
+    table = crossplay_result(a).path
+    if table is None:
         return []
-    path = CaseFolder(a.crossplay_path.parent).adaptive_json
+    path = CaseFolder(table.parent).adaptive_json
     if not path.is_file():
         return []
     try:

@@ -56,8 +56,9 @@ def _places(a: CaseAnalysis[RunRecord]) -> dict[str, tuple[str, bool, bool]]:
     }
 
 
-def _outcomes(a: CaseAnalysis[RunRecord]) -> dict[str, VutOutcome]:
-    return a.outcomes.get(a.ranking_mode) or a.outcomes.get(EXPOSURE.name, {})
+def _outcomes(a: CaseAnalysis[RunRecord]) -> Mapping[str, VutOutcome]:
+    """The ranking mode's outcomes, else the VUTs' own SPCPs' (as the leaderboard's)."""
+    return get_mode(a.ranking_mode).outcomes(a) or EXPOSURE.outcomes(a)
 
 
 def _median(values: Sequence[float]) -> float:

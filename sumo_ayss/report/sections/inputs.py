@@ -7,14 +7,14 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from sumo_ayss.report.blocks import Block, BulletList, Heading, Paragraph, Table
-from sumo_ayss.report.checks import (
+from sumo_ayss.report.sections.common import display_path, seeds_text
+from sumo_ayss.run_folder import RunFolder, RunRecord
+from sumo_ayss.training.trust import (
     NOISE_SE,
     TRUSTED_TIMESTEPS,
     improving_runs,
     training_status,
 )
-from sumo_ayss.report.sections.common import display_path, seeds_text
-from sumo_ayss.run_folder import VERSIONS_JSON, RunRecord
 
 __all__ = ["inputs_blocks", "training_table"]
 
@@ -108,11 +108,11 @@ def inputs_blocks(
         )
         blocks.append(
             Table(
-                f"Versions ({VERSIONS_JSON} of {with_versions} of {len(runs)} runs)",
+                f"Versions ({RunFolder.versions.name} of {with_versions} of {len(runs)} runs)",
                 ("package", "version"),
                 v_rows,
             )
         )
     else:
-        blocks.append(Paragraph(f"No run holds a {VERSIONS_JSON}: versions unknown."))
+        blocks.append(Paragraph(f"No run holds a {RunFolder.versions.name}: versions unknown."))
     return blocks

@@ -10,8 +10,9 @@ from sumo_ayss.analysis.premise import Premise
 from sumo_ayss.cases import OUTCOME_COLUMNS
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import EXPOSURE
-from sumo_ayss.modes.exposure import exposure_sentence
+from sumo_ayss.modes.exposure import exposure_result, exposure_sentence
 from sumo_ayss.modes.formatting import fmt_num, seed_interval_text
+from sumo_ayss.modes.paper import paper_result
 from sumo_ayss.report.blocks import (
     Block,
     BulletList,
@@ -133,7 +134,7 @@ def premise_sentence(premise: Premise | None, options: ReportOptions) -> str:
 
 def premise_blocks(a: CaseAnalysis[RunRecord], options: ReportOptions) -> list[Block]:
     blocks: list[Block] = [Heading("(e) Premise check: the same overall outcome?", 3)]
-    premise = a.premise
+    premise = paper_result(a).premise
     if premise is None or not premise.metrics:
         return [*blocks, Paragraph(premise_sentence(premise, options))]
     pct = f"{100 * options.level:g} %"
@@ -186,13 +187,14 @@ def exposure_blocks(
 ) -> list[Block]:
     blocks: list[Block] = [Heading("(f) Exposure ranking", 3)]
     blocks.append(Paragraph(EXPOSURE.description))
-    if not a.exposure_rows:
+    result = exposure_result(a)
+    if not result.rows:
         return [*blocks, Paragraph("No exposure: no outcome summaries in this case yet.")]
     pct = f"{100 * options.level:g} %"
-    scores = a.exposure_scores
-    outcomes = a.outcomes.get(EXPOSURE.name, {})
+    scores = result.scores
+    outcomes = result.outcomes
     path = seed_scores_figure(
-        a.exposure_rows,
+        result.rows,
         scores,
         colors,
         out_dir / f"{a.case}_exposure_by_seed.png",
@@ -208,7 +210,7 @@ def exposure_blocks(
         )
     )
     rows = []
-    for r in a.exposure_rows:
+    for r in result.rows:
         nxt = r.vs_next
         per_seed = ", ".join(f"s{k}: {fmt_num(v, 3)}" for k, v in scores[r.name].items())
         ci = seed_interval_text(r.lo, r.hi, r.n_seeds, 3)
@@ -247,10 +249,10 @@ def exposure_blocks(
     )
     if any(o.timid for o in outcomes.values()):
         blocks.append(Callout("Timid VUT", (TIMID_NOTE,), "warning"))
-    blocks.append(pairs_table(a.exposure_pairs, "harm", pct, options.welch_alpha))
+    blocks.append(pairs_table(result.pairs, "harm", pct, options.welch_alpha))
     blocks.append(
         BulletList(
-            tuple(exposure_sentence(r.vs_next) for r in a.exposure_rows if r.vs_next is not None),
+            tuple(exposure_sentence(r.vs_next) for r in result.rows if r.vs_next is not None),
         )
     )
     return blocks

@@ -14,6 +14,7 @@ from sumo_ayss.modes.paper import (
     MIN_SEEDS_FOR_INTERVAL,
     diff_interval,
     pair_sentence,
+    paper_result,
     significance_rule,
 )
 from sumo_ayss.report import figures
@@ -54,10 +55,11 @@ def paper_blocks(
             f"({options.n_boot} replicates: seeds, then samples within a seed)."
         )
     )
-    if not a.indices:
+    result = paper_result(a)
+    if not result.indices:
         return [*blocks, Paragraph("No safety index: no AYSS samples in this case yet.")]
     path = figures.safety_index_figure(
-        a.indices,
+        result.indices,
         colors,
         out_dir / f"{a.case}_safety_index.png",
         unit=unit,
@@ -67,11 +69,11 @@ def paper_blocks(
     blocks.append(
         FigureBlock(path, f"Safety index per VUT with its {pct} interval; safest on top.")
     )
-    by_pair = {(p.verdict.name_a, p.verdict.name_b): p for p in a.pairs}
+    by_pair = {(p.verdict.name_a, p.verdict.name_b): p for p in result.pairs}
     rows = []
-    for r in a.ranking:
-        idx = a.indices[r.name]
-        nxt = a.ranking[r.rank].name if r.rank < len(a.ranking) else None
+    for r in result.ranking:
+        idx = result.indices[r.name]
+        nxt = result.ranking[r.rank].name if r.rank < len(result.ranking) else None
         pair = by_pair.get((r.name, nxt)) if nxt else None
         rows.append(
             (
@@ -102,7 +104,7 @@ def paper_blocks(
             (True, False, True, True, True, True, True, False),
         )
     )
-    if a.pairs:
+    if result.pairs:
         p_rows = tuple(
             (
                 p.verdict.name_a,
@@ -116,7 +118,7 @@ def paper_blocks(
                 "yes" if p.significant else "no",
                 p.safer or "no significant difference",
             )
-            for p in a.pairs
+            for p in result.pairs
         )
         blocks.append(
             Table(
@@ -138,5 +140,5 @@ def paper_blocks(
                 significance_rule(options),
             )
         )
-        blocks.append(BulletList(tuple(pair_sentence(p) for p in a.pairs)))
+        blocks.append(BulletList(tuple(pair_sentence(p) for p in result.pairs)))
     return blocks

@@ -6,6 +6,7 @@ from collections.abc import Sequence
 
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.analysis.reference import ReferenceComparison, ReferenceReading
+from sumo_ayss.modes.crossplay import crossplay_result
 from sumo_ayss.modes.formatting import fmt_num, fmt_prob
 from sumo_ayss.report.blocks import Block, Heading, Paragraph, Table
 from sumo_ayss.report.sections.common import crash_text
@@ -121,7 +122,7 @@ def _scenario_line(reading: ReferenceReading, case: str) -> str:
 
 def scenario_set_line(a: CaseAnalysis[RunRecord]) -> str:
     """One sentence on the scenario set's inevitable-collision states ("" without them)."""
-    ss = a.scenario_set
+    ss = crossplay_result(a).scenario_set
     if ss is None:
         return ""
     return (
@@ -137,12 +138,13 @@ def scenario_set_line(a: CaseAnalysis[RunRecord]) -> str:
 def reference_blocks(a: CaseAnalysis[RunRecord]) -> list[Block]:
     """(k) The case's VUTs against each reference driver that drove in cross-play, and the
     scenario set's inevitable-collision states."""
-    if not a.references and a.scenario_set is None:
+    result = crossplay_result(a)
+    if not result.references and result.scenario_set is None:
         return []
     blocks: list[Block] = [Heading("(k) Against the careful human", 3), Paragraph(EXPLANATION)]
-    if a.scenario_set is not None:
+    if result.scenario_set is not None:
         blocks.append(Paragraph(scenario_set_line(a)))
-    for reading in a.references.values():
+    for reading in result.references.values():
         blocks.append(Paragraph(_scenario_line(reading, a.info.title)))
         blocks.append(
             Table(
@@ -164,9 +166,10 @@ def reference_markdown(analyses: Sequence[CaseAnalysis[RunRecord]]) -> list[str]
     """``ranking.md`` lines: per case, the VUTs against each reference driver."""
     lines: list[str] = []
     for a in analyses:
-        if a.scenario_set is not None:
+        result = crossplay_result(a)
+        if result.scenario_set is not None:
             lines += ["", f"Scenario set, {a.case}: {scenario_set_line(a)}"]
-        for reading in a.references.values():
+        for reading in result.references.values():
             lines += [
                 "",
                 f"Against {_name(reading.reference)}, {a.case}: {_scenario_line(reading, a.case)}",

@@ -1,0 +1,167 @@
+"""Whether a study's training can be trusted: training budget, seeds, SPCP still improving.
+
+They read each run's :class:`~sumo_ayss.run_folder.Training` (from ``config.yaml``,
+``eval.csv`` and ``spcp.json``, read with the run record); no file. The report writes them
+at its top, the pipeline and ``rank`` print them on the terminal.
+
+- :func:`training_status` — the state of a run's learning curve at the end (its
+  :class:`~sumo_ayss.run_folder.Training`, read with the run): the SPCP is the last
+  candidate (the curve was still at its best when training stopped: it may still be
+  improving), the last candidate's mean evaluation reward is within :data:`NOISE_SE`
+  standard errors of the SPCP's (a plateau: the SPCP is one of several candidates equal
+  within noise), or it is clearly below (the curve peaked earlier).
+- :func:`trust_warnings` — sentences for the top of a report (and the terminal) when the
+  budget is below :data:`TRUSTED_TIMESTEPS`, the seeds too few for it (no named budget of
+  :mod:`sumo_ayss.config.budget` covers the protocol), or SPCPs may still be improving at
+  such a budget; :func:`budget_note` — at a validated budget, what was validated and what
+  was not, once.
+
+Imports neither SUMO nor torch.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Iterable, Sequence
+
+from sumo_ayss.config.budget import BUDGETS, Budget
+from sumo_ayss.run_folder import Training
+
+TRUSTED_TIMESTEPS = min(b.total_timesteps for b in BUDGETS.values())
+"""Training transitions per run below which verdicts are flagged as not to be trusted: the
+smallest named budget's (``verdict``, 20,000), the least that ordered every validation ladder
+right with its seeds (docs/performance.md)."""
+
+NOISE_SE = 2.0
+"""The last candidate counts as "within noise" of the SPCP when its mean evaluation reward
+is less than this many standard errors (SPCP's ``std_return / sqrt(n_episodes)``) lower."""
+
+
+def training_status(t: Training) -> str:
+    """A run's SPCP state (:class:`~sumo_ayss.run_folder.Training`) in one phrase, for a
+    table cell."""
+    if t.still_improving is None:
+        return "unknown"
+    if t.still_improving:
+        return "may still improve: SPCP is the last candidate"
+    if t.gap_se < NOISE_SE:
+        return f"plateau: last candidate within {t.gap_se:.1f} SE of the SPCP"
+    return f"peaked: last candidate {t.gap_se:.1f} SE below the SPCP"
+
+
+def fewest_seeds(keys: Iterable[tuple[str, str]]) -> int | None:
+    """The fewest runs (training seeds) of any (case, VUT) among ``keys``, one key per run;
+    None without runs."""
+    counts = Counter(keys)
+    return min(counts.values()) if counts else None
+
+
+def validated_budget(
+    runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None
+) -> tuple[str, Budget] | None:
+    """The largest named budget (:data:`~sumo_ayss.config.budget.BUDGETS`) whose transitions
+    and seeds ``runs`` meet (every run's budget known), or None."""
+    totals = [t.total_timesteps for _, t in runs]
+    if not totals or seeds_per_vut is None or any(t is None for t in totals):
+        return None
+    total = min(t for t in totals if t is not None)
+    met = [
+        (name, b)
+        for name, b in BUDGETS.items()
+        if total >= b.total_timesteps and seeds_per_vut >= b.seeds
+    ]
+    return max(met, key=lambda nb: nb[1].total_timesteps) if met else None
+
+
+def trust_warnings(
+    runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None = None
+) -> list[str]:
+    """Sentences that say why verdicts built on ``runs`` (``(label, training)``) are weak.
+
+    Empty when every run trained at least :data:`TRUSTED_TIMESTEPS` transitions and the
+    protocol (the smallest budget, ``seeds_per_vut`` when given: the fewest seeds of any VUT)
+    meets one of the named budgets validated on ladders (:data:`~sumo_ayss.config.budget.
+    BUDGETS`: at least its transitions and its seeds). SPCPs that were the last candidate of
+    their training are a warning only at a budget no ladder validated: at a validated one the
+    verdict curve found the ranking unchanged by more training, and :func:`budget_note` says
+    so (issue 35: a warning on every default run taught users to ignore it).
+    """
+    out = []
+    budgets_known = {t.total_timesteps for _, t in runs if t.total_timesteps is not None}
+    small = sorted(b for b in budgets_known if b < TRUSTED_TIMESTEPS)
+    if small:
+        budgets = ", ".join(f"{b:,}" for b in small)
+        out.append(
+            f"Small training budget: {budgets} transitions per run, below the "
+            f"{TRUSTED_TIMESTEPS:,} of the smallest budget that ordered every validation "
+            "ladder right. The SPCPs are undertrained; the verdicts and rankings below are "
+            "NOT to be trusted (a demonstration of the machinery, not a result)."
+        )
+    elif budgets_known and seeds_per_vut is not None:
+        total = min(budgets_known)
+        if not any(
+            total >= b.total_timesteps and seeds_per_vut >= b.seeds for b in BUDGETS.values()
+        ):
+            validated = "; ".join(
+                f"{b.seeds} at {b.total_timesteps:,} ({name})" for name, b in BUDGETS.items()
+            )
+            out.append(
+                f"Few training seeds: {seeds_per_vut} per VUT at {total:,} transitions per "
+                f"run, fewer than a protocol validated on ladders uses (seeds at transitions: "
+                f"{validated}). With fewer seeds the tests miss real differences more often: "
+                "a 'no significant difference' here is weak evidence."
+            )
+    unknown = [label for label, t in runs if t.total_timesteps is None]
+    if unknown:
+        out.append(
+            f"Training budget unknown (no readable train.total_timesteps in config.yaml) for "
+            f"{len(unknown)} of {len(runs)} runs: " + ", ".join(unknown) + "."
+        )
+    improving = [label for label, t in runs if t.still_improving]
+    if improving and (out or validated_budget(runs, seeds_per_vut) is None):
+        out.append(
+            f"{len(improving)} of {len(runs)} SPCPs may still be improving (the SPCP is the "
+            "last candidate of its training), at a budget whose ranking no ladder validated: "
+            "more training could change them and the verdicts (the runs are listed under "
+            "Inputs)."
+        )
+    return out
+
+
+def budget_note(runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None) -> str | None:
+    """What the evidence for this protocol's budget covers and what it does not, one
+    paragraph, at a budget validated on ladders (:func:`validated_budget`) with nothing to
+    warn about (:func:`trust_warnings` empty); None otherwise."""
+    found = validated_budget(runs, seeds_per_vut)
+    if found is None or trust_warnings(runs, seeds_per_vut):
+        return None
+    name, b = found
+    total = min(t.total_timesteps or 0 for _, t in runs)
+    improving = sum(1 for _, t in runs if t.still_improving)
+    last = (
+        f"{improving} of {len(runs)} SPCPs were the last candidate of their training (listed "
+        "under Inputs); on the ladders the ranking did not depend on that"
+        if improving
+        else "every SPCP had peaked or reached a plateau"
+    )
+    paper = (
+        "; the paper mode's AYSS reading was validated at the paper budget only"
+        if name != "paper"
+        else ""
+    )
+    return (
+        f"Budget: {total:,} transitions per run and {seeds_per_vut} or more seeds per VUT, at "
+        f"least the '{name}' budget ({b.total_timesteps:,} transitions, {b.seeds} seeds). "
+        "Validated at this budget: the cross-play ranking of the validation ladders (braking, "
+        "ACC time gap, minGap, time headway; reaction time in cut-in) came out in their known "
+        "order, and the verdict curve found the same order at every budget it tried, from "
+        "10,000 to 100,000 transitions (docs/performance.md). Not validated: that each SPCP "
+        "has converged ("
+        f"{last}); VUT kinds unlike the ladders' (the reaction-time ladder's car-following "
+        f"order is inverted at every budget){paper}."
+    )
+
+
+def improving_runs(runs: Sequence[tuple[str, Training]]) -> list[str]:
+    """The labels of the runs whose SPCP is the last candidate of their training."""
+    return [label for label, t in runs if t.still_improving]
