@@ -224,7 +224,7 @@ PIPELINE_CASES: list[tuple[str, str, str]] = [
         "unknown case in experiments",
         "grid: {cases: [car_following]}\nexperiments: {car_following: EXP, car_follow: EXP}",
         "experiments.car_follow: unknown case (did you mean 'car_following'?); allowed: "
-        "['car_following', 'cut_in']",
+        "['car_following', 'cut_in', 'lead_and_cut_in']",
     ),
     (
         "negative seed",

@@ -54,7 +54,6 @@ from sumo_ayss.envs.two_pov import (
     two_pov_start,
 )
 from sumo_ayss.laws import VehicleLaws, build_laws
-from sumo_ayss.sim.actuator import next_speed, pov_acceleration
 from sumo_ayss.sim.pair import PairPlacement, VehiclePair
 from sumo_ayss.sim.second_pov import SecondPov
 from sumo_ayss.util.errors import ActionError, ConfigError
@@ -237,12 +236,9 @@ class LeadAndCutInEnv(PairEnv):
         """The supporting POV's actuator, then the primary's and the VUT's laws."""
         second = self._second
         assert second is not None
-        actuator = self.config.actuator
-        a = self._support_accel = pov_acceleration(
-            self._support_speed, self._support_target, actuator
+        self._support_accel, self._support_speed = second.drive_toward(
+            self._support_speed, self._support_target, self._dt_s, self.config.actuator
         )
-        self._support_speed = next_speed(self._support_speed, a, self._dt_s, actuator)
-        second.command_speed(self._support_speed)
         super().command_pov()
 
     def end_decision(

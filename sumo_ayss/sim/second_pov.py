@@ -16,6 +16,8 @@ from typing import NamedTuple
 import libsumo
 from libsumo import _libsumo
 
+from sumo_ayss.config import ActuatorConfig
+from sumo_ayss.sim.actuator import next_speed, pov_acceleration
 from sumo_ayss.sim.pair import LC_MODE_NONE, SPEED_MODE_UNCHECKED, VehiclePair
 from sumo_ayss.sim.session import SUMO_ERRORS
 from sumo_ayss.util.errors import SimulationError
@@ -105,6 +107,17 @@ class SecondPov:
     def command_speed(self, speed_mps: float) -> None:
         """It drives at exactly ``speed_mps`` during the next step (checks are off)."""
         _set_speed(self.id, speed_mps)
+
+    def drive_toward(
+        self, speed_mps: float, target_mps: float, dt_s: float, actuator: ActuatorConfig
+    ) -> tuple[float, float]:
+        """Command the next step on the POV actuator (``env.actuator``, clipped): from
+        ``speed_mps`` toward ``target_mps`` over ``dt_s`` [s]. Returns ``(acceleration
+        [m/s²], speed [m/s] it will drive)``, the model state the caller keeps."""
+        accel = pov_acceleration(speed_mps, target_mps, actuator)
+        speed = next_speed(speed_mps, accel, dt_s, actuator)
+        self.command_speed(speed)
+        return accel, speed
 
     def change_lane(self, lane: int, request_s: float) -> None:
         """Start a forced, continuous change to ``lane`` (``--lanechange.duration``)."""
