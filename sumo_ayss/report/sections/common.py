@@ -21,7 +21,6 @@ from sumo_ayss.run_folder import Estimate, RunRecord
 from sumo_ayss.util.paths import display_path
 
 __all__ = [
-    "OVERBRAKING_NOTE",
     "TIMID_NOTE",
     "crash_cell",
     "crash_text",
@@ -112,16 +111,6 @@ TIMID_NOTE = (
     "episodes: it may owe its low harm to standing still rather than to driving safely."
 )
 """What a TIMID flag means (:data:`sumo_ayss.analysis.harm.MOBILITY_FLOOR`)."""
-
-
-OVERBRAKING_NOTE = (
-    "A VUT marked OVER-BRAKING shed more speed in unjustified hard braking (harder than "
-    "3.4 m/s² while nothing ahead was critical and no leader had just braked as hard) than "
-    "1.5 × the median VUT's over the same episodes, and more than 0.68 m/s per episode: its "
-    "low harm may come from braking at everything, which the traffic behind it pays for (the "
-    "follower's braking in 'hazards caused'; docs/ranking.md)."
-)
-"""What an OVER-BRAKING flag means (:mod:`sumo_ayss.analysis.hazards`)."""
 
 
 def hazards_cell(o: VutOutcome | None) -> str:
