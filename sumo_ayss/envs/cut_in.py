@@ -98,7 +98,7 @@ from sumo_ayss.envs.pair_env import (
     PairEnv,
     PairKinematics,
 )
-from sumo_ayss.envs.rewards import adversarial_reward
+from sumo_ayss.envs.rewards import lane_phase_reward
 from sumo_ayss.laws import VehicleLaws
 from sumo_ayss.sim.pair import PairPlacement
 from sumo_ayss.util.errors import ActionError
@@ -255,14 +255,14 @@ class CutInEnv(PairEnv):
         lane = self._lane
         assert lane is not None
         h = k.headway_m
-        if h <= -self._both_lengths_m:
-            r_a, phase = 0.0, "behind"
-        elif lane.changing:
-            r_a, phase = adversarial_reward(h, self._lane_change_cfg), "lane_change"
-        elif lane.same_lane:
-            r_a, phase = adversarial_reward(h, self._same_lane_cfg), "same_lane"
-        else:
-            r_a, phase = 0.0, "different_lanes"
+        r_a, phase = lane_phase_reward(
+            h,
+            self._both_lengths_m,
+            lane.changing,
+            lane.same_lane,
+            self._lane_change_cfg,
+            self._same_lane_cfg,
+        )
         extra = {
             "reward_phase": phase,
             "lane_change_started": self._lc_started,

@@ -37,7 +37,7 @@ from sumo_ayss.envs.pair_env import (
     session_vtypes,
 )
 from sumo_ayss.envs.reference import reference_config
-from sumo_ayss.envs.rewards import adversarial_reward
+from sumo_ayss.envs.rewards import adversarial_reward, lane_phase_reward
 from sumo_ayss.envs.two_pov import (
     CUT_LANE,
     CUT_LANE_CHANGE,
@@ -335,14 +335,15 @@ class LeadAndCutInEnv(PairEnv):
         shapes = self._reward_cfg
         if not self._primary_is_cut():
             r_a, phase = adversarial_reward(h, shapes.same_lane), "same_lane"
-        elif h <= -self._both_lengths_m:
-            r_a, phase = 0.0, "behind"
-        elif lane["lane_changing"]:
-            r_a, phase = adversarial_reward(h, shapes.lane_change), "lane_change"
-        elif lane["same_lane"]:
-            r_a, phase = adversarial_reward(h, shapes.same_lane), "same_lane"
         else:
-            r_a, phase = 0.0, "different_lanes"
+            r_a, phase = lane_phase_reward(
+                h,
+                self._both_lengths_m,
+                bool(lane["lane_changing"]),
+                bool(lane["same_lane"]),
+                shapes.lane_change,
+                shapes.same_lane,
+            )
         extra = {
             "reward_phase": phase,
             "lane_change_started": self._lc_started,

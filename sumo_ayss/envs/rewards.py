@@ -46,6 +46,26 @@ def adversarial_reward_array(
     return np.vectorize(lambda x: adversarial_reward(float(x), shape), otypes=[float])(h)
 
 
+def lane_phase_reward(
+    headway_m: float,
+    both_lengths_m: float,
+    changing: bool,
+    same_lane: bool,
+    lane_change: RewardShape,
+    same: RewardShape,
+) -> tuple[float, str]:
+    """R_A and its phase for a POV that may cut in: 0 once it is wholly behind the VUT
+    (``headway_m`` <= -``both_lengths_m``, the two lengths [m]), the lane-change shape
+    while it changes lanes, the same-lane shape in the VUT's lane, else 0."""
+    if headway_m <= -both_lengths_m:
+        return 0.0, "behind"
+    if changing:
+        return adversarial_reward(headway_m, lane_change), "lane_change"
+    if same_lane:
+        return adversarial_reward(headway_m, same), "same_lane"
+    return 0.0, "different_lanes"
+
+
 def total_reward(r_adversarial: float, collided: bool, cfg: RewardConfig) -> float:
     """R = α_A·R_A + α_C·R_C with R_C = -1 on a collision (R_A is then not paid)."""
     if collided:
