@@ -145,19 +145,26 @@ def test_committed_configs_naming_a_controller_by_module_path_read_as_its_regist
     and the same vehicle as the definition key its study's records stored."""
     import json
 
+    from sumo_ayss.config import load_pipeline
     from sumo_ayss.vuts.catalog import BUILTIN_VUTS
-    from sumo_ayss.vuts.reference_types import OVERBRAKER_VUT
 
+    human075 = load_pipeline(ROOT / "configs/ladders/careful_human.yaml").vuts["human075"]
     studies = [
-        ("results/paper_fidelity/car_following", "hwenv_pi1", BUILTIN_VUTS["hwenv_pi1"]),
-        ("results/overbraking/car_following", "overbraker", OVERBRAKER_VUT),
+        (
+            "results/paper_fidelity/car_following/hwenv_pi1/seed_0",
+            "sumo_ayss.hwenv_laws:HighwayEnvIDM",
+            BUILTIN_VUTS["hwenv_pi1"],
+        ),
+        (
+            "results/ladders/careful_human_a/car_following/human075/seed_501",
+            "sumo_ayss.vuts.reference:CarefulDriver",
+            human075,
+        ),
     ]
-    for case_dir, vut, today in studies:
-        folder = RunFolder(ROOT / case_dir / vut / "seed_0")
+    for run_dir, old, today in studies:
+        folder = RunFolder(ROOT / run_dir)
+        vut = folder.path.parent.name
         text = folder.config.read_text(encoding="utf-8")
-        old = {"hwenv_pi1": "sumo_ayss.hwenv_laws:HighwayEnvIDM"}.get(
-            vut, "sumo_ayss.vuts.overbraking:OverBraker"
-        )
         assert f"target: {old}" in text  # the old-style config, as committed
         cfg, seed = stored_experiment(folder)
         stored = cfg.env.vut_type.controller
@@ -165,7 +172,7 @@ def test_committed_configs_naming_a_controller_by_module_path_read_as_its_regist
         assert stored.target == (today.controller.target if today.controller else None)
         stage = TrainStage(folder, _with_catalog(cfg, {vut: today}), seed)
         assert stage.key() == stage.recorded(), folder
-        record = ROOT / case_dir / "crossplay.json"
+        record = folder.path.parents[1] / "crossplay.json"
         keys = json.loads(record.read_text(encoding="utf-8")).get("vut_keys", {})
         if vut in keys:
             assert vut_key(today) == vut_key(cfg.env.vut_type) == keys[vut]
