@@ -120,7 +120,6 @@ from sumo_ayss.run_folder.metadata import (
 )
 from sumo_ayss.run_folder.record import (
     RunRecord,
-    Training,
     read_run,
 )
 from sumo_ayss.run_folder.schemas import (
@@ -185,7 +184,6 @@ __all__ = [
     "StageHeader",
     "StudyFolder",
     "Table",
-    "Training",
     "ayss_cells",
     "case_of",
     "case_runs",
