@@ -16,7 +16,12 @@ normal law with the bin's own mean and variance times the count, which the sum o
 many samples drawn from the bin tends to (thousands per bin at the paper budget). Its
 interval is therefore a Monte Carlo draw of nearly the same bootstrap, not the same
 replicates: the seed choices, which dominate the interval with three seeds, are drawn
-alike, the within-bin noise only in distribution.
+alike, the within-bin noise only in distribution. Measured on the paper budget's samples
+(car-following pi1, seeds 0-2 of the issue 35 re-run of configs/paper.yaml, 79,935 kept
+samples per seed, 2,000 replicates, bootstrap seeds 0-4): the point and per-seed indices
+equal, the bounds from cells within 0.0035 m/s² of the samples' (an interval 0.27 m/s²
+wide), about as far as the samples' own bounds move between bootstrap seeds (SD 0.0014 and
+0.0020).
 """
 
 from __future__ import annotations
