@@ -147,3 +147,22 @@ def test_a_run_with_only_ayss_bins_reads_and_draws_as_with_its_samples(
     assert not figures.has_ayss(neither)
     figures.indicator_figure({"pi1": [neither]}, {"pi1": "C0"}, tmp_path / "b.png", **draw)
     assert said == ["no AYSS samples (ayss.csv) in these runs yet"]
+
+
+def test_git_keeps_ayss_bins_and_leaves_out_ayss_csv() -> None:
+    from fnmatch import fnmatch
+
+    from sumo_ayss.config import PROJECT_ROOT
+
+    patterns = [
+        line.strip()
+        for line in (PROJECT_ROOT / ".gitignore").read_text().splitlines()
+        if line.strip() and not line.startswith("#")
+    ]
+    run = "results/paper/car_following/pi1/seed_0"
+
+    def ignored(name: str) -> bool:
+        path = f"{run}/{name}"
+        return any(fnmatch(path, p.replace("**/", "*")) or fnmatch(name, p) for p in patterns)
+
+    assert ignored("ayss.csv") and not ignored("ayss_bins.csv")
