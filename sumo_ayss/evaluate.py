@@ -46,6 +46,7 @@ from sumo_ayss.run_folder import (
     RunRecord,
     StageHeader,
     ayss_cells,
+    backfill_ayss_bins,
     read_run,
     write_ayss_bins,
     write_ayss_json,
@@ -246,6 +247,7 @@ def _evaluate_run(
     cfg = run.experiment  # raises if config.yaml is missing or invalid
     ayss_cfg = ayss if ayss is not None else AyssConfig()
     f = run.folder
+    backfill_ayss_bins(f.ayss_csv, f.ayss_bins)  # evaluated before ayss_bins.csv existed
     do_outcome = _should_run(OutcomeStage(f, n_outcome, outcome_seed), force)
     do_ayss = _should_run(AyssStage(f, ayss_cfg), force)
     outcome: OutcomeResult | None = None

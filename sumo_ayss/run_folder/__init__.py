@@ -78,6 +78,7 @@ from sumo_ayss.run_folder.adaptive import (
 from sumo_ayss.run_folder.ayss_bins import (
     AyssCells,
     ayss_cells,
+    backfill_ayss_bins,
     read_ayss_bins,
     write_ayss_bins,
 )
@@ -185,6 +186,7 @@ __all__ = [
     "StudyFolder",
     "Table",
     "ayss_cells",
+    "backfill_ayss_bins",
     "case_of",
     "case_runs",
     "find_run_dirs",

@@ -33,11 +33,18 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sumo_ayss.run_folder.schemas import AYSS_BINS_SCHEMA
+from sumo_ayss.run_folder.schemas import AYSS_BINS_SCHEMA, AYSS_SCHEMA
 from sumo_ayss.run_folder.table import Table, read_table, write_table
 from sumo_ayss.util.errors import AyssError
 
-__all__ = ["CELL_WIDTH_M", "AyssCells", "ayss_cells", "read_ayss_bins", "write_ayss_bins"]
+__all__ = [
+    "CELL_WIDTH_M",
+    "AyssCells",
+    "ayss_cells",
+    "backfill_ayss_bins",
+    "read_ayss_bins",
+    "write_ayss_bins",
+]
 
 CELL_WIDTH_M = 1.0 / 32.0
 """Width of a headway cell [m]: a binary fraction, so every cell edge is exact."""
@@ -120,6 +127,23 @@ def write_ayss_bins(path: Path, cells: AyssCells) -> None:
         },
     )
     write_table(path, table)
+
+
+def backfill_ayss_bins(ayss_csv: Path, ayss_bins: Path) -> bool:
+    """Write ``ayss_bins`` from an existing ``ayss_csv`` that has none beside it (a run
+    evaluated before the evaluate stage wrote it): the stage's own reduction, no simulation
+    (``ayss.csv`` stores every float exactly, so the file is the one the stage writes).
+
+    Returns:
+        Whether it wrote the file.
+    """
+    if ayss_bins.is_file() or not ayss_csv.is_file():
+        return False
+    table = read_table(ayss_csv, AYSS_SCHEMA)
+    names = Counter(str(v) for v in table["indicator_name"])
+    name = names.most_common(1)[0][0] if names else None
+    write_ayss_bins(ayss_bins, ayss_cells(table["h_m"], table["indicator"], name))
+    return True
 
 
 def read_ayss_bins(path: Path) -> AyssCells:

@@ -108,6 +108,10 @@ def test_a_run_with_only_ayss_bins_reads_and_draws_as_with_its_samples(
     run = train(load_experiment(config), seed=1, out=tmp_path / "runs")
     evaluate_run(run, n_outcome=2, ayss=AyssConfig(n_samples=3000, seed=5), progress=False)
     assert (run / "ayss_bins.csv").is_file()  # written by the evaluate stage with ayss.csv
+    written = (run / "ayss_bins.csv").read_bytes()
+    (run / "ayss_bins.csv").unlink()  # a run evaluated before the file existed: reduced, not re-run
+    again = evaluate_run(run, n_outcome=2, ayss=AyssConfig(n_samples=3000, seed=5), progress=False)
+    assert not again.ran_ayss and (run / "ayss_bins.csv").read_bytes() == written
     with_samples = read_run(run)
     assert with_samples.ayss is not None and len(with_samples.ayss) > 0
     only_bins = tmp_path / "only_bins"
