@@ -24,6 +24,7 @@ from sumo_ayss.run_folder import (
     RunFolder,
     Seeds,
     StageHeader,
+    StudyFolder,
     Table,
     find_run_dirs,
     read_ayss_json,
@@ -46,7 +47,6 @@ from sumo_ayss.run_folder import (
     write_spcp,
     write_table,
 )
-from sumo_ayss.run_folder.layout import case_dir_for, run_dir_for
 from sumo_ayss.run_folder.metadata import (
     read_command,
     read_seeds,
@@ -120,7 +120,7 @@ def _ayss_table(n: int = 5) -> Table:
 @pytest.fixture
 def run_folder(tmp_path: Path) -> RunFolder:
     """A run folder with every file, each written by its writer."""
-    folder = RunFolder(run_dir_for(tmp_path, "cut_in", "pi2", 3))
+    folder = StudyFolder(tmp_path).run("cut_in", "pi2", 3)
     folder.checkpoints.mkdir(parents=True)
     env = {
         "case": "cut_in",
@@ -345,8 +345,8 @@ def test_config_yaml_holds_the_vut_once_and_legacy_folders_still_read(tmp_path: 
 
 
 def test_crossplay_files_of_a_case_folder_round_trip(tmp_path: Path) -> None:
-    folder = CaseFolder(case_dir_for(tmp_path, "cut_in"))
-    assert run_dir_for(tmp_path, "cut_in", "pi1", 0).parent.parent == folder.path
+    folder = StudyFolder(tmp_path).case("cut_in")
+    assert StudyFolder(tmp_path).run("cut_in", "pi1", 0).path.parent.parent == folder.path
     table = Table(
         CROSSPLAY_SCHEMA,
         {
