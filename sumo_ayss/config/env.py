@@ -51,6 +51,11 @@ MANAGED_SUMO_OPTIONS: dict[str, str] = {
 
 StepMethod = Literal["auto", "euler", "ballistic"]
 
+#: Field metadata key: :func:`~sumo_ayss.config.mapping.to_dict` leaves the field out while
+#: it holds its default (an option added after runs were stored keeps their files and
+#: identities as they were).
+OMIT_DEFAULT = "omit_default"
+
 
 @dataclass(frozen=True)
 class SimConfig:
@@ -220,11 +225,28 @@ class OddConfig:
     vut_speed_mps: tuple[float, float] = (10.0, 30.0)
     gap_m: tuple[float, float] = (2.0, 25.0)
     """Longitudinal gap POV rear bumper - VUT front bumper [m]."""
+    exclude_inevitable: bool = field(default=False, metadata={OMIT_DEFAULT: True})
+    """Draw again every start that is an inevitable collision (the case's own conservative
+    check, :attr:`~sumo_ayss.cases.Case.start_filter`; ``lead_and_cut_in`` only). Stored
+    only when true, so runs written before the option keep their ``config.yaml``/identity."""
 
     def __post_init__(self) -> None:
         for name in ("pov_speed_mps", "vut_speed_mps", "gap_m"):
             value = check_range(f"{self.SECTION}.{name}", getattr(self, name), low=0.0)
             object.__setattr__(self, name, value)
+        require(
+            isinstance(self.exclude_inevitable, bool),
+            f"{self.SECTION}.exclude_inevitable must be true or false, "
+            f"got {self.exclude_inevitable!r}",
+        )
+
+    def __repr__(self) -> str:
+        # The option only where set: reprs key stored cross-play cells (as before it).
+        extra = ", exclude_inevitable=True" if self.exclude_inevitable else ""
+        return (
+            f"OddConfig(pov_speed_mps={self.pov_speed_mps!r}, vut_speed_mps="
+            f"{self.vut_speed_mps!r}, gap_m={self.gap_m!r}{extra})"
+        )
 
 
 @dataclass(frozen=True)
@@ -362,6 +384,11 @@ class EnvConfig:
             require(path.is_file(), f"{s}.network: file not found: {path}")
             lanes = get_case(self.case).lanes
             check_sumo_network(path, f"{s}.network", ROAD_EDGE, lanes, self.case)
+        require(
+            not self.odd.exclude_inevitable or bool(get_case(self.case).start_filter),
+            f"{s}.odd.exclude_inevitable: case {self.case!r} has no inevitable-start check "
+            f"(cases with one: {[c for c in case_names() if get_case(c).start_filter]})",
+        )
         top = self.actuator.max_speed_mps
         require(
             self.odd.pov_speed_mps[1] <= top,

@@ -252,6 +252,7 @@ class LeadAndCutInEnv(PairEnv):
         info["vut_contact"] = c.primary_vut or c.support_vut
         info["contact"] = c.any
         info["support_vut_contact"] = c.support_vut
+        info["pov_pov_contact"] = c.pov_pov
         info["reward_collision"] = -float(c.povs)
         alpha_c = self._reward_cfg.alpha_collision
         if c.any:

@@ -193,6 +193,7 @@ def test_supporting_pov_touching_the_vut_is_the_povs_failure(
     env = make()
     rewards, info = run(env, start, encode_action(HOLD, CUT_LANE_CHANGE))
     assert info["pov_failure"] and info["vut_contact"] and not info["collision"]
+    assert info["support_vut_contact"] and not info["pov_pov_contact"]
     assert rewards[-1] == -ALPHA_C and info["reward_adversarial"] == 0.0
     assert env.replays == 0 and "crash_unpreventable" not in info
 
@@ -207,6 +208,7 @@ def test_pov_pov_contact_is_the_povs_failure_with_both_safe_terms(
     env = make()
     rewards, info = run(env, start, encode_action(HOLD, CUT_LANE_CHANGE))
     assert info["pov_failure"] and not info["collision"] and not info["vut_contact"]
+    assert info["pov_pov_contact"] and not info["support_vut_contact"]
     assert rewards[-1] == -2 * ALPHA_C
 
 
@@ -248,6 +250,7 @@ def test_safety_measures_are_read_per_pov(make: Callable[..., LeadAndCutInEnv]) 
     action = encode_action(HOLD, CUT_LANE_CHANGE)
     episode = run_episode(make(), lambda obs: np.full(len(obs), action), start)
     assert episode.pov_failure and not episode.collided
+    assert episode.support_vut_contact and not episode.pov_pov_contact
     assert episode.support_measures is not None and episode.measures is not None
     assert episode.support_measures.min_ttc_s == 0.0
     assert episode.measures.min_ttc_s > 1.0
