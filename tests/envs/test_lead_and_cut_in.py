@@ -273,3 +273,32 @@ def test_inevitable_collision_states_use_the_cases_own_worst_plays() -> None:
         20.0, 20.0, 40.0, support_speed_mps=20.0, support_gap_m=60.0, primary=PRIMARY_LEAD
     )
     assert ics_flags(config(), [near, far]) == [True, False]
+
+
+def test_braking_for_the_supporting_pov_is_not_unjustified(
+    make: Callable[..., LeadAndCutInEnv],
+) -> None:
+    """The supporting lead 8 m ahead brakes hard, the cut-in primary holds its lane 60 m
+    ahead: the VUT's hard braking answers the supporting POV, so it is justified; read
+    against the primary alone (session 10's reading) it would count as unjustified."""
+    from sumo_ayss.analysis.hazards import episode_hazards
+    from sumo_ayss.scenarios.trajectory import trajectory_from_infos
+
+    start = TwoPovStart(
+        20.0, 20.0, 60.0, support_speed_mps=20.0, support_gap_m=8.0, primary=PRIMARY_CUT_IN
+    )
+    env = make()
+    action = encode_action(BRAKE, 1 + HOLD)
+    episode = run_episode(env, lambda obs: np.full(len(obs), action), start)
+    assert episode.hazards is not None and not episode.collided and not episode.pov_failure
+    assert episode.hazards.unjustified_braking == 0.0
+    # The same episode against the primary only: the braking reads as for nothing.
+    _, reset_info = env.reset(options={"initial_condition": start})
+    infos = []
+    while True:
+        *_, term, trunc, info = env.step(action)
+        infos.append(info)
+        if term or trunc:
+            break
+    primary_only = episode_hazards(trajectory_from_infos(env.config, reset_info, infos), None)
+    assert primary_only.unjustified_braking == 1.0
