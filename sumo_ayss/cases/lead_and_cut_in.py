@@ -29,6 +29,7 @@ LEAD_AND_CUT_IN = register_case(
         lane_change=True,
         vec_env=False,
         default_grid=False,  # the paper's two cases stay the default grid
+        povs=2,
         start_filter="sumo_ayss.envs.two_pov:start_filter",
         env="sumo_ayss.envs.lead_and_cut_in:LeadAndCutInEnv",
         gym_id="sumo_ayss/LeadAndCutIn-v0",

@@ -147,6 +147,8 @@ class Case:
             False: ``train.n_envs`` must be 1 (the configuration refuses more).
         default_grid: A pipeline whose ``grid`` names no cases runs this one
             (:func:`default_grid_cases`); False: only where a grid names it.
+        povs: How many POVs an episode has (more than one: the supporting POVs' forbidden
+            contacts, ``env.reward.pov_failure_penalty``).
         start_filter: ``"module:function"``, ``(EnvConfig) -> (InitialCondition) -> bool``:
             whether a start drawn from the ODD is admissible when ``env.odd.
             exclude_inevitable`` is set (no inevitable collision); empty: the case has no
@@ -176,6 +178,7 @@ class Case:
     one_decision_note: str = ""
     vec_env: bool = True
     default_grid: bool = True
+    povs: int = 1
     start_filter: str = ""
 
     def __post_init__(self) -> None:

@@ -57,6 +57,17 @@ StepMethod = Literal["auto", "euler", "ballistic"]
 OMIT_DEFAULT = "omit_default"
 
 
+def repr_omitting_defaults(obj: Any) -> str:
+    """The dataclass ``repr`` of ``obj`` without its :data:`OMIT_DEFAULT` fields at their
+    defaults: reprs key stored cross-play cells, which stay as they were before the field."""
+    parts = [
+        f"{f.name}={getattr(obj, f.name)!r}"
+        for f in dataclasses.fields(obj)
+        if f.repr and not (f.metadata.get(OMIT_DEFAULT) and getattr(obj, f.name) == f.default)
+    ]
+    return f"{type(obj).__qualname__}({', '.join(parts)})"
+
+
 @dataclass(frozen=True)
 class SimConfig:
     """How SUMO runs. Section ``env.sim``."""
@@ -240,13 +251,7 @@ class OddConfig:
             f"got {self.exclude_inevitable!r}",
         )
 
-    def __repr__(self) -> str:
-        # The option only where set: reprs key stored cross-play cells (as before it).
-        extra = ", exclude_inevitable=True" if self.exclude_inevitable else ""
-        return (
-            f"OddConfig(pov_speed_mps={self.pov_speed_mps!r}, vut_speed_mps="
-            f"{self.vut_speed_mps!r}, gap_m={self.gap_m!r}{extra})"
-        )
+    __repr__ = repr_omitting_defaults
 
 
 @dataclass(frozen=True)
@@ -296,9 +301,19 @@ class RewardConfig:
         default_factory=lambda: RewardShape(peak_m=1.0, zero_m=5.0, value_at_contact=0.5)
     )
     """R_A while the POV changes lanes (cut-in only)."""
+    pov_failure_penalty: float = field(default=0.0, metadata={OMIT_DEFAULT: True})
+    """A case with two POVs (``lead_and_cut_in``): the further cost of a forbidden contact
+    (the POVs' failure), in units of ``alpha_collision``, on top of the POVs' safe terms.
+    Stored only when not 0 (runs written before it keep their identity)."""
+
+    __repr__ = repr_omitting_defaults
 
     def __post_init__(self) -> None:
         s = self.SECTION
+        require(
+            self.pov_failure_penalty >= 0,
+            f"{s}.pov_failure_penalty must be >= 0, got {self.pov_failure_penalty}",
+        )
         require(
             self.alpha_adversarial > 0,
             f"{s}.alpha_adversarial must be > 0, got {self.alpha_adversarial}",
@@ -384,6 +399,11 @@ class EnvConfig:
             require(path.is_file(), f"{s}.network: file not found: {path}")
             lanes = get_case(self.case).lanes
             check_sumo_network(path, f"{s}.network", ROAD_EDGE, lanes, self.case)
+        require(
+            not self.reward.pov_failure_penalty or get_case(self.case).povs > 1,
+            f"{s}.reward.pov_failure_penalty: case {self.case!r} has one POV (no forbidden "
+            "contact to penalise)",
+        )
         require(
             not self.odd.exclude_inevitable or bool(get_case(self.case).start_filter),
             f"{s}.odd.exclude_inevitable: case {self.case!r} has no inevitable-start check "

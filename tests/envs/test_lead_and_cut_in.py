@@ -302,3 +302,38 @@ def test_braking_for_the_supporting_pov_is_not_unjustified(
             break
     primary_only = episode_hazards(trajectory_from_infos(env.config, reset_info, infos), None)
     assert primary_only.unjustified_braking == 1.0
+
+
+@pytest.mark.parametrize("penalty", [0.0, 2.0])
+def test_a_forbidden_contact_costs_the_failure_penalty(penalty: float) -> None:
+    """``env.reward.pov_failure_penalty`` (α_F, in α_C): the supporting POV's cut-in into
+    the VUT pays ``-(1 + α_F)·α_C``; the default 0 is session 10's reward."""
+    from sumo_ayss.config import RewardConfig
+
+    cfg = dataclasses.replace(config(), reward=RewardConfig(pov_failure_penalty=penalty))
+    start = TwoPovStart(
+        25.0, 25.0, 40.0, support_speed_mps=12.0, support_gap_m=0.5, primary=PRIMARY_LEAD
+    )
+    env = make_env(cfg, sumo_seed=7)
+    try:
+        assert isinstance(env, LeadAndCutInEnv)
+        rewards, info = run(env, start, encode_action(HOLD, CUT_LANE_CHANGE))
+    finally:
+        env.close()
+    assert info["pov_failure"] and info["support_vut_contact"]
+    assert rewards[-1] == pytest.approx(-(1.0 + penalty) * ALPHA_C)
+
+
+def test_the_failure_penalty_is_refused_with_one_pov_and_stored_only_when_set() -> None:
+    from sumo_ayss.config import RewardConfig
+    from sumo_ayss.config.mapping import to_dict
+
+    with pytest.raises(ConfigError, match="pov_failure_penalty"):
+        EnvConfig(case="cut_in", reward=RewardConfig(pov_failure_penalty=1.0))
+    with pytest.raises(ConfigError, match=">= 0"):
+        RewardConfig(pov_failure_penalty=-1.0)
+    assert "pov_failure_penalty" not in to_dict(EnvConfig())["reward"]
+    assert "pov_failure_penalty" not in repr(EnvConfig())
+    set_ = EnvConfig(case="lead_and_cut_in", reward=RewardConfig(pov_failure_penalty=2.0))
+    assert to_dict(set_)["reward"]["pov_failure_penalty"] == 2.0
+    assert "pov_failure_penalty=2.0" in repr(set_)
