@@ -34,9 +34,9 @@ import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any
 
-from sumo_ayss.run_folder.jsonio import json_field, read_json, write_json
+from sumo_ayss.run_folder.jsonio import json_field, json_records, read_json, write_json
 from sumo_ayss.run_folder.layout import CaseFolder
 from sumo_ayss.run_folder.schemas import CROSSPLAY_SCHEMA
 from sumo_ayss.run_folder.table import Table, read_table
@@ -59,7 +59,6 @@ __all__ = [
 
 #: How the cross-play stage drives its episodes now (see the module docstring).
 ROLLOUT = "outcome"
-_R = TypeVar("_R")
 
 #: What a record without ``rollout`` was driven by.
 _LEGACY_ROLLOUT = "pairs"
@@ -178,21 +177,6 @@ def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
     )
 
 
-def _records(
-    data: Mapping[str, Any], key: str, where: str, cls: type[_R], kinds: tuple[type, ...]
-) -> tuple[_R, ...]:
-    """The list ``data[key]`` of JSON objects as ``cls`` records, field by field in the
-    order of ``cls``'s dataclass fields, each checked to be of its kind."""
-    out = []
-    for i, item in enumerate(json_field(data, key, list, where)):
-        at = f"{where}: {key}[{i}]"
-        if not isinstance(item, Mapping):
-            raise TableError(f"{at}: expected an object, got {item!r}")
-        names = [f.name for f in dataclasses.fields(cls)]  # type: ignore[arg-type]
-        out.append(cls(*(json_field(item, n, k, at) for n, k in zip(names, kinds, strict=True))))
-    return tuple(out)
-
-
 def read_crossplay_json(path: Path) -> CrossplayRecord:
     """Read ``crossplay.json``.
 
@@ -202,12 +186,12 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
     """
     data = read_json(path)
     where = str(path)
-    opponents = _records(data, "opponents", where, CrossplayOpponent, (str, int, str))
+    opponents = json_records(data, "opponents", CrossplayOpponent, where)
     vuts = json_field(data, "vuts", list, where)
     if not all(isinstance(v, str) for v in vuts):
         raise TableError(f"{where}: vuts: expected a list of names, got {vuts!r}")
     diagonal = (
-        _records(data, "diagonal", where, DiagonalCheck, (str, int, int, int))
+        json_records(data, "diagonal", DiagonalCheck, where)
         if "diagonal" in data
         else ()  # a record from before the check
     )
