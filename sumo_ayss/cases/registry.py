@@ -215,11 +215,13 @@ class Case:
 
     def env_class(self) -> type[Any]:
         """The env class (imports its module: libsumo, gymnasium)."""
-        return _resolve(self, "env")
+        env: type[Any] = _resolve(self, "env")
+        return env
 
     def ayss_row_builder(self) -> Callable[..., Any]:
         """The AYSS row builder (imports its module)."""
-        return _resolve(self, "ayss_rows")
+        rows: Callable[..., Any] = _resolve(self, "ayss_rows")
+        return rows
 
     def start_filter_factory(self) -> Callable[..., Any]:
         """The factory of :attr:`start_filter` (imports its module)."""

@@ -77,19 +77,6 @@ class AdaptiveRecord:
         """Whether the last look found the ranking settled."""
         return bool(self.looks) and self.looks[-1].settled
 
-    def same_plan(self, first_seeds: tuple[int, ...], max_seeds: int, alpha: float) -> bool:
-        """Whether this record belongs to the same schedule (a changed config starts over)."""
-        return (self.first_seeds, self.max_seeds, self.alpha) == (
-            tuple(first_seeds),
-            max_seeds,
-            alpha,
-        )
-
-    def same_vuts(self, vuts: tuple[tuple[str, str], ...]) -> bool:
-        """Whether this record looked at the VUTs ``vuts`` (``(name, key)``, in any order);
-        a record that does not name its VUTs (written before they were) is taken as is."""
-        return not self.vuts or dict(self.vuts) == dict(vuts)
-
 
 def write_adaptive(path: str | Path, record: AdaptiveRecord) -> None:
     """Write ``adaptive.json`` atomically."""

@@ -19,7 +19,8 @@ that each SPCP, driven against its own VUT, reproduced its run's ``outcome.csv``
 how many of the ``n`` episodes were equal (absent in older records). ``vut_keys`` names the
 vehicle each VUT name stood for (:func:`~sumo_ayss.config.identity.vut_key` of its
 definition; absent in older records): a study that adds, drops, redefines or renames a VUT
-keeps the cells whose VUT and opponent are unchanged (:mod:`.crossplay_cells`).
+keeps the cells whose VUT and opponent are unchanged
+(:mod:`sumo_ayss.stages.crossplay_cells`).
 
 :func:`load_crossplay` reads a case's table and record back for the analysis, as stored
 (:class:`CrossplayTables`); the analysis scores them on the runs' harm scale
@@ -34,7 +35,7 @@ import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from sumo_ayss.run_folder.jsonio import json_field, json_records, read_json, write_json
 from sumo_ayss.run_folder.layout import CaseFolder
@@ -131,27 +132,6 @@ class CrossplayRecord:
     rollout: str = ROLLOUT
     diagonal: tuple[DiagonalCheck, ...] = ()
     vut_keys: tuple[str, ...] = ()
-
-    def same_vuts(self, other: CrossplayRecord) -> bool:
-        """Whether both tables drive the same VUTs in the same order and, where both
-        records name their definitions, the same vehicles."""
-        keys = not (self.vut_keys and other.vut_keys) or self.vut_keys == other.vut_keys
-        return self.vuts == other.vuts and keys
-
-    def inputs(self) -> dict[str, Any]:
-        """What the table was made from: the scenario set, the opponents and how they were
-        driven (the cross-play stage's inputs, :class:`~.stage.CrossplayStage`)."""
-        return {
-            "n": self.n,
-            "seed": self.seed,
-            "opponents": [dataclasses.asdict(o) for o in self.opponents],
-            "rollout": self.rollout,
-        }
-
-    def same_scenarios(self, other: CrossplayRecord) -> bool:
-        """Whether both tables' cells were driven on the same scenarios in the same way,
-        so that a cell of one may stand for the same cell of the other."""
-        return (self.n, self.seed, self.rollout) == (other.n, other.seed, other.rollout)
 
 
 def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:

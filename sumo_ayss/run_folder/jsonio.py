@@ -174,7 +174,7 @@ def json_records(
         at = f"{where}: {key}[{i}]"
         if not isinstance(item, Mapping):
             raise error(f"{at}: expected an object, got {item!r}")
-        fields = {}
+        fields: dict[str, Any] = {}
         for f in dataclasses.fields(cls):  # type: ignore[arg-type]
             kind = str(f.type)
             if kind == "float":

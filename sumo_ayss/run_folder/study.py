@@ -36,8 +36,6 @@ from sumo_ayss.run_folder.layout import (
     CaseFolder,
     FolderFile,
     RunFolder,
-    case_dir_for,
-    run_dir_for,
 )
 from sumo_ayss.run_folder.table import read_table, text_schema, write_rows
 from sumo_ayss.util.atomic import atomic_write_json
@@ -184,11 +182,11 @@ class StudyFolder:
 
     def case(self, case: str) -> CaseFolder:
         """The case folder ``<out>/<case>/``."""
-        return CaseFolder(case_dir_for(self.path, case))
+        return CaseFolder(self.path / case)
 
     def run(self, case: str, vut: str, seed: int) -> RunFolder:
         """The run folder ``<out>/<case>/<vut>/seed_<seed>/``."""
-        return RunFolder(run_dir_for(self.path, case, vut, seed))
+        return RunFolder(self.path / case / vut / f"seed_{seed}")
 
 
 # --------------------------------------------------------------------------- pipeline.json
