@@ -225,7 +225,8 @@ class Case:
 
     def start_filter_factory(self) -> Callable[..., Any]:
         """The factory of :attr:`start_filter` (imports its module)."""
-        return _resolve(self, "start_filter")
+        factory: Callable[..., Any] = _resolve(self, "start_filter")
+        return factory
 
 
 def _resolve(case: Case, attr: str) -> Any:
