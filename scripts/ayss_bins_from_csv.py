@@ -12,7 +12,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from sumo_ayss.run_folder import RunFolder, backfill_ayss_bins, find_run_dirs
+from sumo_ayss.run_folder import RunFolder, find_run_dirs
+from sumo_ayss.run_folder.ayss_bins import backfill_ayss_bins
 
 
 def main(studies: list[str]) -> None:

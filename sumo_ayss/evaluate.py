@@ -46,13 +46,12 @@ from sumo_ayss.run_folder import (
     RunRecord,
     StageHeader,
     ayss_cells,
-    backfill_ayss_bins,
     read_run,
-    write_ayss_bins,
     write_ayss_json,
     write_outcome_json,
     write_table,
 )
+from sumo_ayss.run_folder.ayss_bins import backfill_ayss_bins, write_ayss_bins
 from sumo_ayss.scenarios.ayss import run_ayss
 from sumo_ayss.scenarios.outcome import (
     DEFAULT_OUTCOME_N,

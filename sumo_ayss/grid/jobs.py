@@ -18,10 +18,10 @@ from sumo_ayss.config import AyssConfig, ExperimentConfig
 from sumo_ayss.run_folder import (
     RunFolder,
     StudyFolder,
-    backfill_ayss_bins,
     read_run,
     write_progress,
 )
+from sumo_ayss.run_folder.ayss_bins import backfill_ayss_bins
 from sumo_ayss.stages import EvaluateStage, TrainStage, is_done
 from sumo_ayss.util.errors import ControllerError, DiskFullError
 from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE

@@ -75,13 +75,7 @@ from sumo_ayss.run_folder.adaptive import (
     read_adaptive,
     write_adaptive,
 )
-from sumo_ayss.run_folder.ayss_bins import (
-    AyssCells,
-    ayss_cells,
-    backfill_ayss_bins,
-    read_ayss_bins,
-    write_ayss_bins,
-)
+from sumo_ayss.run_folder.ayss_bins import ayss_cells
 from sumo_ayss.run_folder.crossplay import (
     CrossplayOpponent,
     CrossplayRecord,
@@ -124,7 +118,6 @@ from sumo_ayss.run_folder.record import (
     read_run,
 )
 from sumo_ayss.run_folder.schemas import (
-    AYSS_BINS_SCHEMA,
     AYSS_SCHEMA,
     CROSSPLAY_SCHEMA,
     OUTCOME_SCHEMA,
@@ -161,14 +154,12 @@ from sumo_ayss.run_folder.table import (
 )
 
 __all__ = [
-    "AYSS_BINS_SCHEMA",
     "AYSS_SCHEMA",
     "CROSSPLAY_SCHEMA",
     "EVAL_SCHEMA",
     "OUTCOME_SCHEMA",
     "AdaptiveLook",
     "AdaptiveRecord",
-    "AyssCells",
     "CaseFolder",
     "CellStore",
     "CrossplayOpponent",
@@ -186,14 +177,12 @@ __all__ = [
     "StudyFolder",
     "Table",
     "ayss_cells",
-    "backfill_ayss_bins",
     "case_of",
     "case_runs",
     "find_run_dirs",
     "group_runs",
     "load_runs",
     "read_adaptive",
-    "read_ayss_bins",
     "read_ayss_json",
     "read_crossplay_json",
     "read_discriminability_json",
@@ -208,7 +197,6 @@ __all__ = [
     "stored_experiment",
     "table_from_rows",
     "write_adaptive",
-    "write_ayss_bins",
     "write_ayss_json",
     "write_crossplay_json",
     "write_discriminability",

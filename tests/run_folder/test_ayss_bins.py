@@ -30,7 +30,8 @@ from sumo_ayss.config import AyssConfig, load_experiment
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.evaluate import evaluate_run
 from sumo_ayss.report import figures
-from sumo_ayss.run_folder import AyssCells, ayss_cells, read_ayss_bins, read_run, write_ayss_bins
+from sumo_ayss.run_folder import ayss_cells, read_run
+from sumo_ayss.run_folder.ayss_bins import AyssCells, read_ayss_bins, write_ayss_bins
 from sumo_ayss.train import train
 from sumo_ayss.util.errors import ConfigError
 from tests.helpers import tiny_experiment
