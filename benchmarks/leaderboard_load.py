@@ -4,6 +4,7 @@
         [--budget tiny] [--seeds 1 2 3]
     python benchmarks/leaderboard_load.py --out runs/load12 --k 12 --vuts varied --budget verdict
     python benchmarks/leaderboard_load.py --out runs/load12 --analyse   # tables of a finished run
+    python benchmarks/leaderboard_load.py --row-bytes   # heap per cross-play row held in memory
 
 Writes ``<out>/load.yaml`` and runs ``python -m sumo_ayss.rank <out>/load.yaml --no-live`` on
 it as a child process.
@@ -332,6 +333,30 @@ def analyse(out: Path) -> dict:
     return result
 
 
+def row_bytes(n: int = 20_000) -> dict[str, float]:
+    """Python heap per cross-play row [bytes], measured with tracemalloc on ``n`` rows shaped
+    as :func:`sumo_ayss.scenarios.crossplay.run_crossplay` holds them (a dict per episode,
+    every column of the schema) and then as the table built from them."""
+    import random
+    import tracemalloc
+
+    from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, table_from_rows
+
+    names = [c.name for c in CROSSPLAY_SCHEMA.columns]
+    tracemalloc.start()
+    rows = []
+    for i in range(n):
+        row: dict[str, object] = {c: random.random() for c in names}
+        row |= {"vut": "pi1", "opponent_vut": "pi2", "opponent_seed": 3, "scenario": i % 200}
+        row |= {"collided": i % 7 == 0, "n_steps": 25}
+        rows.append(row)
+    held = tracemalloc.get_traced_memory()[0]
+    table_from_rows(CROSSPLAY_SCHEMA, rows)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    return {"rows_b_per_row": round(held / n), "peak_b_per_row": round(peak / n)}
+
+
 def run(out: Path, config: Path, meta: dict, period_s: float = 0.5) -> None:
     """Run ``rank`` on ``config``, sampling its process tree; write the raw records."""
     cmd = [sys.executable, "-m", "sumo_ayss.rank", str(config), "--no-live"]
@@ -379,7 +404,11 @@ def main() -> None:
     p.add_argument("--budget", choices=["tiny", "verdict"], default="tiny")
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3], help="tiny budget only")
     p.add_argument("--analyse", action="store_true", help="only the tables of a run in --out")
+    p.add_argument("--row-bytes", action="store_true", help="only the heap per cross-play row")
     args = p.parse_args()
+    if args.row_bytes:
+        print(row_bytes())
+        return
     if not args.analyse:
         config = write_config(args.out, args.k, args.seeds, args.budget, args.vuts)
         meta = {

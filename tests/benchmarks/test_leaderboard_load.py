@@ -134,3 +134,8 @@ def test_the_varied_set_has_twelve_vuts_without_an_action_step(load: ModuleType)
     assert len(vuts) == 12
     for spec in vuts.values():
         assert spec is None or "actionStepLength" not in spec.get("params", {})
+
+
+def test_a_cross_play_row_costs_more_than_its_floats(load: ModuleType) -> None:
+    sizes = load.row_bytes(2000)
+    assert 33 * 24 < sizes["rows_b_per_row"] <= sizes["peak_b_per_row"] < 10_000
