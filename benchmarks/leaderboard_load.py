@@ -294,7 +294,12 @@ def read_run(out: Path) -> tuple[list[tuple[float, str]], list[Sample], dict]:
             events.append((float(t), line))
     with (out / "samples.csv").open() as f:
         samples = [Sample(*(float(v) for v in r[:3]), int(r[3])) for r in list(csv.reader(f))[1:]]
-    meta = json.loads((out / "run.json").read_text())
+    if (out / "run.json").is_file():
+        meta = json.loads((out / "run.json").read_text())
+    else:  # still running (or killed): the stages so far, the last one cut at the last sample
+        cfg = yaml.safe_load((out / "load.yaml").read_text())
+        budget = cfg.get("budget", "tiny")
+        meta = {"k": len(cfg["grid"]["vuts"]), "vuts": "?", "budget": budget, "returncode": None}
     return events, samples, meta
 
 

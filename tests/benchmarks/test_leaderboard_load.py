@@ -139,3 +139,15 @@ def test_the_varied_set_has_twelve_vuts_without_an_action_step(load: ModuleType)
 def test_a_cross_play_row_costs_more_than_its_floats(load: ModuleType) -> None:
     sizes = load.row_bytes(2000)
     assert 33 * 24 < sizes["rows_b_per_row"] <= sizes["peak_b_per_row"] < 10_000
+
+
+def test_analyse_a_run_still_going(load: ModuleType, tmp_path: Path) -> None:
+    # No run.json yet: the stages so far, the last cut at the last sample; files written.
+    load.write_config(tmp_path, 2, [1], "verdict", "varied")
+    (tmp_path / "events.tsv").write_text("".join(f"{t}\t{line}\n" for t, line in _events()[:4]))
+    rows = "".join(f"{t},{100 + t},{2.0 * t},3\n" for t in range(0, 20))
+    (tmp_path / "samples.csv").write_text("t_s,rss_mib,cpu_s,n_procs\n" + rows)
+    result = load.analyse(tmp_path)
+    assert [r["stage"] for r in result["stages"]] == ["setup", "grid", "cross-play"]
+    assert result["stages"][2]["cpu_s"] == pytest.approx(38.0 - 22.0)  # 11 s -> 19 s
+    assert (tmp_path / "stages.csv").read_text().startswith("stage,segments,wall_s,cpu_s")
