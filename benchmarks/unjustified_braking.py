@@ -26,10 +26,7 @@ from sumo_ayss.analysis.hazards import (
     unjustified_braking,
 )
 from sumo_ayss.analysis.safety_measures import PairTrajectory
-from sumo_ayss.config import EnvConfig, FollowerConfig
-from sumo_ayss.envs import make_env
-from sumo_ayss.envs.odd import sample_initial_conditions, with_followers
-from sumo_ayss.scenarios.trajectory import trajectory_from_infos
+from sumo_ayss.scenarios.scripted import scripted_episodes
 from sumo_ayss.vuts.catalog import BUILTIN_VUTS
 from sumo_ayss.vuts.reference_types import OVERBRAKER_VUT
 
@@ -37,44 +34,11 @@ VUTS = ("pi1", "pi2", "overbraker")
 CASES = ("car_following", "cut_in")
 
 
-def pov_action(case: str, rng: np.random.Generator, obs: np.ndarray, t: int, lc_at: int) -> int:
-    """The scripted POV's action (car-following: k·0.5·v_pov; cut-in: 0 = lane change,
-    1 + k = k m/s)."""
-    u = rng.random()
-    if case == "car_following":
-        return 0 if u < 0.08 else 1 if u < 0.2 else 2 if u < 0.85 else 3
-    if t == lc_at:
-        return 0
-    d = -8 if u < 0.08 else -3 if u < 0.2 else 0 if u < 0.85 else 3
-    return 1 + int(np.clip(round(float(obs[0])) + d, 0, 40))
-
-
 def episodes(case: str, vut: str, n: int, seed: int = 11) -> list[PairTrajectory]:
     """``n`` episodes of ``vut`` in ``case`` (the same scenarios and POV for every VUT)."""
-    cfg = EnvConfig(
-        case=case,
-        vuts={**BUILTIN_VUTS, "overbraker": OVERBRAKER_VUT},
-        vut=vut,
-        follower=FollowerConfig(enabled=True),
+    return scripted_episodes(
+        case, vut, {**BUILTIN_VUTS, "overbraker": OVERBRAKER_VUT}, n, seed=seed
     )
-    ics = with_followers(sample_initial_conditions(cfg.odd, n, seed), cfg.follower, seed)
-    env = make_env(cfg, sumo_seed=0)
-    out = []
-    try:
-        for i, ic in enumerate(ics):
-            rng = np.random.default_rng(1000 + i)
-            obs, info0 = env.reset(options={"initial_condition": ic})
-            lc_at = int(rng.integers(0, 15))
-            infos = []
-            for t in range(cfg.max_decisions):
-                obs, _, term, trunc, info = env.step(pov_action(case, rng, obs, t, lc_at))
-                infos.append(info)
-                if term or trunc:
-                    break
-            out.append(trajectory_from_infos(cfg, info0, infos))
-    finally:
-        env.close()
-    return out
 
 
 Rule = Callable[[PairTrajectory], np.ndarray]

@@ -163,8 +163,9 @@ def bench_ladder(
 
     import yaml
 
-    from sumo_ayss.pipeline import load_pipeline, run_pipeline
-    from sumo_ayss.rank import main as rank_main
+    from sumo_ayss.commands.pipeline import run_pipeline
+    from sumo_ayss.commands.rank import main as rank_main
+    from sumo_ayss.pipeline import load_pipeline
 
     out = (out_root or folder) / f"ladder_{kind.split()[0]}"
     gaps = {"tg06": 0.6, "tg12": 1.2, "tg20": 2.0}

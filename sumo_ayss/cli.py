@@ -10,7 +10,9 @@
     sumo-ayss networks
 
 ``sumo-ayss <command> ...`` is the same as ``python -m <module> ...`` of the command's
-module (:data:`COMMANDS`); ``sumo-ayss <command> --help`` names itself ``sumo-ayss
+module (:data:`COMMANDS`; ``pipeline`` and ``rank`` are the commands above their stages,
+:mod:`sumo_ayss.commands`, which ``python -m sumo_ayss.pipeline`` and ``python -m
+sumo_ayss.rank`` run too); ``sumo-ayss <command> --help`` names itself ``sumo-ayss
 <command>``.
 """
 
@@ -24,9 +26,9 @@ COMMANDS = {
     "train": ("sumo_ayss.train", "train one (case, VUT, seed) and select its SPCP"),
     "evaluate": ("sumo_ayss.evaluate", "outcome table and Monte Carlo AYSS of a run's SPCP"),
     "report": ("sumo_ayss.report.__main__", "HTML + Markdown report from run folders"),
-    "pipeline": ("sumo_ayss.pipeline", "the grid cases x VUTs x seeds, resumable"),
+    "pipeline": ("sumo_ayss.commands.pipeline", "the grid cases x VUTs x seeds, resumable"),
     "rank": (
-        "sumo_ayss.rank",
+        "sumo_ayss.commands.rank",
         "leaderboard of K VUTs by safety (a pipeline + ranking; default mode cross-play)",
     ),
     "discriminability": (

@@ -64,6 +64,7 @@ from sumo_ayss.run_folder import (
     write_table,
 )
 from sumo_ayss.stages import CellPlan, CrossplayStage, is_done, merged_rows, plan_cells
+from sumo_ayss.stages.crossplay_cells import same_scenarios
 from sumo_ayss.util.errors import AyssError, CheckpointError, TableError
 from sumo_ayss.vuts.catalog import controller_imports
 from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
@@ -357,7 +358,7 @@ def _reusable(folder: CaseFolder, requested: CrossplayRecord) -> CellPlan | None
         return None
     try:
         done = read_crossplay_json(folder.crossplay_json)
-        if not (done.same_scenarios(requested) and done.diagonal):
+        if not (same_scenarios(done, requested) and done.diagonal):
             return None
         rows = read_table(folder.crossplay_csv, CROSSPLAY_SCHEMA).rows()
         return plan_cells(done, rows, requested)

@@ -52,9 +52,8 @@ import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal, NamedTuple
+from typing import TYPE_CHECKING, Any, Literal, NamedTuple, Protocol
 
-from sumo_ayss.cli import STRICT_HELP, prog
 from sumo_ayss.config import (
     PipelineConfig,
     check_out_dir,
@@ -73,16 +72,32 @@ from sumo_ayss.util.errors import AyssError, DiskFullError
 
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
+    from sumo_ayss.config.report import ReportOptions
 
 logger = logging.getLogger("sumo_ayss.pipeline")  # also when run as __main__
 
 Backend = Literal["local", "ray"]
 
 
+class ReportWriter(Protocol):
+    """Writes a study's report from its loaded runs and analyses; returns ``report.html``
+    (:func:`sumo_ayss.report.document.write_report_for`, handed in by the command,
+    :mod:`sumo_ayss.commands.pipeline`: the stage imports no renderer)."""
+
+    def __call__(
+        self,
+        runs: Sequence[RunRecord],
+        out_dir: Path,
+        *,
+        analyses: Sequence[CaseAnalysis[RunRecord]] | None = ...,
+        options: ReportOptions | None = ...,
+    ) -> Path: ...
+
+
 __all__ = [
     "PipelineResult",
+    "ReportWriter",
     "load_pipeline",
-    "main",
     "plan_jobs",
     "run_crossplay_stage",
     "run_pipeline",
@@ -94,7 +109,8 @@ class PipelineResult(NamedTuple):
 
     Attributes:
         statuses: One per job, in grid order.
-        report: The report's ``report.html``, or None when no job finished.
+        report: The report's ``report.html``, or None when no job finished or no report
+            writer was handed in.
         runs: The finished jobs' run folders, read once
             (:func:`sumo_ayss.run_folder.read_run`), in the order of ``statuses``.
         analyses: Every case's analysis (:func:`sumo_ayss.modes.analyse_cases`, paper
@@ -181,9 +197,15 @@ def run_pipeline(
     address: str | None = None,
     live: bool = True,
     console: Any = None,
+    report: ReportWriter | None = None,
 ) -> PipelineResult:
     """Run the grid, then load every finished job's run folder, analyse each case once and
-    write the report; return the statuses, the report, the loaded runs and the analyses.
+    (with ``report``) write the report; return the statuses, the report, the loaded runs and
+    the analyses.
+
+    ``report``: the report writer, called with the runs and the analyses while the output
+    folder is still locked (the command's, :func:`sumo_ayss.commands.pipeline.run_pipeline`;
+    None: no report, :attr:`PipelineResult.report` is None).
 
     The output folder is locked while it runs (:func:`sumo_ayss.grid.folder_lock.output_lock`):
     a second pipeline on it is refused with a :class:`~sumo_ayss.util.errors.LockError` naming
@@ -197,7 +219,7 @@ def run_pipeline(
     jobs = plan_jobs(cfg)
     check_out_dir(cfg.out, "out")
     with output_lock(cfg.out):  # one writer per output folder
-        return _run_locked(cfg, jobs, backend, address, live, console)
+        return _run_locked(cfg, jobs, backend, address, live, console, report)
 
 
 def _run_locked(
@@ -207,6 +229,7 @@ def _run_locked(
     address: str | None,
     live: bool,
     console: Any,
+    write_report: ReportWriter | None,
 ) -> PipelineResult:
     """:func:`run_pipeline` once the output folder's lock is held."""
     from sumo_ayss.grid.study import prepare_out, set_aside_redefined
@@ -240,7 +263,6 @@ def _run_locked(
     if not finished:
         return PipelineResult(statuses, None, [], [], cfg, notes)
     from sumo_ayss.grid.adaptive import is_adaptive, run_adaptive
-    from sumo_ayss.report.document import write_report_for
 
     runs = load_runs(finished)  # read once: cross-play, the report and rank use them
     if get_mode(cfg.report.mode).runs_crossplay:
@@ -250,9 +272,14 @@ def _run_locked(
             cfg, statuses, runs, run_jobs, run_crossplay_stage, plan_seed, load_runs
         )
     write_discriminability(cfg)
-    logger.info("report: analysing %d run folders and drawing the figures", len(runs))
+    drawing = " and drawing the figures" if write_report is not None else ""
+    logger.info("report: analysing %d run folders%s", len(runs), drawing)
     analyses = analyse_cases(case_runs(runs), cfg.report)  # once per case: the report's and rank's
-    report = write_report_for(runs, study.report_dir, analyses=analyses, options=cfg.report)
+    report = (
+        None
+        if write_report is None
+        else write_report(runs, study.report_dir, analyses=analyses, options=cfg.report)
+    )
     return PipelineResult(statuses, report, runs, analyses, cfg, notes)
 
 
@@ -423,60 +450,7 @@ def config_from_args(args: argparse.Namespace) -> PipelineConfig:
     return cfg
 
 
-def main(argv: Sequence[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(
-        prog=prog("python -m sumo_ayss.pipeline"), description=__doc__.splitlines()[0]
-    )
-    parser.add_argument(
-        "config", type=Path, help="pipeline YAML (configs/paper.yaml runs the paper's grid)"
-    )
-    add_config_flags(parser)
-    parser.add_argument("--backend", choices=["local", "ray"], default="local")
-    parser.add_argument("--address", default=None, help="Ray cluster address (ray backend)")
-    parser.add_argument(
-        "--no-live",
-        action="store_true",
-        help="no live table: one log line per job event (the default when stdout is not a "
-        "terminal)",
-    )
+if __name__ == "__main__":  # python -m sumo_ayss.pipeline: the command (sumo_ayss.commands)
+    from sumo_ayss.commands.pipeline import main
 
-    parser.add_argument("--strict", action="store_true", help=STRICT_HELP)
-    args = parser.parse_args(argv)
-    console = configure_logging(not args.no_live)
-    try:
-        cfg = config_from_args(args)
-        result = run_pipeline(
-            cfg,
-            backend=args.backend,
-            address=args.address,
-            live=console is not None,
-            console=console,
-        )
-    except AyssError as e:
-        sys.exit(f"error: {e}")
-    except KeyboardInterrupt:
-        print("interrupted: no job runs any more; rerun the same command to resume", flush=True)
-        sys.exit(130)
-    if result.analyses:
-        from sumo_ayss.report.leaderboard import leaderboard_text
-
-        print(leaderboard_text(result.analyses))
-    for line in final_messages(result):
-        print(line)
-    from sumo_ayss.modes import input_problems
-
-    problems = input_problems(result.analyses)
-    for line in problems:
-        print(f"WARNING: {line}", file=sys.stderr)
-    if any(s.state == "failed" for s in result.statuses):
-        sys.exit(1)
-    if args.strict and problems:
-        sys.exit(
-            f"error: --strict: {len(problems)} problem(s) in the input files (the WARNING "
-            "lines above); the report was written"
-        )
-    sys.exit(0)
-
-
-if __name__ == "__main__":
     main()

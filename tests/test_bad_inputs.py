@@ -264,7 +264,7 @@ def test_pipeline_seed_override_out_of_range_is_refused(tmp_path: Path) -> None:
 def test_pipeline_without_a_config_argument_refuses_to_start(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    from sumo_ayss.pipeline import main
+    from sumo_ayss.commands.pipeline import main
 
     with pytest.raises(SystemExit) as info:
         main([])
@@ -273,7 +273,7 @@ def test_pipeline_without_a_config_argument_refuses_to_start(
 
 
 def test_pipeline_out_pointing_at_a_file_is_refused_before_any_job(tmp_path: Path) -> None:
-    from sumo_ayss.pipeline import main
+    from sumo_ayss.commands.pipeline import main
 
     exp = _yaml(tmp_path, yaml.safe_dump({"env": {"case": "car_following"}}), "cf.yaml")
     file = _yaml(tmp_path, "precious\n", "results.txt")
@@ -451,7 +451,8 @@ def test_a_controller_failure_in_a_pipeline_job_is_not_retried(
 ) -> None:
     """A controller that raises mid-run raises again on a retry (same seed, same path): the
     retry only delayed the pipeline's exit (by 18-40 s in the issue, 21.8 s measured)."""
-    from sumo_ayss.pipeline import load_pipeline, run_pipeline
+    from sumo_ayss.commands.pipeline import run_pipeline
+    from sumo_ayss.pipeline import load_pipeline
 
     module = tmp_path / "late.py"
     module.write_text(
@@ -1033,7 +1034,7 @@ def test_rank_no_run_warns_on_the_console_naming_a_damaged_file(
     damage: Corruption,
     expected: str,
 ) -> None:
-    from sumo_ayss.rank import main
+    from sumo_ayss.commands.rank import main
 
     damaged = _case_folder(tmp_path / "runs", name, damage)
     args = [str(_rank_pipeline(tmp_path)), "--no-run", "--no-live"]
@@ -1062,12 +1063,13 @@ def test_pipeline_warns_on_the_console_and_fails_under_strict(
     """The pipeline's end prints the analyses' problems as rank and report do (here the
     grid runner is replaced by the analyses it hands on: a run whose candidates all scored
     the same)."""
-    import sumo_ayss.pipeline as pipeline
+    import sumo_ayss.commands.pipeline as pipeline
+    from sumo_ayss.pipeline import PipelineResult
     from sumo_ayss.rank import analyse
 
     damaged = _case_folder(tmp_path / "runs", f"{PI1}/eval.csv", _flat_returns)
     analyses = analyse(sorted((tmp_path / "runs").glob("*/*/seed_*")))
-    result = pipeline.PipelineResult([], None, [], analyses)
+    result = PipelineResult([], None, [], analyses)
     monkeypatch.setattr(pipeline, "run_pipeline", lambda cfg, **kw: result)
     args = [str(_rank_pipeline(tmp_path)), "--no-live"]
     with pytest.raises(SystemExit) as info:
@@ -1125,8 +1127,8 @@ def test_a_second_writer_on_a_locked_output_folder_is_refused_naming_the_holder(
     import subprocess
     import sys
 
-    from sumo_ayss.pipeline import main as pipeline_main
-    from sumo_ayss.rank import main as rank_main
+    from sumo_ayss.commands.pipeline import main as pipeline_main
+    from sumo_ayss.commands.rank import main as rank_main
 
     pipe, out = _tiny_pipeline(tmp_path)
     holder = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"])

@@ -55,20 +55,15 @@ NO_IMPORTS = (
     ("sumo_ayss.analysis", "sumo_ayss.run_folder"),
     ("sumo_ayss.run_folder", "sumo_ayss.analysis"),
 )
-#: The stages whose imports of the report are counted (issue 34: data flows one way, the
-#: report is the end of it): what they take from it may only shrink.
+#: The stages that import nothing of the report at any level (issue 34: data flows one way,
+#: the report is the end of it): the commands that end in documents sit above both
+#: (:mod:`sumo_ayss.commands`).
 REPORT_FREE = ("sumo_ayss.pipeline", "sumo_ayss.rank", "sumo_ayss.crossplay", "sumo_ayss.grid")
-#: What of the report they still take: rendered study documents only (the report the
-#: pipeline writes at its end, the terminal leaderboard, ranking.md's reference-driver lines,
-#: measures.csv); helpers, checks and formatting live below the report.
-REPORT_DOCUMENTS = (
-    "sumo_ayss.report",
-    "sumo_ayss.report.document",
-    "sumo_ayss.report.leaderboard",
-    "sumo_ayss.report.measures",
-    "sumo_ayss.report.sections",
-    "sumo_ayss.report.sections.reference",
-)
+#: Where a stage module's ``if __name__ == "__main__":`` guard may hand over (``python -m
+#: sumo_ayss.<stage>``): its own command. Imports under the guard run only when the file is
+#: the program (``__main__``), never when the module is imported, so they are no edge of the
+#: import graph; :func:`test_main_guards_hand_over_to_their_command` checks them instead.
+COMMANDS_PACKAGE = "sumo_ayss.commands"
 #: Packages whose ``__init__`` is a docstring: importing one of their modules runs nothing
 #: else of them (checked below), so the package edge itself carries no import.
 PACKAGES_WITHOUT_CODE = frozenset({"sumo_ayss.util"})
@@ -112,6 +107,8 @@ def _imports(body: list[ast.stmt], in_function: bool) -> Iterator[tuple[ast.stmt
     for node in body:
         if isinstance(node, ast.Import | ast.ImportFrom):
             yield node, in_function
+        elif _is_main_guard(node):  # runs only as the program: see COMMANDS_PACKAGE
+            continue
         elif isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
             yield from _imports(node.body, True)
         else:  # incl. ``if TYPE_CHECKING:``: a type-only import is a dependency too
@@ -123,6 +120,35 @@ def _imports(body: list[ast.stmt], in_function: bool) -> Iterator[tuple[ast.stmt
                         if isinstance(child, ast.ExceptHandler | ast.match_case):
                             stmts.extend(child.body)
                     yield from _imports(stmts, in_function)
+
+
+def _is_main_guard(node: ast.stmt) -> bool:
+    """``if __name__ == "__main__":``."""
+    test = getattr(node, "test", None)
+    return (
+        isinstance(node, ast.If)
+        and isinstance(test, ast.Compare)
+        and isinstance(test.left, ast.Name)
+        and test.left.id == "__name__"
+        and len(test.comparators) == 1
+        and isinstance(test.comparators[0], ast.Constant)
+        and test.comparators[0].value == "__main__"
+    )
+
+
+def main_guard_imports(modules: dict[str, Path]) -> dict[str, list[str]]:
+    """Module -> the modules its ``if __name__ == "__main__":`` guard imports."""
+    found: dict[str, list[str]] = {}
+    for name, path in modules.items():
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if _is_main_guard(node):
+                found[name] = [
+                    (n.module or "") if isinstance(n, ast.ImportFrom) else a.name
+                    for n in ast.walk(node)
+                    if isinstance(n, ast.Import | ast.ImportFrom)
+                    for a in n.names
+                ]
+    return found
 
 
 def _with_packages(name: str, modules: dict[str, Path]) -> set[str]:
@@ -271,9 +297,23 @@ def report_imports(modules: dict[str, Path]) -> list[tuple[str, str]]:
     )
 
 
-def test_the_stages_take_only_rendered_documents_from_the_report() -> None:
-    edges = report_imports(module_files())
-    assert [(a, b) for a, b in edges if b not in REPORT_DOCUMENTS] == []
+def test_the_stages_import_nothing_of_the_report() -> None:
+    """pipeline, rank, crossplay and grid import no report module at any level; the
+    commands above them hand the report their data (:mod:`sumo_ayss.commands`)."""
+    assert report_imports(module_files()) == []
+
+
+def test_main_guards_hand_over_to_their_command() -> None:
+    """A module's ``__main__`` guard imports nothing, or (a stage whose command lives above
+    it) only ``sumo_ayss.commands.<stage>``; at least pipeline's and rank's do."""
+    guards = main_guard_imports(module_files())
+    handing_over = {}
+    for module, imported in guards.items():
+        stage = module.rpartition(".")[2]
+        assert set(imported) <= {f"{COMMANDS_PACKAGE}.{stage}"}, (module, imported)
+        if imported:
+            handing_over[module] = imported
+    assert {"sumo_ayss.pipeline", "sumo_ayss.rank"} <= set(handing_over)
 
 
 def script_report_imports(scripts: Path) -> list[str]:

@@ -13,8 +13,9 @@ from typing import Any
 import pytest
 import yaml
 
+from sumo_ayss.commands.pipeline import run_pipeline
 from sumo_ayss.config import PROJECT_ROOT
-from sumo_ayss.pipeline import load_pipeline, run_pipeline
+from sumo_ayss.pipeline import load_pipeline
 from tests.helpers import TINY_AGENT
 
 ACC_INPUTS = {

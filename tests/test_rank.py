@@ -8,10 +8,11 @@ from pathlib import Path
 import pytest
 import yaml
 
+from sumo_ayss.commands.rank import main
 from sumo_ayss.config import PROJECT_ROOT
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes.paper import paper_result
-from sumo_ayss.rank import analyse, main, order_check, ranking_rows, write_ranking
+from sumo_ayss.rank import analyse, order_check, ranking_rows, write_ranking
 from sumo_ayss.run_folder import read_run
 from sumo_ayss.run_folder.study import read_order_check, read_ranking_csv
 from tests.report.test_report import EXPOSURE, OFFSET, make_crossplay, make_run

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
+from sumo_ayss.commands.rank import main as rank_main
 from sumo_ayss.config import PROJECT_ROOT, to_dict
 from sumo_ayss.config.pipeline import load_pipeline
 from sumo_ayss.pipeline import plan_jobs
-from sumo_ayss.rank import main as rank_main
 from sumo_ayss.util.errors import ConfigError
 from tests.test_rank import _pipe_yaml, _three_vuts
 

@@ -31,7 +31,9 @@ class GreedyPolicy:
     def q_values(self, obs: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
         with th.no_grad():
             obs_t = th.as_tensor(np.asarray(obs, dtype=np.float32), device=self.device)
-            return self.q_net(obs_t).cpu().numpy()
+            q: npt.NDArray[np.float32] = self.q_net(obs_t).cpu().numpy()
+            return q
 
     def __call__(self, obs: npt.NDArray[np.float32]) -> npt.NDArray[np.int64]:
-        return self.q_values(obs).argmax(axis=1).astype(np.int64)
+        actions: npt.NDArray[np.int64] = self.q_values(obs).argmax(axis=1).astype(np.int64)
+        return actions

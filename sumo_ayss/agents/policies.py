@@ -52,7 +52,7 @@ class DuelingQNetwork(BasePolicy):
 
     def __init__(
         self,
-        observation_space: spaces.Space,
+        observation_space: spaces.Space[Any],
         action_space: spaces.Discrete,
         features_extractor: BaseFeaturesExtractor,
         features_dim: int,
@@ -111,7 +111,8 @@ class DuelingQNetwork(BasePolicy):
 
     def _predict(self, observation: PyTorchObs, deterministic: bool = True) -> th.Tensor:
         """Return the greedy action per observation, shape (batch,)."""
-        return self(observation).argmax(dim=1).reshape(-1)
+        action: th.Tensor = self(observation).argmax(dim=1).reshape(-1)
+        return action
 
     def _get_constructor_parameters(self) -> dict[str, Any]:
         data = super()._get_constructor_parameters()
@@ -148,7 +149,7 @@ class AyssDQNPolicy(DQNPolicy):
 
     def __init__(
         self,
-        observation_space: spaces.Space,
+        observation_space: spaces.Space[Any],
         action_space: spaces.Discrete,
         lr_schedule: Schedule,
         feature_net_arch: Sequence[int] = DEFAULT_ARCH,
@@ -223,7 +224,8 @@ def _run_mlp(mlp: nn.Sequential, x: th.Tensor) -> th.Tensor:
         elif kind is nn.ReLU and not layer.inplace:
             y = F.relu(y)
         else:
-            return mlp(x)  # start over, through the modules
+            out: th.Tensor = mlp(x)  # start over, through the modules
+            return out
     return y
 
 

@@ -68,7 +68,8 @@ class SumTree:
 
     def get(self, indices: np.ndarray) -> np.ndarray:
         """Return the leaf values at ``indices``."""
-        return self._values[0][indices]
+        values: np.ndarray = self._values[0][indices]
+        return values
 
     def update(self, indices: np.ndarray, values: np.ndarray | float) -> None:
         """Set leaves ``indices`` to ``values`` and refresh their ancestors.
@@ -153,8 +154,8 @@ class PrioritizedReplayBuffer(ReplayBuffer):
     def __init__(
         self,
         buffer_size: int,
-        observation_space: spaces.Space,
-        action_space: spaces.Space,
+        observation_space: spaces.Space[Any],
+        action_space: spaces.Space[Any],
         device: th.device | str = "auto",
         n_envs: int = 1,
         optimize_memory_usage: bool = False,

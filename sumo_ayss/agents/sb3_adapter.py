@@ -60,7 +60,8 @@ def set_rollout_start(
 def rollout_actions(rollout: MutableMapping[str, Any]) -> npt.NDArray[Any]:
     """The actions of the step just taken, from a callback's ``locals`` (``(n_envs,)``)."""
     # SB3 2.9.2 ``collect_rollouts``: local ``actions`` (env actions, unscaled).
-    return rollout["actions"]
+    actions: np.ndarray = rollout["actions"]
+    return actions
 
 
 def rollout_episode_ended(rollout: MutableMapping[str, Any], env_index: int = 0) -> bool:

@@ -46,7 +46,8 @@ def _check_groups(groups: Sequence[ArrayLike]) -> list[NDArray[np.float64]]:
 
 def _resample_rows(arr: NDArray[np.float64], gen: np.random.Generator) -> NDArray[np.float64]:
     """Draws ``len(arr)`` rows of ``arr`` with replacement."""
-    return arr[gen.integers(0, arr.shape[0], size=arr.shape[0])]
+    rows: NDArray[np.float64] = arr[gen.integers(0, arr.shape[0], size=arr.shape[0])]
+    return rows
 
 
 def hierarchical_bootstrap(

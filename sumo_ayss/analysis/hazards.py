@@ -120,7 +120,8 @@ def r157_min_following_distance_m(v_mps: FloatArray) -> FloatArray:
     """
     v = np.asarray(v_mps, float)
     gap_s = np.where(v * 3.6 >= 10.0, 1.0 + v * 3.6 / 100.0, 1.0 + (v - 2.0) / 7.8)
-    return np.maximum(v * gap_s, 2.0)
+    distance_m: NDArray[np.float64] = np.maximum(v * gap_s, 2.0)
+    return distance_m
 
 
 @dataclass(frozen=True)
@@ -216,7 +217,8 @@ def _leader_braked(tr: PairTrajectory, window_s: float) -> FloatArray:
     pov_braking = -np.diff(tr.pov_speed_mps) / dt
     w = max(1, math.floor(window_s / float(dt[0]) + 1e-9))
     padded = np.concatenate([np.zeros(w), pov_braking[:-1]])  # padded[k + j]: decision k - w + j
-    return np.lib.stride_tricks.sliding_window_view(padded, w).max(axis=1)
+    worst: NDArray[np.float64] = np.lib.stride_tricks.sliding_window_view(padded, w).max(axis=1)
+    return worst
 
 
 def _follower(tr: PairTrajectory, f: FollowerTrack) -> tuple[float, float, float, float]:
@@ -332,4 +334,5 @@ def harm_crash(
     if rear_end_unjustified is None:
         return crash
     caused = np.nan_to_num(np.asarray(rear_end_unjustified, float), nan=0.0) == 1.0
-    return crash | caused
+    harmed: NDArray[np.bool_] = crash | caused
+    return harmed

@@ -98,7 +98,9 @@ def _check_h_range(h_range: Sequence[float]) -> tuple[float, float]:
     return lo, hi
 
 
-def _check_seed_pair(y: ArrayLike, h: ArrayLike, s: int) -> tuple[NDArray, NDArray]:
+def _check_seed_pair(
+    y: ArrayLike, h: ArrayLike, s: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Validates the indicator and headway arrays of seed ``s``."""
     try:
         ys, hs = np.asarray(y, dtype=np.float64), np.asarray(h, dtype=np.float64)

@@ -207,11 +207,13 @@ class Case:
 
     def env_class(self) -> type[Any]:
         """The env class (imports its module: libsumo, gymnasium)."""
-        return _resolve(self, "env")
+        env: type[Any] = _resolve(self, "env")
+        return env
 
     def ayss_row_builder(self) -> Callable[..., Any]:
         """The AYSS row builder (imports its module)."""
-        return _resolve(self, "ayss_rows")
+        rows: Callable[..., Any] = _resolve(self, "ayss_rows")
+        return rows
 
 
 def _resolve(case: Case, attr: str) -> Any:

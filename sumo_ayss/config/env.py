@@ -429,3 +429,18 @@ class EnvConfig:
     def max_decisions(self) -> int:
         """Decisions per episode (25 for 5 s at 5 Hz)."""
         return round(self.episode_s / self.decision_period_s)
+
+
+def decisions_of(env: Mapping[str, Any]) -> int:
+    """Decisions per episode of a stored env section (a run's ``config.yaml``):
+    ``episode_s / decision_period_s`` rounded (:class:`EnvConfig`'s defaults where unset).
+
+    Raises:
+        ConfigError: If the timing gives no decision.
+    """
+    episode_s = float(env.get("episode_s", EnvConfig.episode_s))
+    period_s = float(env.get("decision_period_s", EnvConfig.decision_period_s))
+    decisions = round(episode_s / period_s)
+    if decisions < 1:
+        raise ConfigError(f"env: {episode_s} s episodes of {period_s} s decisions: no decision")
+    return decisions

@@ -33,6 +33,8 @@ Imports neither SUMO nor torch.
 
 from __future__ import annotations
 
+import json
+from collections.abc import Mapping
 from typing import Any
 
 from sumo_ayss.config.experiment import ExperimentConfig
@@ -45,6 +47,7 @@ __all__ = [
     "DISPLAY_FIELDS",
     "OWN_VUT",
     "VUT_DISPLAY_FIELDS",
+    "config_key",
     "flat_config",
     "identity_differences",
     "is_redefinition",
@@ -127,3 +130,23 @@ def is_redefinition(differences: list[str]) -> bool:
     """Whether every difference (:func:`identity_differences`) lies in the run's own VUT's
     definition: the same study asks for a redefined VUT, whose run is trained again."""
     return bool(differences) and all(d.startswith(f"{OWN_VUT}.") for d in differences)
+
+
+#: Entries of a stored ``config.yaml`` that may differ between runs pooled in one report: the
+#: run's own VUT and seed, the VUT catalog (a leaderboard adds VUTs), and display-only
+#: settings (:func:`config_key`).
+POOL_IGNORED = (("seed",), ("vut",), ("env", "vut"), ("env", "vuts"), ("train", "progress_bar"))
+
+
+def config_key(config: Mapping[str, Any]) -> str:
+    """12 hex digits of :func:`~sumo_ayss.util.fingerprint.fingerprint` of a resolved
+    ``config.yaml`` without :data:`POOL_IGNORED`: runs with different keys in one case must
+    not be pooled (:func:`sumo_ayss.run_folder.study_runs.mixing_problems`)."""
+    data = json.loads(json.dumps(config, default=str))
+    for key in POOL_IGNORED:
+        node: Any = data
+        for part in key[:-1]:
+            node = node.get(part) if isinstance(node, Mapping) else None
+        if isinstance(node, dict):
+            node.pop(key[-1], None)
+    return fingerprint(data)[:12]

@@ -15,7 +15,7 @@ import types
 import typing
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
 from sumo_ayss.config.env import EnvConfig
 from sumo_ayss.util.errors import ConfigError
@@ -113,7 +113,13 @@ def _convert(tp: Any, value: Any, where: str, base_dir: Path, default: Any) -> A
     raise ConfigError(f"{where}: unsupported type {tp!r}")  # pragma: no cover
 
 
-def build(cls: type, data: Any, where: str, base_dir: Path, default: Any = None) -> Any:
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
+_T = TypeVar("_T", bound="DataclassInstance")
+
+
+def build(cls: type[_T], data: Any, where: str, base_dir: Path, default: _T | None = None) -> _T:
     """Build dataclass ``cls`` from a mapping, over ``default`` (or the class defaults).
 
     Errors name the dotted field under ``where``: a section whose checks name its usual

@@ -149,7 +149,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         self.sumo_seed = sumo_seed
         self._fixed_sumo_seed = sumo_seed is not None
         self._session: SumoSession | None = None
-        self._finalizer: weakref.finalize | None = None
+        self._finalizer: weakref.finalize[..., Any] | None = None
         self._done = False  # the episode ended (terminated or truncated): step() refuses
         self._pair: VehiclePair | None = None
         # Per-step constants, looked up once (config properties compute on each access).

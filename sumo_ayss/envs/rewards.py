@@ -43,7 +43,10 @@ def adversarial_reward_array(
 ) -> npt.NDArray[np.float64]:
     """Elementwise :func:`adversarial_reward` (for plots and tables)."""
     h = np.asarray(headway_m, dtype=float)
-    return np.vectorize(lambda x: adversarial_reward(float(x), shape), otypes=[float])(h)
+    rewards: npt.NDArray[np.float64] = np.vectorize(
+        lambda x: adversarial_reward(float(x), shape), otypes=[float]
+    )(h)
+    return rewards
 
 
 def lane_phase_reward(

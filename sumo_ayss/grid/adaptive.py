@@ -49,6 +49,8 @@ __all__ = [
     "is_adaptive",
     "read_record",
     "run_adaptive",
+    "same_plan",
+    "same_vuts",
     "stale_record",
     "summary_lines",
 ]
@@ -85,6 +87,23 @@ def grid_vuts(cfg: PipelineConfig, case: str) -> tuple[tuple[str, str], ...]:
     return tuple((v, vut_key(vuts[v])) for v in cfg.grid.vuts)
 
 
+def same_plan(
+    record: AdaptiveRecord, first_seeds: tuple[int, ...], max_seeds: int, alpha: float
+) -> bool:
+    """Whether ``record`` belongs to the same schedule (a changed config starts over)."""
+    return (record.first_seeds, record.max_seeds, record.alpha) == (
+        tuple(first_seeds),
+        max_seeds,
+        alpha,
+    )
+
+
+def same_vuts(record: AdaptiveRecord, vuts: tuple[tuple[str, str], ...]) -> bool:
+    """Whether ``record`` looked at the VUTs ``vuts`` (``(name, key)``, in any order); a
+    record that does not name its VUTs (written before they were) is taken as is."""
+    return not record.vuts or dict(record.vuts) == dict(vuts)
+
+
 def stale_record(cfg: PipelineConfig, case: str) -> str | None:
     """Why the case's record is ignored although it is this schedule's (it looked at other
     VUTs), as a sentence; None when there is no such record."""
@@ -96,7 +115,7 @@ def stale_record(cfg: PipelineConfig, case: str) -> str | None:
     except AyssError:
         return None
     now = grid_vuts(cfg, case)
-    if record is None or record.same_vuts(now):
+    if record is None or same_vuts(record, now):
         return None
     names = {n for n, _ in record.vuts} & {n for n, _ in now}
     redefined = sorted(n for n in names if dict(record.vuts)[n] != dict(now)[n])
@@ -122,9 +141,9 @@ def read_record(cfg: PipelineConfig, case: str) -> AdaptiveRecord | None:
         logger.warning("%s; adaptive seeding of %s starts over", exc, case)
         return None
     assert cfg.max_seeds is not None
-    if not record.same_plan(cfg.seeds, cfg.max_seeds, cfg.report.welch_alpha):
+    if not same_plan(record, cfg.seeds, cfg.max_seeds, cfg.report.welch_alpha):
         return None
-    if not record.same_vuts(grid_vuts(cfg, case)):
+    if not same_vuts(record, grid_vuts(cfg, case)):
         return None
     return record
 

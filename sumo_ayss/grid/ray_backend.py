@@ -33,7 +33,7 @@ import tarfile
 import tempfile
 import time
 import traceback
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -189,7 +189,11 @@ def run_grid_ray(
         _connect(ray, address)
     task = ray.remote(num_cpus=1, max_retries=0)(remote_job)
     statuses = [JobStatus(j) for j in jobs]
-    resources = ray.cluster_resources() if hasattr(ray, "cluster_resources") else {}
+    # ray's own function is untyped: named through a typed callable (mypy --strict).
+    cluster_resources: Callable[[], dict[str, float]] | None = getattr(
+        ray, "cluster_resources", None
+    )
+    resources = cluster_resources() if cluster_resources is not None else {}
     progress = GridProgress(statuses, int(resources.get("CPU", 1)), after)
     pending: dict[Any, JobStatus] = {}
     gcs = _gcs_address(ray) if address is not None else None

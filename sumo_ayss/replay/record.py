@@ -125,7 +125,7 @@ def export_scenario(
 
 def _export(
     run: RunRecord, kind: Kind, index: int, out: Path, policy: Policy | None, decisions: int | None
-) -> Any:
+) -> ExportResult:
     env_cfg = run.experiment.env  # raises first if the folder is not a run folder
     row = read_row(run.folder, kind, index)
     ic = initial_condition(kind, row, run)

@@ -74,7 +74,8 @@ def initial_condition(
         sample = InitialCondition(row["v_pov_mps"], row["v_vut_mps"], row["h_m"])
         if run is None:
             return sample
-        return get_case(run.experiment.env.case).env_class().ayss_start(sample)
+        start: InitialCondition = get_case(run.experiment.env.case).env_class().ayss_start(sample)
+        return start
     ic = InitialCondition(row["v_pov0_mps"], row["v_vut0_mps"], row["gap0_m"])
     if run is None or not run.experiment.env.follower.enabled:
         return ic

@@ -108,7 +108,6 @@ from sumo_ayss.run_folder.metadata import (
 )
 from sumo_ayss.run_folder.record import (
     RunRecord,
-    Training,
     read_run,
 )
 from sumo_ayss.run_folder.schemas import (
@@ -170,7 +169,6 @@ __all__ = [
     "StageHeader",
     "StudyFolder",
     "Table",
-    "Training",
     "case_of",
     "case_runs",
     "find_run_dirs",

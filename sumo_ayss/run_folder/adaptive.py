@@ -12,12 +12,10 @@ dropped, redefined or renamed) ignores the record and starts over (records writt
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
 
-from sumo_ayss.run_folder.jsonio import json_field, json_number, read_json, write_json
+from sumo_ayss.run_folder.jsonio import json_field, json_list, json_records, read_json, write_json
 from sumo_ayss.util.errors import TableError
 
 __all__ = ["ADAPTIVE_FORMAT", "AdaptiveLook", "AdaptiveRecord", "read_adaptive", "write_adaptive"]
@@ -79,19 +77,6 @@ class AdaptiveRecord:
         """Whether the last look found the ranking settled."""
         return bool(self.looks) and self.looks[-1].settled
 
-    def same_plan(self, first_seeds: tuple[int, ...], max_seeds: int, alpha: float) -> bool:
-        """Whether this record belongs to the same schedule (a changed config starts over)."""
-        return (self.first_seeds, self.max_seeds, self.alpha) == (
-            tuple(first_seeds),
-            max_seeds,
-            alpha,
-        )
-
-    def same_vuts(self, vuts: tuple[tuple[str, str], ...]) -> bool:
-        """Whether this record looked at the VUTs ``vuts`` (``(name, key)``, in any order);
-        a record that does not name its VUTs (written before they were) is taken as is."""
-        return not self.vuts or dict(self.vuts) == dict(vuts)
-
 
 def write_adaptive(path: str | Path, record: AdaptiveRecord) -> None:
     """Write ``adaptive.json`` atomically."""
@@ -99,15 +84,6 @@ def write_adaptive(path: str | Path, record: AdaptiveRecord) -> None:
     data["vuts"] = dict(record.vuts)
     data["format"] = ADAPTIVE_FORMAT
     write_json(path, data)
-
-
-_NUMBER = (int, float)
-
-
-def _ints(values: list[Any], key: str, where: str) -> list[int]:
-    if not all(isinstance(v, int) and not isinstance(v, bool) for v in values):
-        raise TableError(f"{where}: {key}: expected a list of integers, got {values!r}")
-    return values
 
 
 def read_adaptive(path: str | Path) -> AdaptiveRecord:
@@ -120,31 +96,13 @@ def read_adaptive(path: str | Path) -> AdaptiveRecord:
     where = str(path)
     if data.get("format") != ADAPTIVE_FORMAT:
         raise TableError(f"{path}: format {data.get('format')!r}, expected {ADAPTIVE_FORMAT}")
-    looks = []
-    for i, x in enumerate(json_field(data, "looks", list, where)):
-        at = f"{where}: looks[{i}]"
-        if not isinstance(x, Mapping):
-            raise TableError(f"{at}: expected an object, got {x!r}")
-        looks.append(
-            AdaptiveLook(
-                n_seeds=json_field(x, "n_seeds", int, at),
-                omnibus_p=json_number(x, "omnibus_p", at),
-                gate_level=float(json_field(x, "gate_level", _NUMBER, at)),
-                safest=json_field(x, "safest", str, at),
-                least_safe=json_field(x, "least_safe", str, at),
-                ends_p=json_number(x, "ends_p", at),
-                alpha=float(json_field(x, "alpha", _NUMBER, at)),
-                settled=json_field(x, "settled", bool, at),
-            )
-        )
+    looks = json_records(data, "looks", AdaptiveLook, where)  # read first, as before
     vuts = (json_field(data, "vuts", (dict, type(None)), where) if "vuts" in data else None) or {}
     return AdaptiveRecord(
-        first_seeds=tuple(
-            _ints(json_field(data, "first_seeds", list, where), "first_seeds", where)
-        ),
+        first_seeds=json_list(data, "first_seeds", int, where),
         max_seeds=json_field(data, "max_seeds", int, where),
-        alpha=float(json_field(data, "alpha", _NUMBER, where)),
-        seeds=tuple(_ints(json_field(data, "seeds", list, where), "seeds", where)),
-        looks=tuple(looks),
+        alpha=float(json_field(data, "alpha", (int, float), where)),
+        seeds=json_list(data, "seeds", int, where),
+        looks=looks,
         vuts=tuple((str(k), str(v)) for k, v in vuts.items()),
     )

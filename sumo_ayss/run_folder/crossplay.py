@@ -19,7 +19,8 @@ that each SPCP, driven against its own VUT, reproduced its run's ``outcome.csv``
 how many of the ``n`` episodes were equal (absent in older records). ``vut_keys`` names the
 vehicle each VUT name stood for (:func:`~sumo_ayss.config.identity.vut_key` of its
 definition; absent in older records): a study that adds, drops, redefines or renames a VUT
-keeps the cells whose VUT and opponent are unchanged (:mod:`.crossplay_cells`).
+keeps the cells whose VUT and opponent are unchanged
+(:mod:`sumo_ayss.stages.crossplay_cells`).
 
 :func:`load_crossplay` reads a case's table and record back for the analysis, as stored
 (:class:`CrossplayTables`); the analysis scores them on the runs' harm scale
@@ -34,9 +35,9 @@ import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING
 
-from sumo_ayss.run_folder.jsonio import json_field, read_json, write_json
+from sumo_ayss.run_folder.jsonio import json_field, json_records, read_json, write_json
 from sumo_ayss.run_folder.layout import CaseFolder
 from sumo_ayss.run_folder.schemas import CROSSPLAY_SCHEMA
 from sumo_ayss.run_folder.table import Table, read_table
@@ -59,7 +60,6 @@ __all__ = [
 
 #: How the cross-play stage drives its episodes now (see the module docstring).
 ROLLOUT = "outcome"
-_R = TypeVar("_R")
 
 #: What a record without ``rollout`` was driven by.
 _LEGACY_ROLLOUT = "pairs"
@@ -133,27 +133,6 @@ class CrossplayRecord:
     diagonal: tuple[DiagonalCheck, ...] = ()
     vut_keys: tuple[str, ...] = ()
 
-    def same_vuts(self, other: CrossplayRecord) -> bool:
-        """Whether both tables drive the same VUTs in the same order and, where both
-        records name their definitions, the same vehicles."""
-        keys = not (self.vut_keys and other.vut_keys) or self.vut_keys == other.vut_keys
-        return self.vuts == other.vuts and keys
-
-    def inputs(self) -> dict[str, Any]:
-        """What the table was made from: the scenario set, the opponents and how they were
-        driven (the cross-play stage's inputs, :class:`~.stage.CrossplayStage`)."""
-        return {
-            "n": self.n,
-            "seed": self.seed,
-            "opponents": [dataclasses.asdict(o) for o in self.opponents],
-            "rollout": self.rollout,
-        }
-
-    def same_scenarios(self, other: CrossplayRecord) -> bool:
-        """Whether both tables' cells were driven on the same scenarios in the same way,
-        so that a cell of one may stand for the same cell of the other."""
-        return (self.n, self.seed, self.rollout) == (other.n, other.seed, other.rollout)
-
 
 def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
     """Write ``crossplay.json``."""
@@ -178,21 +157,6 @@ def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
     )
 
 
-def _records(
-    data: Mapping[str, Any], key: str, where: str, cls: type[_R], kinds: tuple[type, ...]
-) -> tuple[_R, ...]:
-    """The list ``data[key]`` of JSON objects as ``cls`` records, field by field in the
-    order of ``cls``'s dataclass fields, each checked to be of its kind."""
-    out = []
-    for i, item in enumerate(json_field(data, key, list, where)):
-        at = f"{where}: {key}[{i}]"
-        if not isinstance(item, Mapping):
-            raise TableError(f"{at}: expected an object, got {item!r}")
-        names = [f.name for f in dataclasses.fields(cls)]  # type: ignore[arg-type]
-        out.append(cls(*(json_field(item, n, k, at) for n, k in zip(names, kinds, strict=True))))
-    return tuple(out)
-
-
 def read_crossplay_json(path: Path) -> CrossplayRecord:
     """Read ``crossplay.json``.
 
@@ -202,12 +166,12 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
     """
     data = read_json(path)
     where = str(path)
-    opponents = _records(data, "opponents", where, CrossplayOpponent, (str, int, str))
+    opponents = json_records(data, "opponents", CrossplayOpponent, where)
     vuts = json_field(data, "vuts", list, where)
     if not all(isinstance(v, str) for v in vuts):
         raise TableError(f"{where}: vuts: expected a list of names, got {vuts!r}")
     diagonal = (
-        _records(data, "diagonal", where, DiagonalCheck, (str, int, int, int))
+        json_records(data, "diagonal", DiagonalCheck, where)
         if "diagonal" in data
         else ()  # a record from before the check
     )

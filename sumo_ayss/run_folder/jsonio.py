@@ -13,18 +13,21 @@ written atomically.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
 from sumo_ayss.util.atomic import atomic_write_text
 from sumo_ayss.util.errors import StoredFileError, TableError
 
-__all__ = ["json_field", "json_number", "read_json", "write_json"]
+__all__ = ["json_field", "json_list", "json_number", "json_records", "read_json", "write_json"]
+
+_R = TypeVar("_R")
 
 
 def _jsonable(obj: Any) -> Any:
@@ -124,3 +127,61 @@ def json_number(
     writes a non-finite float); checked as :func:`json_field`."""
     value = json_field(data, key, (int, float, type(None)), where, error=error)
     return math.nan if value is None else float(value)
+
+
+def json_list(
+    data: Mapping[str, Any],
+    key: str,
+    kind: type,
+    where: str,
+    *,
+    error: type[StoredFileError] = TableError,
+) -> tuple[Any, ...]:
+    """``data[key]``, a list whose every element is of ``kind`` (a boolean is never an
+    ``int``), as a tuple; checked as :func:`json_field`."""
+    values = json_field(data, key, object, where, error=error)
+    if not isinstance(values, list) or not all(
+        isinstance(v, kind) and (kind is bool or not isinstance(v, bool)) for v in values
+    ):
+        raise error(f"{where}: {key}: expected a list of {kind.__name__}, got {values!r}")
+    return tuple(values)
+
+
+#: The field annotations :func:`json_records` reads with :func:`json_field`.
+_KINDS: dict[str, type] = {"str": str, "int": int, "bool": bool}
+
+
+def json_records(
+    data: Mapping[str, Any],
+    key: str,
+    cls: type[_R],
+    where: str,
+    *,
+    error: type[StoredFileError] = TableError,
+) -> tuple[_R, ...]:
+    """``data[key]``, a list of JSON objects, as records of the flat dataclass ``cls``: each
+    field read by its annotation (``str``, ``int``, ``bool`` as :func:`json_field`;
+    ``float`` as :func:`json_number`, ``null`` read as NaN; ``tuple[str, ...]`` as
+    :func:`json_list`). The schema is the dataclass: no per-field reader is written by hand.
+
+    Raises:
+        StoredFileError: As :func:`json_field`, the element named (``<where>: looks[2]:
+            n_seeds: expected int, got True``), or ``<where>: looks[2]: expected an
+            object, got ...``.
+    """
+    out = []
+    for i, item in enumerate(json_field(data, key, list, where, error=error)):
+        at = f"{where}: {key}[{i}]"
+        if not isinstance(item, Mapping):
+            raise error(f"{at}: expected an object, got {item!r}")
+        fields: dict[str, Any] = {}
+        for f in dataclasses.fields(cls):  # type: ignore[arg-type]
+            kind = str(f.type)
+            if kind == "float":
+                fields[f.name] = json_number(item, f.name, at, error=error)
+            elif kind == "tuple[str, ...]":
+                fields[f.name] = json_list(item, f.name, str, at, error=error)
+            else:
+                fields[f.name] = json_field(item, f.name, _KINDS[kind], at, error=error)
+        out.append(cls(**fields))
+    return tuple(out)

@@ -1,7 +1,8 @@
 """Where each file of a run folder lives: the names, once, and the folder's paths.
 
-A run folder is ``<out>/<case>/<vut>/seed_<k>/`` (:func:`run_dir_for`). :class:`RunFolder`
-gives the path of every file in it; no other module spells a file name of a run folder.
+A run folder is ``<out>/<case>/<vut>/seed_<k>/`` (:meth:`~.study.StudyFolder.run`).
+:class:`RunFolder` gives the path of every file in it; no other module spells a file name of
+a run folder.
 The case folder ``<out>/<case>/`` above a case's runs holds the cross-play and
 discriminability files (:class:`CaseFolder`).
 """
@@ -43,10 +44,8 @@ __all__ = [
     "CaseFolder",
     "FolderFile",
     "RunFolder",
-    "case_dir_for",
     "find_run_dirs",
     "is_run_dir",
-    "run_dir_for",
     "seed_of_dir",
 ]
 
@@ -114,16 +113,6 @@ DISCRIMINABILITY_PNG = "discriminability.png"
 """Its figure (drawn by the report's discriminability section)."""
 
 _SEED_DIR = re.compile(r"^seed_(-?\d+)$")
-
-
-def run_dir_for(out: str | Path, case: str, vut: str, seed: int) -> Path:
-    """The run folder ``<out>/<case>/<vut>/seed_<seed>``."""
-    return Path(out) / case / vut / f"seed_{seed}"
-
-
-def case_dir_for(out: str | Path, case: str) -> Path:
-    """The case folder ``<out>/<case>``: the parent of the case's ``<vut>/seed_<k>`` runs."""
-    return Path(out) / case
 
 
 def seed_of_dir(path: Path) -> int | None:
@@ -204,7 +193,7 @@ class CaseFolder:
     above its runs.
 
     Attributes:
-        path: The case folder ``<out>/<case>/`` (:func:`case_dir_for`).
+        path: The case folder ``<out>/<case>/`` (:meth:`~.study.StudyFolder.case`).
     """
 
     path: Path

@@ -19,9 +19,6 @@ torch, nor the analysis.
 
 from __future__ import annotations
 
-import hashlib
-import json
-import math
 from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -33,7 +30,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sumo_ayss.cases import case_of_indicator
-from sumo_ayss.config import EnvConfig, ExperimentConfig, RewardConfig, build, experiment_from_dict
+from sumo_ayss.config import ExperimentConfig, RewardConfig, build, experiment_from_dict
+from sumo_ayss.config.env import decisions_of
+from sumo_ayss.config.identity import config_key
 from sumo_ayss.run_folder.eval_table import EVAL_SCHEMA
 from sumo_ayss.run_folder.layout import AYSS_CSV, CONFIG_YAML, EVAL_CSV, RunFolder, seed_of_dir
 from sumo_ayss.run_folder.metadata import RunConfig, SpcpChoice, read_run_config, read_spcp
@@ -41,23 +40,18 @@ from sumo_ayss.run_folder.metadata import read_versions as _read_versions
 from sumo_ayss.run_folder.schemas import AYSS_SCHEMA, OUTCOME_SCHEMA
 from sumo_ayss.run_folder.summaries import Outcome, OutcomeRecord, read_outcome_json
 from sumo_ayss.run_folder.table import Table, read_table
+from sumo_ayss.training.trust import Training, training_of
 from sumo_ayss.util.errors import AyssError, CheckpointError, ConfigError
+from sumo_ayss.vuts.catalog import stored_description
 
 __all__ = [
     "AyssSamples",
     "EvalCurve",
     "RunRecord",
-    "Training",
-    "config_key",
-    "decisions_of",
     "read_run",
 ]
 
 _T = TypeVar("_T")
-
-_IGNORED_KEYS = (("seed",), ("vut",), ("env", "vut"), ("env", "vuts"), ("train", "progress_bar"))
-"""Config entries that may differ between runs pooled in one report: the run's own VUT and
-seed, the VUT catalog (a leaderboard adds VUTs), and display-only settings."""
 
 
 def _empty_f() -> NDArray[np.float64]:
@@ -107,32 +101,6 @@ class AyssSamples:
         return int(self.h.size)
 
 
-@dataclass(frozen=True)
-class Training:
-    """A run's training budget and the state of its SPCP at the end of training.
-
-    Attributes:
-        total_timesteps: ``train.total_timesteps`` (transitions), None if unknown.
-        eval_every: ``train.eval_every`` (transitions between candidates), None if unknown.
-        config_key: :func:`config_key` of ``config.yaml``, "" if unknown.
-        n_candidates: Rows of ``eval.csv``.
-        spcp_step: The SPCP's training step, None if unknown.
-        last_step: The last candidate's training step, None if no candidate.
-        gap_se: (SPCP's mean evaluation reward − the last candidate's) / the SPCP's
-            standard error (``std_return / sqrt(n_episodes)``); NaN if unknown.
-        still_improving: True when the SPCP is the last candidate; None when unknown.
-    """
-
-    total_timesteps: int | None = None
-    eval_every: int | None = None
-    config_key: str = ""
-    n_candidates: int = 0
-    spcp_step: int | None = None
-    last_step: int | None = None
-    gap_se: float = math.nan
-    still_improving: bool | None = None
-
-
 @dataclass(frozen=True, eq=False)
 class RunRecord:
     """One run folder, read once (:func:`read_run`); a field is None when its file is
@@ -156,7 +124,7 @@ class RunRecord:
         ayss: The AYSS samples (``ayss.csv``), or None.
         versions: Package versions the run used (``versions.json``), or empty.
         training: Training budget and SPCP state (from ``config.yaml``, ``eval.csv`` and
-            ``spcp.json``).
+            ``spcp.json``; :func:`sumo_ayss.training.trust.training_of`).
         problems: One sentence per missing or unreadable file, each starting with the
             file's name.
     """
@@ -229,66 +197,6 @@ class RunRecord:
         return read_run_config(self.folder.config)  # raises the reader's own message
 
 
-# --------------------------------------------------------------------------- derived views
-
-
-def config_key(config: Mapping[str, Any]) -> str:
-    """A short hash of a resolved ``config.yaml`` without the VUT, seed and catalog."""
-    data = json.loads(json.dumps(config, default=str))
-    for key in _IGNORED_KEYS:
-        node: Any = data
-        for part in key[:-1]:
-            node = node.get(part) if isinstance(node, Mapping) else None
-        if isinstance(node, dict):
-            node.pop(key[-1], None)
-    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:12]
-
-
-def decisions_of(env: Mapping[str, Any]) -> int:
-    """Decisions per episode of a run's env section: ``episode_s / decision_period_s``
-    rounded (the env's defaults where unset).
-
-    Raises:
-        ConfigError: If the timing gives no decision.
-    """
-    episode_s = float(env.get("episode_s", EnvConfig.episode_s))
-    period_s = float(env.get("decision_period_s", EnvConfig.decision_period_s))
-    decisions = round(episode_s / period_s)
-    if decisions < 1:
-        raise ConfigError(f"env: {episode_s} s episodes of {period_s} s decisions: no decision")
-    return decisions
-
-
-def _int_or_none(value: Any) -> int | None:
-    return int(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
-
-
-def _training(
-    config: RunConfig | None, rows: Sequence[Mapping[str, Any]], spcp_step: int | None
-) -> Training:
-    """The :class:`Training` of a run from its config, its ``eval.csv`` rows sorted by step
-    and its SPCP's step."""
-    total = every = None
-    key = ""
-    if config is not None:
-        train = config.experiment.get("train") or {}
-        if isinstance(train, Mapping):
-            total = _int_or_none(train.get("total_timesteps"))
-            every = _int_or_none(train.get("eval_every"))
-        key = config_key(config.as_dict())
-    if not rows or spcp_step is None:
-        return Training(total, every, key, len(rows), spcp_step)
-    last = rows[-1]
-    spcp = next((r for r in rows if int(r["step"]) == spcp_step), None)
-    gap = math.nan
-    if spcp is not None:
-        se = spcp["std_return"] / math.sqrt(spcp["n_episodes"]) if spcp["n_episodes"] > 0 else 0
-        diff = spcp["mean_return"] - last["mean_return"]
-        gap = diff / se if se > 0 else (0.0 if diff == 0 else math.inf)
-    improving = int(last["step"]) == spcp_step
-    return Training(total, every, key, len(rows), spcp_step, int(last["step"]), gap, improving)
-
-
 def _all_same(curve: EvalCurve | None, spcp: SpcpChoice | None) -> str | None:
     """A sentence when two or more SPCP candidates all scored exactly the same (their mean
     reward in ``eval.csv``, or the selection's criterion as ``spcp.json`` records): the
@@ -334,18 +242,6 @@ def _ayss_samples(path: Path) -> AyssSamples:
         indicator=np.asarray(table["indicator"], dtype=np.float64),
         indicator_name=names.most_common(1)[0][0] if names else None,
     )
-
-
-def _vut_description(env: Mapping[str, Any], vut: str) -> str:
-    vuts = env.get("vuts")
-    entry = vuts.get(vut) if isinstance(vuts, Mapping) else None
-    if not isinstance(entry, Mapping):
-        return ""
-    if entry.get("description"):
-        return str(entry["description"])
-    params = entry.get("params") or {}
-    shown = ", ".join(f"{k}={v}" for k, v in sorted(params.items()) if k in ("minGap", "tau"))
-    return f"{entry.get('model', '?')}" + (f" ({shown})" if shown else "")
 
 
 # --------------------------------------------------------------------------- reading
@@ -402,7 +298,7 @@ def read_run(path: str | Path) -> RunRecord:
     if config is not None:
         env = config.experiment["env"]  # a mapping: read_run_config checks it
         case, vut, seed = str(env.get("case", case)), config.vut, config.seed
-        description = _vut_description(env, vut)
+        description = stored_description(env, vut)
         try:
             # Only the reward section is rebuilt: a report does not need the experiment.
             reward = build(RewardConfig, env.get("reward") or {}, "env.reward", run_dir)
@@ -459,6 +355,11 @@ def read_run(path: str | Path) -> RunRecord:
         outcome_table=table,
         ayss=ayss,
         versions=versions or {},
-        training=_training(config, rows, spcp.step if spcp is not None else None),
+        training=training_of(
+            None if config is None else config.experiment.get("train") or {},
+            "" if config is None else config_key(config.as_dict()),
+            rows,
+            spcp.step if spcp is not None else None,
+        ),
         problems=tuple(r.problems),
     )

@@ -31,17 +31,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.jsonio import json_field, read_json
+from sumo_ayss.run_folder.jsonio import json_list, json_records, read_json
 from sumo_ayss.run_folder.layout import (
     CaseFolder,
     FolderFile,
     RunFolder,
-    case_dir_for,
-    run_dir_for,
 )
 from sumo_ayss.run_folder.table import read_table, text_schema, write_rows
 from sumo_ayss.util.atomic import atomic_write_json
-from sumo_ayss.util.errors import TableError
 
 __all__ = [
     "MEASURES_COLUMNS",
@@ -185,11 +182,11 @@ class StudyFolder:
 
     def case(self, case: str) -> CaseFolder:
         """The case folder ``<out>/<case>/``."""
-        return CaseFolder(case_dir_for(self.path, case))
+        return CaseFolder(self.path / case)
 
     def run(self, case: str, vut: str, seed: int) -> RunFolder:
         """The run folder ``<out>/<case>/<vut>/seed_<seed>/``."""
-        return RunFolder(run_dir_for(self.path, case, vut, seed))
+        return RunFolder(self.path / case / vut / f"seed_{seed}")
 
 
 # --------------------------------------------------------------------------- pipeline.json
@@ -291,19 +288,6 @@ class OrderChecks:
     cases: tuple[OrderCheck, ...]
 
 
-_CHECK_KINDS: dict[str, type | tuple[type, ...]] = {
-    "case": str,
-    "mode": str,
-    "order": list,
-    "expected": list,
-    "tau": (int, float),
-    "ends_significant": bool,
-    "ends_p": (int, float),
-    "significant_adjacent": int,
-    "adjacent": int,
-}
-
-
 def write_order_check(path: Path, checks: OrderChecks) -> None:
     """Write ``order_check.json``."""
     cases = []
@@ -314,12 +298,6 @@ def write_order_check(path: Path, checks: OrderChecks) -> None:
     atomic_write_json(path, {"expected": list(checks.expected), "cases": cases})
 
 
-def _names(value: Any, where: str) -> tuple[str, ...]:
-    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-        raise TableError(f"{where}: expected a list of VUT names, got {value!r}")
-    return tuple(value)
-
-
 def read_order_check(path: Path) -> OrderChecks:
     """Read ``order_check.json``.
 
@@ -328,14 +306,7 @@ def read_order_check(path: Path) -> OrderChecks:
             wrong type; the message names the file and the field.
     """
     data = read_json(path)
-    expected = _names(data.get("expected"), f"{path}: expected")
-    cases = []
-    for i, item in enumerate(json_field(data, "cases", list, str(path))):
-        at = f"{path}: cases[{i}]"
-        if not isinstance(item, Mapping):
-            raise TableError(f"{at}: expected an object, got {item!r}")
-        fields = {k: json_field(item, k, kind, at) for k, kind in _CHECK_KINDS.items()}
-        fields["order"] = _names(item["order"], f"{at}: order")
-        fields["expected"] = _names(item["expected"], f"{at}: expected")
-        cases.append(OrderCheck(**fields))
-    return OrderChecks(expected, tuple(cases))
+    where = str(path)
+    return OrderChecks(
+        json_list(data, "expected", str, where), json_records(data, "cases", OrderCheck, where)
+    )

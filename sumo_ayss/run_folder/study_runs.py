@@ -12,7 +12,8 @@ from pathlib import Path
 from sumo_ayss.cases import case_names
 from sumo_ayss.run_folder.crossplay import CrossplayTables, load_crossplay
 from sumo_ayss.run_folder.layout import CONFIG_YAML, find_run_dirs
-from sumo_ayss.run_folder.record import RunRecord, Training, read_run
+from sumo_ayss.run_folder.record import RunRecord, read_run
+from sumo_ayss.training.trust import Training
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.paths import display_path
 

@@ -51,6 +51,7 @@ from sumo_ayss.run_folder import (
     stored_experiment,
     write_done_marker,
 )
+from sumo_ayss.stages.crossplay_cells import crossplay_inputs, same_vuts
 from sumo_ayss.util.errors import TableError
 from sumo_ayss.util.fingerprint import fingerprint
 
@@ -270,15 +271,15 @@ class CrossplayStage:
         return (self.folder.crossplay_csv, self.folder.crossplay_json)
 
     def key(self) -> str:
-        return fingerprint(self.requested.inputs())
+        return fingerprint(crossplay_inputs(self.requested))
 
     def recorded(self) -> str | None:
         """Raises :class:`TableError` if ``crossplay.json`` exists but is unreadable."""
         if not self.folder.crossplay_json.is_file():
             return None
         done = read_crossplay_json(self.folder.crossplay_json)
-        fresh = done.diagonal and done.same_vuts(self.requested)
-        return fingerprint(done.inputs()) if fresh else None
+        fresh = done.diagonal and same_vuts(done, self.requested)
+        return fingerprint(crossplay_inputs(done)) if fresh else None
 
 
 @dataclass(frozen=True)

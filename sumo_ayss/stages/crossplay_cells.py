@@ -31,7 +31,38 @@ from typing import Any
 
 from sumo_ayss.run_folder import CrossplayOpponent, CrossplayRecord, DiagonalCheck
 
-__all__ = ["CellPlan", "merged_rows", "plan_cells"]
+__all__ = [
+    "CellPlan",
+    "crossplay_inputs",
+    "merged_rows",
+    "plan_cells",
+    "same_scenarios",
+    "same_vuts",
+]
+
+
+def same_vuts(done: CrossplayRecord, requested: CrossplayRecord) -> bool:
+    """Whether both tables drive the same VUTs in the same order and, where both records
+    name their definitions, the same vehicles."""
+    keys = not (done.vut_keys and requested.vut_keys) or done.vut_keys == requested.vut_keys
+    return done.vuts == requested.vuts and keys
+
+
+def crossplay_inputs(record: CrossplayRecord) -> dict[str, Any]:
+    """What a table was made from: the scenario set, the opponents and how they were driven
+    (the cross-play stage's inputs, :class:`~sumo_ayss.stages.contract.CrossplayStage`)."""
+    return {
+        "n": record.n,
+        "seed": record.seed,
+        "opponents": [dataclasses.asdict(o) for o in record.opponents],
+        "rollout": record.rollout,
+    }
+
+
+def same_scenarios(done: CrossplayRecord, requested: CrossplayRecord) -> bool:
+    """Whether both tables' cells were driven on the same scenarios in the same way, so that
+    a cell of one may stand for the same cell of the other."""
+    return (done.n, done.seed, done.rollout) == (requested.n, requested.seed, requested.rollout)
 
 
 @dataclass(frozen=True)

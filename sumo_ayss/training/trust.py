@@ -1,11 +1,11 @@
 """Whether a study's training can be trusted: training budget, seeds, SPCP still improving.
 
-They read each run's :class:`~sumo_ayss.run_folder.Training` (from ``config.yaml``,
+They read each run's :class:`Training` (from ``config.yaml``,
 ``eval.csv`` and ``spcp.json``, read with the run record); no file. The report writes them
 at its top, the pipeline and ``rank`` print them on the terminal.
 
 - :func:`training_status` — the state of a run's learning curve at the end (its
-  :class:`~sumo_ayss.run_folder.Training`, read with the run): the SPCP is the last
+  :class:`Training`, read with the run): the SPCP is the last
   candidate (the curve was still at its best when training stopped: it may still be
   improving), the last candidate's mean evaluation reward is within :data:`NOISE_SE`
   standard errors of the SPCP's (a plateau: the SPCP is one of several candidates equal
@@ -21,11 +21,68 @@ Imports neither SUMO nor torch.
 
 from __future__ import annotations
 
+import math
 from collections import Counter
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 from sumo_ayss.config.budget import BUDGETS, Budget
-from sumo_ayss.run_folder import Training
+
+
+@dataclass(frozen=True)
+class Training:
+    """A run's training budget and the state of its SPCP at the end of training.
+
+    Attributes:
+        total_timesteps: ``train.total_timesteps`` (transitions), None if unknown.
+        eval_every: ``train.eval_every`` (transitions between candidates), None if unknown.
+        config_key: :func:`~sumo_ayss.config.identity.config_key` of ``config.yaml``, "" if unknown.
+        n_candidates: Rows of ``eval.csv``.
+        spcp_step: The SPCP's training step, None if unknown.
+        last_step: The last candidate's training step, None if no candidate.
+        gap_se: (SPCP's mean evaluation reward − the last candidate's) / the SPCP's
+            standard error (``std_return / sqrt(n_episodes)``); NaN if unknown.
+        still_improving: True when the SPCP is the last candidate; None when unknown.
+    """
+
+    total_timesteps: int | None = None
+    eval_every: int | None = None
+    config_key: str = ""
+    n_candidates: int = 0
+    spcp_step: int | None = None
+    last_step: int | None = None
+    gap_se: float = math.nan
+    still_improving: bool | None = None
+
+
+def _int_or_none(value: Any) -> int | None:
+    return int(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
+
+
+def training_of(
+    train: Any, key: str, rows: Sequence[Mapping[str, Any]], spcp_step: int | None
+) -> Training:
+    """The :class:`Training` of a run (:func:`sumo_ayss.run_folder.read_run` computes it as
+    it reads): its stored ``train`` section (None: unknown), its
+    :func:`~sumo_ayss.config.identity.config_key` ("" if unknown), its ``eval.csv`` rows
+    sorted by step and its SPCP's step."""
+    total = every = None
+    if isinstance(train, Mapping):
+        total = _int_or_none(train.get("total_timesteps"))
+        every = _int_or_none(train.get("eval_every"))
+    if not rows or spcp_step is None:
+        return Training(total, every, key, len(rows), spcp_step)
+    last = rows[-1]
+    spcp = next((r for r in rows if int(r["step"]) == spcp_step), None)
+    gap = math.nan
+    if spcp is not None:
+        se = spcp["std_return"] / math.sqrt(spcp["n_episodes"]) if spcp["n_episodes"] > 0 else 0
+        diff = spcp["mean_return"] - last["mean_return"]
+        gap = diff / se if se > 0 else (0.0 if diff == 0 else math.inf)
+    improving = int(last["step"]) == spcp_step
+    return Training(total, every, key, len(rows), spcp_step, int(last["step"]), gap, improving)
+
 
 TRUSTED_TIMESTEPS = min(b.total_timesteps for b in BUDGETS.values())
 """Training transitions per run below which verdicts are flagged as not to be trusted: the
@@ -38,7 +95,7 @@ is less than this many standard errors (SPCP's ``std_return / sqrt(n_episodes)``
 
 
 def training_status(t: Training) -> str:
-    """A run's SPCP state (:class:`~sumo_ayss.run_folder.Training`) in one phrase, for a
+    """A run's SPCP state (:class:`Training`) in one phrase, for a
     table cell."""
     if t.still_improving is None:
         return "unknown"

@@ -278,3 +278,18 @@ def vtypes_xml(types: Mapping[str, VehicleType]) -> str:
     lines += [f"    {vt.to_xml(type_id)}" for type_id, vt in types.items()]
     lines.append("</additional>")
     return "\n".join(lines) + "\n"
+
+
+def stored_description(env: Mapping[str, Any], vut: str) -> str:
+    """A VUT's description as a stored ``env`` section's catalog holds it (a run's
+    ``config.yaml``): its ``description``, else its model with ``minGap`` and ``tau``; "" if
+    the catalog has no such entry."""
+    vuts = env.get("vuts")
+    entry = vuts.get(vut) if isinstance(vuts, Mapping) else None
+    if not isinstance(entry, Mapping):
+        return ""
+    if entry.get("description"):
+        return str(entry["description"])
+    params = entry.get("params") or {}
+    shown = ", ".join(f"{k}={v}" for k, v in sorted(params.items()) if k in ("minGap", "tau"))
+    return f"{entry.get('model', '?')}" + (f" ({shown})" if shown else "")

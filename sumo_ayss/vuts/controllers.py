@@ -87,7 +87,8 @@ import numbers
 import time
 from typing import Any, NamedTuple, Protocol, runtime_checkable
 
-from sumo_ayss.sim.pair import SensedObject, VehiclePair, VutSensing
+from sumo_ayss.sim.pair import VehiclePair
+from sumo_ayss.sim.sensing import SensedObject, VutSensing
 from sumo_ayss.util.errors import ControllerError
 from sumo_ayss.vuts.call_budget import CallBudget
 from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType

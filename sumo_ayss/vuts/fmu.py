@@ -415,7 +415,8 @@ class FmuController:
                 f"time {t:g} s (state {state})"
             )
         if self._output_kind == "speed_mps":
-            return (value - state.speed_mps) / dt
+            accel_mps2: float = (value - state.speed_mps) / dt
+            return accel_mps2
         return value
 
     def close(self) -> None:

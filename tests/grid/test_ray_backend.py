@@ -6,8 +6,9 @@ from pathlib import Path
 
 import pytest
 
+from sumo_ayss.commands.pipeline import run_pipeline
 from sumo_ayss.grid.ray_backend import pack, unpack
-from sumo_ayss.pipeline import load_pipeline, run_pipeline
+from sumo_ayss.pipeline import load_pipeline
 from tests.test_pipeline import write_configs
 
 

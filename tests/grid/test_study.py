@@ -14,11 +14,12 @@ from pathlib import Path
 import pytest
 import yaml
 
+from sumo_ayss.commands.pipeline import run_pipeline
 from sumo_ayss.config import PROJECT_ROOT, to_dict
 from sumo_ayss.crossplay import run_case
 from sumo_ayss.grid.adaptive import case_seeds, grid_vuts, read_record, stale_record
 from sumo_ayss.grid.study import prepare_out, same_vehicles
-from sumo_ayss.pipeline import final_messages, load_pipeline, plan_jobs, run_pipeline
+from sumo_ayss.pipeline import final_messages, load_pipeline, plan_jobs
 from sumo_ayss.run_folder import (
     AdaptiveRecord,
     RunConfig,

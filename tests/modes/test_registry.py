@@ -122,8 +122,8 @@ def test_the_registry_loads_without_the_analysis() -> None:
 
 def test_the_pipeline_refuses_an_unknown_mode_before_any_job(tmp_path) -> None:
     """The configuration imports no mode; the pipeline checks ``report.mode`` first."""
+    from sumo_ayss.commands.pipeline import run_pipeline
     from sumo_ayss.config import load_pipeline
-    from sumo_ayss.pipeline import run_pipeline
 
     cfg = load_pipeline("configs/ladders/min_gap.yaml", out=tmp_path / "study")
     bad = dataclasses.replace(cfg, report=dataclasses.replace(cfg.report, mode="exposur"))

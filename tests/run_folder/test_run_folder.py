@@ -24,6 +24,7 @@ from sumo_ayss.run_folder import (
     RunFolder,
     Seeds,
     StageHeader,
+    StudyFolder,
     Table,
     find_run_dirs,
     read_ayss_json,
@@ -46,7 +47,6 @@ from sumo_ayss.run_folder import (
     write_spcp,
     write_table,
 )
-from sumo_ayss.run_folder.layout import case_dir_for, run_dir_for
 from sumo_ayss.run_folder.metadata import (
     read_command,
     read_seeds,
@@ -120,7 +120,7 @@ def _ayss_table(n: int = 5) -> Table:
 @pytest.fixture
 def run_folder(tmp_path: Path) -> RunFolder:
     """A run folder with every file, each written by its writer."""
-    folder = RunFolder(run_dir_for(tmp_path, "cut_in", "pi2", 3))
+    folder = StudyFolder(tmp_path).run("cut_in", "pi2", 3)
     folder.checkpoints.mkdir(parents=True)
     env = {
         "case": "cut_in",
@@ -345,8 +345,8 @@ def test_config_yaml_holds_the_vut_once_and_legacy_folders_still_read(tmp_path: 
 
 
 def test_crossplay_files_of_a_case_folder_round_trip(tmp_path: Path) -> None:
-    folder = CaseFolder(case_dir_for(tmp_path, "cut_in"))
-    assert run_dir_for(tmp_path, "cut_in", "pi1", 0).parent.parent == folder.path
+    folder = StudyFolder(tmp_path).case("cut_in")
+    assert StudyFolder(tmp_path).run("cut_in", "pi1", 0).path.parent.parent == folder.path
     table = Table(
         CROSSPLAY_SCHEMA,
         {
@@ -371,8 +371,12 @@ def test_crossplay_files_of_a_case_folder_round_trip(tmp_path: Path) -> None:
     )
     write_crossplay_json(folder.crossplay_json, record)
     assert read_crossplay_json(folder.crossplay_json) == record
-    assert record.inputs() == dataclasses.replace(record, vuts=(), wall_s=0.0).inputs()
-    assert record.inputs() != dataclasses.replace(record, n=7).inputs()
+    from sumo_ayss.stages.crossplay_cells import crossplay_inputs
+
+    assert crossplay_inputs(record) == crossplay_inputs(
+        dataclasses.replace(record, vuts=(), wall_s=0.0)
+    )
+    assert crossplay_inputs(record) != crossplay_inputs(dataclasses.replace(record, n=7))
     folder.crossplay_json.write_text('{"case": "cut_in", "n": 6, "seed": 1, "opponents": [{}]}')
     with pytest.raises(TableError, match=r"crossplay\.json: opponents\[0\]: missing field 'vut'"):
         read_crossplay_json(folder.crossplay_json)
@@ -400,8 +404,10 @@ def test_adaptive_record_round_trips_and_refuses_another_layout(tmp_path: Path) 
     back = read_adaptive(path)
     assert back.seeds == record.seeds and back.first_seeds == (0, 1, 2, 3)
     assert math.isnan(back.looks[0].omnibus_p) and back.looks[0].ends_p == 0.11
-    assert not back.settled and back.same_plan((0, 1, 2, 3), 6, 0.05)
-    assert not back.same_plan((0, 1, 2), 6, 0.05)
+    from sumo_ayss.grid.adaptive import same_plan
+
+    assert not back.settled and same_plan(back, (0, 1, 2, 3), 6, 0.05)
+    assert not same_plan(back, (0, 1, 2), 6, 0.05)
     path.write_text('{"format": 1, "looks": "x"}')
     with pytest.raises(TableError, match=r"adaptive\.json: looks: expected list, got .x."):
         read_adaptive(path)

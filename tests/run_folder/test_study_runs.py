@@ -6,9 +6,10 @@ import typing
 
 from sumo_ayss.analysis.crossplay import CrossplayInput, CrossplayMatrix
 from sumo_ayss.analysis.crossplay_scoring import case_matrix
-from sumo_ayss.run_folder import Training, study_runs
+from sumo_ayss.run_folder import study_runs
 from sumo_ayss.run_folder.crossplay import CrossplayTables
 from sumo_ayss.run_folder.study_runs import mixing_problems
+from sumo_ayss.training.trust import Training
 
 
 def test_the_study_readers_return_typed_records_not_any() -> None:

@@ -10,7 +10,6 @@ from sumo_ayss.report import write_report
 from sumo_ayss.run_folder import (
     RunConfig,
     RunFolder,
-    Training,
     read_run,
     read_run_config,
     write_eval_table,
@@ -18,7 +17,7 @@ from sumo_ayss.run_folder import (
     write_spcp,
 )
 from sumo_ayss.training.selection import Selection
-from sumo_ayss.training.trust import fewest_seeds, training_status, trust_warnings
+from sumo_ayss.training.trust import Training, fewest_seeds, training_status, trust_warnings
 from sumo_ayss.util.errors import ConfigError
 from tests.report.test_report import FAST, make_run
 

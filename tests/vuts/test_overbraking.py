@@ -45,19 +45,6 @@ def test_the_new_flag_catches_it_and_the_mean_speed_rule_does_not() -> None:
     assert not mobility_flags(speed)["overbraker"]
 
 
-def _pov(case: str, rng: np.random.Generator, obs: np.ndarray, t: int, lc_at: int) -> int:
-    """A scripted POV (as ``benchmarks/unjustified_braking.py``'s): per decision it brakes
-    hard (8 %), mildly (12 %), holds (65 %) or speeds up (15 %); in cut-in it also cuts in
-    once."""
-    u = rng.random()
-    if case == "car_following":
-        return 0 if u < 0.08 else 1 if u < 0.2 else 2 if u < 0.85 else 3
-    if t == lc_at:
-        return 0
-    d = -8 if u < 0.08 else -3 if u < 0.2 else 0 if u < 0.85 else 3
-    return 1 + int(np.clip(round(float(obs[0])) + d, 0, 40))
-
-
 @pytest.mark.parametrize("case", ["car_following", "cut_in"])
 def test_the_revised_rule_spares_idm_and_still_flags_the_over_braker(case: str) -> None:
     """Issue 33, session 10: on the same 40 episodes per VUT, the first rule called the IDM
@@ -65,37 +52,27 @@ def test_the_revised_rule_spares_idm_and_still_flags_the_over_braker(case: str) 
     earlier, at gaps below R157's following distance); the revised rule rarely does, and
     the over-braker stays flagged."""
     from sumo_ayss.analysis.hazards import unjustified_braking
-    from sumo_ayss.envs.odd import sample_initial_conditions, with_followers
-    from sumo_ayss.scenarios.trajectory import trajectory_from_infos
+    from sumo_ayss.scenarios.scripted import scripted_episodes
 
     vuts = {**BUILTIN_VUTS, "overbraker": OVERBRAKER_VUT}
     share: dict[str, dict[str, float]] = {"first": {}, "revised": {}}
     dv: dict[str, float] = {}
     for vut in ("pi1", "pi2", "overbraker"):
-        cfg = EnvConfig(case=case, vuts=vuts, vut=vut, follower=FollowerConfig(enabled=True))
-        ics = with_followers(sample_initial_conditions(cfg.odd, 40, 11), cfg.follower, 11)
-        env = make_env(cfg, sumo_seed=0)
-        trs = []
-        try:
-            for i, ic in enumerate(ics):
-                rng = np.random.default_rng(1000 + i)
-                obs, info0 = env.reset(options={"initial_condition": ic})
-                lc_at, infos = int(rng.integers(0, 15)), []
-                for t in range(cfg.max_decisions):
-                    obs, _, term, trunc, info = env.step(_pov(case, rng, obs, t, lc_at))
-                    infos.append(info)
-                    if term or trunc:
-                        break
-                trs.append(trajectory_from_infos(cfg, info0, infos))
-        finally:
-            env.close()
+        trs = scripted_episodes(case, vut, vuts, 40)
         first = [
             unjustified_braking(t, reaction_window_s=0.0, following_distance=False) for t in trs
         ]
         revised = [unjustified_braking(t) for t in trs]
         share["first"][vut] = float(np.mean([u.any() for u in first]))
         share["revised"][vut] = float(np.mean([u.any() for u in revised]))
-        dv[vut] = float(np.mean([u.sum() * cfg.decision_period_s for u in revised]))
+        dv[vut] = float(
+            np.mean(
+                [
+                    u.sum() * float(t.time_s[1] - t.time_s[0])
+                    for u, t in zip(revised, trs, strict=True)
+                ]
+            )
+        )
     assert min(share["first"]["pi1"], share["first"]["pi2"]) > 0.4  # before
     assert share["revised"]["pi1"] <= 0.1 and share["revised"]["pi2"] <= 0.25  # after
     assert share["revised"]["overbraker"] > 2 * share["revised"]["pi2"]

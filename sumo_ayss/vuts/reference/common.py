@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from sumo_ayss.sim.pair import SensedObject
+from sumo_ayss.sim.sensing import SensedObject
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.vuts.controllers import ControllerInput
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from sumo_ayss.sim.pair import SensedObject
+from sumo_ayss.sim.sensing import SensedObject
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.vuts.controllers import ControllerInput
 from sumo_ayss.vuts.reference.common import (
