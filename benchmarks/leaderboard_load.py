@@ -286,6 +286,10 @@ def adaptive_lines(events: list[tuple[float, str]]) -> dict[str, list]:
     return out
 
 
+#: The child's command as recorded (no machine paths in committed results).
+COMMAND = "python -m sumo_ayss.rank load.yaml --no-live"
+
+
 def read_run(out: Path) -> tuple[list[tuple[float, str]], list[Sample], dict]:
     events = []
     with (out / "events.tsv").open() as f:
@@ -296,6 +300,9 @@ def read_run(out: Path) -> tuple[list[tuple[float, str]], list[Sample], dict]:
         samples = [Sample(*(float(v) for v in r[:3]), int(r[3])) for r in list(csv.reader(f))[1:]]
     if (out / "run.json").is_file():
         meta = json.loads((out / "run.json").read_text())
+        if meta.get("command") != COMMAND:  # an older run's record named the interpreter's path
+            meta["command"] = COMMAND
+            (out / "run.json").write_text(json.dumps(meta, indent=1) + "\n")
     else:  # still running (or killed): the stages so far, the last one cut at the last sample
         cfg = yaml.safe_load((out / "load.yaml").read_text())
         budget = cfg.get("budget", "tiny")
@@ -396,7 +403,7 @@ def run(out: Path, config: Path, meta: dict, period_s: float = 0.5) -> None:
         "returncode": child.returncode,
         "wall_s": round(wall, 1),
         "cpu_s": round(usage.ru_utime + usage.ru_stime, 1),
-        "command": " ".join(cmd),
+        "command": COMMAND,
     }
     (out / "run.json").write_text(json.dumps(meta, indent=1) + "\n")
 
