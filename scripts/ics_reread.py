@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sumo_ayss.envs.odd import sample_initial_conditions
+from sumo_ayss.envs.odd import scenario_set
 from sumo_ayss.run_folder import (
     CROSSPLAY_SCHEMA,
     CaseFolder,
@@ -44,7 +44,7 @@ def _case_rows(study: Path, case_dir: Path) -> dict[str, object] | None:
     record = read_crossplay_json(folder.crossplay_json)
     run_dir = next(case_dir.glob("*/seed_*"))
     env = read_run(run_dir).experiment.env
-    flags = np.array(ics_flags(env, sample_initial_conditions(env.odd, record.n, record.seed)))
+    flags = np.array(ics_flags(env, scenario_set(env, record.n, record.seed)))
     t = read_table(folder.crossplay_csv, CROSSPLAY_SCHEMA)
     vuts = sorted(set(t["vut"].tolist()))
     cells: dict[tuple[str, int, int], list[bool]] = {}

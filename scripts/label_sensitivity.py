@@ -24,7 +24,7 @@ from typing import Any
 
 from sumo_ayss.agents.weights import load_spcp
 from sumo_ayss.envs import make_env
-from sumo_ayss.envs.odd import sample_initial_conditions
+from sumo_ayss.envs.odd import scenario_set
 from sumo_ayss.run_folder import read_crossplay_json, read_run
 from sumo_ayss.scenarios.preventability import label_crashes
 from sumo_ayss.scenarios.rollout import run_episodes
@@ -56,7 +56,7 @@ def case_rows(
     policies = {}
     for vut in vuts:
         cfg = envs[vut]
-        scenarios = sample_initial_conditions(cfg.odd, record.n, record.seed)
+        scenarios = scenario_set(cfg, record.n, record.seed)
         for opp in runs:
             t0 = time.perf_counter()
             env = make_env(cfg, sumo_seed=opp.config_seed)

@@ -55,3 +55,5 @@ for study in braking reaction acc_time_gap min_gap; do
   fi
 done
 rank configs/ladders/braking_lead_and_cut_in.yaml --out results/ladders/braking_lead_and_cut_in_a  # issue 39
+rank configs/ladders/braking_lead_and_cut_in_safe.yaml --out results/ladders/braking_lead_and_cut_in_b  # issue 39, session 11
+rank configs/ladders/acc_time_gap_lead_and_cut_in.yaml --out results/ladders/acc_time_gap_lead_and_cut_in_a  # issue 39, session 11

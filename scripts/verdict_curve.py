@@ -130,7 +130,7 @@ def cells(out: Path, studies: Sequence[Path], budget_step: int = BUDGET_STEP) ->
     (budgets every ``budget_step`` transitions)."""
     from sumo_ayss.agents.weights import load_greedy_policy
     from sumo_ayss.envs import make_env
-    from sumo_ayss.envs.odd import sample_initial_conditions
+    from sumo_ayss.envs.odd import scenario_set
     from sumo_ayss.scenarios.rollout import run_episodes
 
     cases = sorted({p.name for s in studies for p in s.iterdir() if list(p.glob("*/seed_*"))})
@@ -195,7 +195,7 @@ def cells(out: Path, studies: Sequence[Path], budget_step: int = BUDGET_STEP) ->
                                 env.action_space,  # type: ignore[arg-type]
                             )
                         }
-                    scenarios = sample_initial_conditions(envs[vut].odd, n, seed)
+                    scenarios = scenario_set(envs[vut], n, seed)
                     episodes = run_episodes(env, policies[key], scenarios)  # type: ignore[arg-type]
                 finally:
                     env.close()

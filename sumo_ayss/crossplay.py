@@ -216,7 +216,7 @@ def run_case(
 def _inevitable(env: Any, folder: CaseFolder, n: int, seed: int) -> None:
     """``inevitable.json``: which of the ``n`` scenarios are inevitable-collision states
     (a second per thousand scenarios; kept when it holds this scenario set)."""
-    from sumo_ayss.envs.odd import sample_initial_conditions
+    from sumo_ayss.envs.odd import scenario_set
     from sumo_ayss.scenarios.inevitable import ics_flags, pov_strategies
 
     path = folder.inevitable_json
@@ -226,7 +226,7 @@ def _inevitable(env: Any, folder: CaseFolder, n: int, seed: int) -> None:
                 return
         except TableError:
             pass
-    flags = ics_flags(env, sample_initial_conditions(env.odd, n, seed))
+    flags = ics_flags(env, scenario_set(env, n, seed))
     write_inevitable(path, n, seed, flags, tuple(pov_strategies(env.case)))
 
 

@@ -9,6 +9,8 @@ selected policy ``<run>/spcp.zip``, and writes into the run folder:
     outcome.csv   one row per outcome episode   (sumo_ayss.run_folder.OUTCOME_SCHEMA)
     outcome.json  crash / lane-change rates, mean reward and final headway with 95 % CIs
     ayss.csv      one row per kept AYSS sample  (sumo_ayss.run_folder.AYSS_SCHEMA)
+    ayss_bins.csv the same samples as moments per 1/32 m headway cell (committed where
+                  ayss.csv is not: sumo_ayss.run_folder.ayss_bins)
     ayss.json     filter counts, throughput, the Monte Carlo settings, mean indicator
 
 (file names, writers and readers: :mod:`sumo_ayss.run_folder`).
@@ -43,7 +45,10 @@ from sumo_ayss.grid.threads import set_torch_threads
 from sumo_ayss.run_folder import (
     RunRecord,
     StageHeader,
+    ayss_cells,
+    backfill_ayss_bins,
     read_run,
+    write_ayss_bins,
     write_ayss_json,
     write_outcome_json,
     write_table,
@@ -176,6 +181,10 @@ def _ayss_stage(
     result = run_ayss(env, policy, cfg, progress=progress)
     folder = run.folder
     write_table(folder.ayss_csv, result.table)
+    table = result.table
+    write_ayss_bins(
+        folder.ayss_bins, ayss_cells(table["h_m"], table["indicator"], result.indicator_name)
+    )
     summary = result.summary()
     settings = summary.pop("config")  # the AyssConfig used, compared on a later skip
     write_ayss_json(folder.ayss_json, _header(run), settings, summary)
@@ -238,6 +247,7 @@ def _evaluate_run(
     cfg = run.experiment  # raises if config.yaml is missing or invalid
     ayss_cfg = ayss if ayss is not None else AyssConfig()
     f = run.folder
+    backfill_ayss_bins(f.ayss_csv, f.ayss_bins)  # evaluated before ayss_bins.csv existed
     do_outcome = _should_run(OutcomeStage(f, n_outcome, outcome_seed), force)
     do_ayss = _should_run(AyssStage(f, ayss_cfg), force)
     outcome: OutcomeResult | None = None

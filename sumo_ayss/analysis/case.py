@@ -24,6 +24,7 @@ from typing import Generic, Protocol, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
+from sumo_ayss.analysis.ayss_cells import CellsLike, safety_index_from_cells
 from sumo_ayss.analysis.case_verdict import CaseVerdict
 from sumo_ayss.analysis.crossplay import CrossplayInput
 from sumo_ayss.analysis.harm import ColumnsLike, RewardLike
@@ -132,6 +133,9 @@ class RunLike(Protocol):
     def ayss(self) -> AyssLike | None: ...
 
     @property
+    def ayss_cells(self) -> CellsLike | None: ...
+
+    @property
     def outcome(self) -> OutcomeLike | None: ...
 
     @property
@@ -160,7 +164,9 @@ def bootstrap_rng(options: CaseOptions, case: str, vut: str) -> np.random.Genera
 def vut_safety_index(
     runs: Sequence[RunLike], options: CaseOptions, rng: np.random.Generator | int | None = None
 ) -> SafetyIndex | None:
-    """Safety index of one VUT from the AYSS samples of its runs (one seed per run).
+    """Safety index of one VUT from the AYSS samples of its runs (one seed per run); from
+    their per-cell moments (:func:`~.ayss_cells.safety_index_from_cells`) when a run has
+    only those (``ayss_bins.csv`` without ``ayss.csv``).
 
     Args:
         runs: The VUT's runs; those without AYSS samples are skipped.
@@ -171,9 +177,19 @@ def vut_safety_index(
         The :class:`SafetyIndex`, or None if no run has a sample in the headway range.
     """
     seeds = [r.ayss for r in runs if r.ayss is not None and len(r.ayss) > 0]
-    if not seeds:
+    cells = [c for r in runs if (c := r.ayss_cells) is not None and int(c.n.sum()) > 0]
+    if not cells:
         return None
     try:
+        if len(cells) > len(seeds):  # a run without ayss.csv: its ayss_bins.csv
+            return safety_index_from_cells(
+                cells,
+                options.h_range,
+                n_bins=options.index_bins,
+                level=options.level,
+                n_boot=options.n_boot,
+                rng=rng,
+            )
         return safety_index(
             [s.indicator for s in seeds],
             [s.h for s in seeds],

@@ -14,8 +14,9 @@ VUT's unjustified hard braking, per episode (pure numpy, no SUMO).
 
 **Unjustified hard braking.** The VUT brakes harder than :data:`HARD_BRAKING_MPS2` over a
 decision while nothing ahead was critical at its start (the state it decided on) and no
-leader had braked as hard just before. Critical means, for the POV ahead of the VUT's front,
-in its path or moving sideways toward it:
+leader had braked as hard just before; with two POVs (``lead_and_cut_in``), against
+either of them (:func:`episode_hazards`' ``others``). Critical means, for the POV ahead of
+the VUT's front, in its path or moving sideways toward it:
 
 * its TTC (1-D in one path, or 2-D) below :data:`CRITICAL_TTC_S`, or
 * the gap inside the Fuzzy Safety Model's unsafe distance (PFS = 1: the careful driver model
@@ -60,6 +61,7 @@ Imports neither SUMO nor torch; reads no file.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import astuple, dataclass, fields
 
 import numpy as np
@@ -241,9 +243,18 @@ def _follower(tr: PairTrajectory, f: FollowerTrack) -> tuple[float, float, float
     )
 
 
-def episode_hazards(tr: PairTrajectory, follower: FollowerTrack | None) -> HazardMeasures:
-    """The :class:`HazardMeasures` of one episode (``follower`` None: no follower)."""
+def episode_hazards(
+    tr: PairTrajectory, follower: FollowerTrack | None, others: Sequence[PairTrajectory] = ()
+) -> HazardMeasures:
+    """The :class:`HazardMeasures` of one episode (``follower`` None: no follower).
+
+    ``others``: the same episode seen against each further POV (``lead_and_cut_in``'s
+    supporting POV, in ``tr``'s POV fields): braking is unjustified only where it is so
+    against every POV (any of them ahead and critical, or braking, justifies it).
+    """
     ub = unjustified_braking(tr)
+    for other in others:
+        ub = np.where(unjustified_braking(other) > 0.0, ub, 0.0)
     any_ub = bool(np.any(ub > 0.0))
     if follower is None:
         fol = (math.nan, math.nan, math.nan, math.nan)

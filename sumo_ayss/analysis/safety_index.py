@@ -62,6 +62,9 @@ class SafetyIndex:
             pooled over seeds, shape ``(n_samples,)``; used for Cohen's d.
         seed_points: The index computed on each seed alone (same bins), one per seed in
             ``n_seeds``; used for the seed-level Welch cross-check of :func:`compare`.
+        indicator_moments: ``(n, mean, m2)`` of ``indicator_samples`` when the index was
+            computed from per-cell moments (:mod:`~.ayss_cells`), which hold no samples;
+            None otherwise.
     """
 
     point: float
@@ -78,6 +81,7 @@ class SafetyIndex:
         default_factory=_empty, repr=False, compare=False
     )
     seed_points: tuple[float, ...] = ()
+    indicator_moments: tuple[int, float, float] | None = None
 
 
 def _check_pos_int(value: object, name: str, minimum: int = 1) -> int:

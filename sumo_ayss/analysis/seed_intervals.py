@@ -31,6 +31,7 @@ __all__ = [
     "SeedBands",
     "binned_seed_means",
     "clip_interval",
+    "seed_bands",
     "seed_mean_ci",
 ]
 
@@ -130,6 +131,13 @@ def binned_seed_means(
     per_seed = tuple(
         binned_mean_ci(h, y, edges, level=level, min_count=min_count) for h, y in seeds
     )
+    return seed_bands(per_seed, edges, level)
+
+
+def seed_bands(per_seed: Sequence[BinnedStats], edges: ArrayLike, level: float = 0.95) -> SeedBands:
+    """:func:`binned_seed_means` from each seed's own :class:`BinnedStats` on ``edges``
+    (e.g. from per-cell moments, :func:`~.ayss_cells.binned_stats_from_cells`)."""
+    per_seed = tuple(per_seed)
     e = np.asarray(edges, dtype=np.float64)
     k = e.size - 1
     means, lo, hi = (np.full(k, np.nan) for _ in range(3))

@@ -87,9 +87,30 @@ def _check_comparable(a: SafetyIndex, b: SafetyIndex) -> None:
 def _oriented_cohens_d(a: SafetyIndex, b: SafetyIndex) -> float:
     """Cohen's d of the negated indicators (positive = A safer), NaN if undefined."""
     ya, yb = a.indicator_samples, b.indicator_samples
+    if a.indicator_moments is not None or b.indicator_moments is not None:
+        return _moments_cohens_d(_moments(a), _moments(b))
     if ya.size == 0 or yb.size == 0 or ya.size + yb.size < 3:
         return math.nan
     return cohens_d(-ya, -yb)
+
+
+def _moments(a: SafetyIndex) -> tuple[int, float, float]:
+    """``(n, mean, m2)`` of an index's indicator: stored, or of its samples."""
+    if a.indicator_moments is not None:
+        return a.indicator_moments
+    y = a.indicator_samples
+    if y.size == 0:
+        return 0, math.nan, math.nan
+    return int(y.size), float(y.mean()), float(np.sum((y - y.mean()) ** 2))
+
+
+def _moments_cohens_d(a: tuple[int, float, float], b: tuple[int, float, float]) -> float:
+    """:func:`~.stats.cohens_d` of the negated indicators from their moments."""
+    (na, ma, sa), (nb, mb, sb) = a, b
+    if na == 0 or nb == 0 or na + nb < 3:
+        return math.nan
+    s_pooled = math.sqrt((sa + sb) / (na + nb - 2))
+    return math.nan if s_pooled == 0.0 else (mb - ma) / s_pooled
 
 
 def _seed_welch_p(a: SafetyIndex, b: SafetyIndex) -> float:

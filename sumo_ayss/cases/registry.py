@@ -147,6 +147,12 @@ class Case:
             False: ``train.n_envs`` must be 1 (the configuration refuses more).
         default_grid: A pipeline whose ``grid`` names no cases runs this one
             (:func:`default_grid_cases`); False: only where a grid names it.
+        povs: How many POVs an episode has (more than one: the supporting POVs' forbidden
+            contacts, ``env.reward.pov_failure_penalty``).
+        start_filter: ``"module:function"``, ``(EnvConfig) -> (InitialCondition) -> bool``:
+            whether a start drawn from the ODD is admissible when ``env.odd.
+            exclude_inevitable`` is set (no inevitable collision); empty: the case has no
+            such check and the option is refused.
     """
 
     name: str
@@ -172,6 +178,8 @@ class Case:
     one_decision_note: str = ""
     vec_env: bool = True
     default_grid: bool = True
+    povs: int = 1
+    start_filter: str = ""
 
     def __post_init__(self) -> None:
         where = f"case {self.name!r}"
@@ -198,7 +206,7 @@ class Case:
                 f"{where}: unknown outcome column {key!r}{suggest(key, OUTCOME_COLUMNS)}; "
                 f"allowed: {list(OUTCOME_COLUMNS)}",
             )
-        for attr in ("env", "ayss_rows"):
+        for attr in ("env", "ayss_rows", "start_filter"):
             path = getattr(self, attr)
             require(
                 not path or _IMPORT_PATH.fullmatch(path) is not None,
@@ -214,6 +222,11 @@ class Case:
         """The AYSS row builder (imports its module)."""
         rows: Callable[..., Any] = _resolve(self, "ayss_rows")
         return rows
+
+    def start_filter_factory(self) -> Callable[..., Any]:
+        """The factory of :attr:`start_filter` (imports its module)."""
+        factory: Callable[..., Any] = _resolve(self, "start_filter")
+        return factory
 
 
 def _resolve(case: Case, attr: str) -> Any:

@@ -51,6 +51,22 @@ MANAGED_SUMO_OPTIONS: dict[str, str] = {
 
 StepMethod = Literal["auto", "euler", "ballistic"]
 
+#: Field metadata key: :func:`~sumo_ayss.config.mapping.to_dict` leaves the field out while
+#: it holds its default (an option added after runs were stored keeps their files and
+#: identities as they were).
+OMIT_DEFAULT = "omit_default"
+
+
+def repr_omitting_defaults(obj: Any) -> str:
+    """The dataclass ``repr`` of ``obj`` without its :data:`OMIT_DEFAULT` fields at their
+    defaults: reprs key stored cross-play cells, which stay as they were before the field."""
+    parts = [
+        f"{f.name}={getattr(obj, f.name)!r}"
+        for f in dataclasses.fields(obj)
+        if f.repr and not (f.metadata.get(OMIT_DEFAULT) and getattr(obj, f.name) == f.default)
+    ]
+    return f"{type(obj).__qualname__}({', '.join(parts)})"
+
 
 @dataclass(frozen=True)
 class SimConfig:
@@ -220,11 +236,22 @@ class OddConfig:
     vut_speed_mps: tuple[float, float] = (10.0, 30.0)
     gap_m: tuple[float, float] = (2.0, 25.0)
     """Longitudinal gap POV rear bumper - VUT front bumper [m]."""
+    exclude_inevitable: bool = field(default=False, metadata={OMIT_DEFAULT: True})
+    """Draw again every start that is an inevitable collision (the case's own conservative
+    check, :attr:`~sumo_ayss.cases.Case.start_filter`; ``lead_and_cut_in`` only). Stored
+    only when true, so runs written before the option keep their ``config.yaml``/identity."""
 
     def __post_init__(self) -> None:
         for name in ("pov_speed_mps", "vut_speed_mps", "gap_m"):
             value = check_range(f"{self.SECTION}.{name}", getattr(self, name), low=0.0)
             object.__setattr__(self, name, value)
+        require(
+            isinstance(self.exclude_inevitable, bool),
+            f"{self.SECTION}.exclude_inevitable must be true or false, "
+            f"got {self.exclude_inevitable!r}",
+        )
+
+    __repr__ = repr_omitting_defaults
 
 
 @dataclass(frozen=True)
@@ -274,9 +301,19 @@ class RewardConfig:
         default_factory=lambda: RewardShape(peak_m=1.0, zero_m=5.0, value_at_contact=0.5)
     )
     """R_A while the POV changes lanes (cut-in only)."""
+    pov_failure_penalty: float = field(default=0.0, metadata={OMIT_DEFAULT: True})
+    """A case with two POVs (``lead_and_cut_in``): the further cost of a forbidden contact
+    (the POVs' failure), in units of ``alpha_collision``, on top of the POVs' safe terms.
+    Stored only when not 0 (runs written before it keep their identity)."""
+
+    __repr__ = repr_omitting_defaults
 
     def __post_init__(self) -> None:
         s = self.SECTION
+        require(
+            self.pov_failure_penalty >= 0,
+            f"{s}.pov_failure_penalty must be >= 0, got {self.pov_failure_penalty}",
+        )
         require(
             self.alpha_adversarial > 0,
             f"{s}.alpha_adversarial must be > 0, got {self.alpha_adversarial}",
@@ -362,6 +399,16 @@ class EnvConfig:
             require(path.is_file(), f"{s}.network: file not found: {path}")
             lanes = get_case(self.case).lanes
             check_sumo_network(path, f"{s}.network", ROAD_EDGE, lanes, self.case)
+        require(
+            not self.reward.pov_failure_penalty or get_case(self.case).povs > 1,
+            f"{s}.reward.pov_failure_penalty: case {self.case!r} has one POV (no forbidden "
+            "contact to penalise)",
+        )
+        require(
+            not self.odd.exclude_inevitable or bool(get_case(self.case).start_filter),
+            f"{s}.odd.exclude_inevitable: case {self.case!r} has no inevitable-start check "
+            f"(cases with one: {[c for c in case_names() if get_case(c).start_filter]})",
+        )
         top = self.actuator.max_speed_mps
         require(
             self.odd.pov_speed_mps[1] <= top,

@@ -17,7 +17,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
-from sumo_ayss.config.env import EnvConfig
+from sumo_ayss.config.env import OMIT_DEFAULT, EnvConfig
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.validation import check_choice, unknown_key
 from sumo_ayss.vuts.catalog import DRIVER_KEYS, ControllerSpec, VehicleType
@@ -164,7 +164,11 @@ def to_dict(obj: Any) -> Any:
     if isinstance(obj, VehicleType) and obj.controller is not None:
         return _controlled_vut_dict(obj)
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        return {f.name: to_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+        return {
+            f.name: to_dict(getattr(obj, f.name))
+            for f in dataclasses.fields(obj)
+            if not (f.metadata.get(OMIT_DEFAULT) and getattr(obj, f.name) == f.default)
+        }
     if isinstance(obj, Mapping):
         return {str(k): to_dict(v) for k, v in obj.items()}
     if isinstance(obj, tuple | list):

@@ -9,7 +9,8 @@ The rules and their reasons are in docs/cases.md; in short:
   gap (from the ODD's ranges) and the primary (a fair coin) come from a generator keyed by
   those three numbers (:func:`two_pov_start`), or explicitly from a :class:`TwoPovStart`.
 * One joint discrete action: ``a = i_lead · N_CUT + i_cut`` (:func:`decode_action`).
-* Reward ``α_A·R_A(primary) − α_C·(POVs in a contact) − α_U·[unpreventable crash]``;
+* Reward ``α_A·R_A(primary) − α_C·(POVs in a contact) − α_U·[unpreventable crash]
+  − α_F·[forbidden contact]`` (``env.reward.pov_failure_penalty``, default 0);
   primary–VUT contact is the VUT's crash (``info["collision"]``); supporting–VUT and
   POV–POV contacts end the episode as ``info["pov_failure"]``; a primary crash is replayed
   online with the careful-human reference in the VUT's body (``info["crash_unpreventable"]``).
@@ -252,10 +253,13 @@ class LeadAndCutInEnv(PairEnv):
         info["vut_contact"] = c.primary_vut or c.support_vut
         info["contact"] = c.any
         info["support_vut_contact"] = c.support_vut
+        info["pov_pov_contact"] = c.pov_pov
         info["reward_collision"] = -float(c.povs)
         alpha_c = self._reward_cfg.alpha_collision
         if c.any:
             reward = -alpha_c * c.povs
+        if c.failure:
+            reward -= self._reward_cfg.pov_failure_penalty * alpha_c
         if c.primary_vut and self.online_labels:
             unpreventable = self._reference_collides()
             info["crash_unpreventable"] = float(unpreventable)

@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from sumo_ayss.config import OddConfig
+from sumo_ayss.cases import get_case
+from sumo_ayss.config import EnvConfig, OddConfig
 from sumo_ayss.config.follower import FollowerConfig
+from sumo_ayss.util.errors import ConfigError
 
 
 @dataclass(frozen=True)
@@ -36,22 +38,54 @@ class InitialCondition:
         return (self.pov_speed_mps, self.vut_speed_mps, self.gap_m)
 
 
-def sample_initial_condition(odd: OddConfig, rng: np.random.Generator) -> InitialCondition:
-    """Uniform draw from the ODD's speed and gap ranges (one ``rng.random(3)``, field order)."""
-    u_pov, u_vut, u_gap = rng.random(3).tolist()
-    return InitialCondition(
-        _lerp(odd.pov_speed_mps, u_pov), _lerp(odd.vut_speed_mps, u_vut), _lerp(odd.gap_m, u_gap)
-    )
+#: Whether a start drawn from the ODD may be used (:func:`start_filter`).
+StartFilter = Callable[[InitialCondition], bool]
+#: Draws per start before an ODD whose starts the filter all refuses is reported.
+MAX_DRAWS = 1000
+
+
+def sample_initial_condition(
+    odd: OddConfig, rng: np.random.Generator, admissible: StartFilter | None = None
+) -> InitialCondition:
+    """Uniform draw from the ODD's speed and gap ranges (one ``rng.random(3)``, field order);
+    with ``admissible``, drawn again until it accepts the start (rejection sampling)."""
+    for _ in range(MAX_DRAWS):
+        u_pov, u_vut, u_gap = rng.random(3).tolist()
+        ic = InitialCondition(
+            _lerp(odd.pov_speed_mps, u_pov),
+            _lerp(odd.vut_speed_mps, u_vut),
+            _lerp(odd.gap_m, u_gap),
+        )
+        if admissible is None or admissible(ic):
+            return ic
+    raise ConfigError(f"env.odd: no admissible start in {MAX_DRAWS} draws of {odd}")
+
+
+def start_filter(cfg: EnvConfig) -> StartFilter | None:
+    """The case's admissible-start check when ``env.odd.exclude_inevitable`` is set, else
+    None (every draw is used, as before the option)."""
+    if not cfg.odd.exclude_inevitable:
+        return None
+    factory: Callable[[EnvConfig], StartFilter] = get_case(cfg.case).start_filter_factory()
+    return factory(cfg)
 
 
 def _lerp(bounds: tuple[float, float], u: float) -> float:
     return bounds[0] + (bounds[1] - bounds[0]) * u
 
 
-def sample_initial_conditions(odd: OddConfig, n: int, seed: int) -> list[InitialCondition]:
+def sample_initial_conditions(
+    odd: OddConfig, n: int, seed: int, admissible: StartFilter | None = None
+) -> list[InitialCondition]:
     """``n`` initial conditions from a seed: the fixed scenario set shared by every VUT."""
     rng = np.random.default_rng(seed)
-    return [sample_initial_condition(odd, rng) for _ in range(n)]
+    return [sample_initial_condition(odd, rng, admissible) for _ in range(n)]
+
+
+def scenario_set(cfg: EnvConfig, n: int, seed: int) -> list[InitialCondition]:
+    """The scenario set of ``cfg``'s ODD: :func:`sample_initial_conditions` with the
+    case's :func:`start_filter` (the same draws as before where none applies)."""
+    return sample_initial_conditions(cfg.odd, n, seed, start_filter(cfg))
 
 
 #: Tag of the follower's random stream, so that its draws never shift the scenario set's.

@@ -31,7 +31,7 @@ from sumo_ayss.envs.follower import (
     follower_wanted,
     place_follower,
 )
-from sumo_ayss.envs.odd import InitialCondition, sample_initial_condition
+from sumo_ayss.envs.odd import InitialCondition, sample_initial_condition, start_filter
 from sumo_ayss.envs.rewards import total_reward
 from sumo_ayss.laws import VehicleLaws, build_laws
 from sumo_ayss.sim.network import ROAD_EDGE, ROAD_LENGTH_M, network_path
@@ -82,9 +82,7 @@ def sumo_seed_of(seed: int) -> int:
 class PairKinematics(NamedTuple):
     """What a step reads back from SUMO (front-bumper positions, m; speeds, m/s).
 
-    A NamedTuple, not a dataclass: it is built on every step and a frozen dataclass costs
-    several times more to construct.
-    """
+    A NamedTuple, not a dataclass: built on every step, a frozen dataclass costs far more."""
 
     pov_pos_m: float
     pov_speed_mps: float
@@ -158,6 +156,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
         self._max_decisions = config.max_decisions
         self._reward_cfg = config.reward
         self._pov_law, self._vut_law = laws if laws is not None else build_laws(config)
+        self._admissible = start_filter(config)  # env.odd.exclude_inevitable: the case's check
         self._decisions = 0
         self._target = 0.0  # the POV's target speed of the current decision [m/s]
         self._shared = False  # a member of a PairVecEnv (see join_shared)
@@ -290,7 +289,7 @@ class PairEnv(gym.Env[npt.NDArray[np.float32], np.int64]):
             self._close_sim()  # restarted by the reset's _ensure_sim, with a fresh SUMO state
         ic = (options or {}).get("initial_condition")
         if ic is None:
-            ic = sample_initial_condition(self.config.odd, self.np_random)
+            ic = sample_initial_condition(self.config.odd, self.np_random, self._admissible)
         elif not isinstance(ic, InitialCondition):
             raise ConfigError(
                 f"reset options['initial_condition'] must be an InitialCondition, got {ic!r}"

@@ -1,5 +1,5 @@
-"""The two-POV case's pure parts: its joint action, its start, its contact kinds
-(:mod:`sumo_ayss.envs.lead_and_cut_in`; docs/cases.md). No SUMO."""
+"""The two-POV case's pure parts: its joint action, its start, its inevitable-start check,
+its contact kinds (:mod:`sumo_ayss.envs.lead_and_cut_in`; docs/cases.md). No SUMO."""
 
 from __future__ import annotations
 
@@ -8,9 +8,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from sumo_ayss.config import OddConfig
-from sumo_ayss.envs.odd import InitialCondition
+from sumo_ayss.config import EnvConfig, OddConfig
+from sumo_ayss.envs.odd import InitialCondition, StartFilter
+from sumo_ayss.laws import braking_contact
 from sumo_ayss.util.errors import ActionError
+from sumo_ayss.vuts.reference import FullBraking
 
 __all__ = [
     "CUT_LANE",
@@ -27,6 +29,8 @@ __all__ = [
     "TwoPovStart",
     "decode_action",
     "encode_action",
+    "inevitable_start",
+    "start_filter",
     "two_pov_start",
 ]
 
@@ -100,6 +104,49 @@ def two_pov_start(ic: InitialCondition, odd: OddConfig) -> TwoPovStart:
         support_gap_m=g0 + (g1 - g0) * u_gap,
         primary=PRIMARY_CUT_IN if u_primary < 0.5 else PRIMARY_LEAD,
     )
+
+
+def inevitable_start(start: TwoPovStart, cfg: EnvConfig) -> bool:
+    """Whether ``start`` is an inevitable collision with **either** POV (conservative).
+
+    The inevitable-collision check of :mod:`sumo_ayss.scenarios.inevitable` (a VUT braking
+    at 0.85 g from the first step touches the POV under one of the POV's worst plain plays,
+    ``LeadAndCutInEnv.ICS_STRATEGIES``: the lead brakes at once; the cut-in POV cuts in at
+    once and brakes from the next decision, or holds its speed), forecast without SUMO
+    (:func:`~sumo_ayss.laws.braking_contact`) and for both POVs, whichever is the primary:
+    a supporting POV that starts where its worst play cannot be escaped forces a forbidden
+    contact no policy is to blame for either. The cut-in POV counts as in the VUT's lane
+    from the first step (SUMO needs part of the lane change first), so every start SUMO's
+    check finds is found, and a few more (tests/envs/test_two_pov_starts.py measures both).
+    """
+    decel = FullBraking().decel_mps2
+    brake = SPEED_OFFSETS_MPS[0]
+    primary = (start.gap_m, start.pov_speed_mps, start.primary == PRIMARY_CUT_IN)
+    support = (start.support_gap_m, start.support_speed_mps, start.primary == PRIMARY_LEAD)
+    for gap, speed, is_cut_in in (primary, support):
+        plays = (1, None) if is_cut_in else (0,)
+        for brake_from in plays:
+            if braking_contact(
+                cfg,
+                gap,
+                speed,
+                start.vut_speed_mps,
+                decel,
+                brake_offset_mps=brake,
+                brake_from=brake_from,
+            ):
+                return True
+    return False
+
+
+def start_filter(cfg: EnvConfig) -> StartFilter:
+    """The case's admissible starts (:attr:`~sumo_ayss.cases.Case.start_filter`): those
+    whose full two-POV start (:func:`two_pov_start`) is not an :func:`inevitable_start`."""
+
+    def admissible(ic: InitialCondition) -> bool:
+        return not inevitable_start(two_pov_start(ic, cfg.odd), cfg)
+
+    return admissible
 
 
 class Contact(NamedTuple):

@@ -15,7 +15,13 @@ from pathlib import Path
 from typing import Any
 
 from sumo_ayss.config import AyssConfig, ExperimentConfig
-from sumo_ayss.run_folder import RunFolder, StudyFolder, read_run, write_progress
+from sumo_ayss.run_folder import (
+    RunFolder,
+    StudyFolder,
+    backfill_ayss_bins,
+    read_run,
+    write_progress,
+)
 from sumo_ayss.stages import EvaluateStage, TrainStage, is_done
 from sumo_ayss.util.errors import ControllerError, DiskFullError
 from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
@@ -112,6 +118,8 @@ def run_job(spec: JobSpec) -> dict[str, Any]:
         write_progress(run_dir, "evaluate")
         t1 = time.perf_counter()
         evaluation = EvaluateStage(folder, spec.n_outcome, spec.ayss)
+        # a run evaluated before ayss_bins.csv existed: reduce its ayss.csv, no re-evaluation
+        backfill_ayss_bins(folder.ayss_csv, folder.ayss_bins)
         if is_done(evaluation):
             stages["evaluate"] = "skipped"
         else:

@@ -14,11 +14,13 @@ law                         drives
 
 :func:`build_laws` picks them by name from the configuration (:mod:`~sumo_ayss.laws.
 registry`). Laws reach SUMO only through :class:`~sumo_ayss.sim.pair.VehiclePair`.
+:func:`braking_contact` forecasts the clipped law without SUMO (inevitable-start checks).
 """
 
 from __future__ import annotations
 
 from sumo_ayss.laws.base import PovLaw, VehicleLaw, VehicleLaws, VutLaw
+from sumo_ayss.laws.braking import braking_contact
 from sumo_ayss.laws.registry import build_laws
 
-__all__ = ["PovLaw", "VehicleLaw", "VehicleLaws", "VutLaw", "build_laws"]
+__all__ = ["PovLaw", "VehicleLaw", "VehicleLaws", "VutLaw", "braking_contact", "build_laws"]

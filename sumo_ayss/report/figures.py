@@ -25,8 +25,15 @@ from matplotlib.ticker import FuncFormatter
 from numpy.typing import NDArray
 
 from sumo_ayss.analysis import binned_mean_ci
+from sumo_ayss.analysis.ayss_cells import binned_stats_from_cells
 from sumo_ayss.analysis.ranking import SafetyIndex
-from sumo_ayss.analysis.seed_intervals import MIN_SEEDS_FOR_INTERVAL, SeedBands, binned_seed_means
+from sumo_ayss.analysis.seed_intervals import (
+    MIN_SEEDS_FOR_INTERVAL,
+    SeedBands,
+    binned_seed_means,
+    seed_bands,
+)
+from sumo_ayss.analysis.stats import BinnedStats
 from sumo_ayss.cases import case_info
 from sumo_ayss.config import RewardConfig
 from sumo_ayss.envs.rewards import adversarial_reward_array
@@ -43,6 +50,7 @@ from sumo_ayss.run_folder import RunRecord
 __all__ = [
     "DPI",
     "band_kind",
+    "has_ayss",
     "indicator_figure",
     "learning_curves_figure",
     "reward_shapes_figure",
@@ -227,10 +235,26 @@ def _run_legend(
 # --------------------------------------------------------------------------- indicator vs headway
 
 
-def _seed_arrays(run: RunRecord) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-    if run.ayss is None or len(run.ayss) == 0:
-        return None
-    return run.ayss.h, run.ayss.indicator
+def has_ayss(run: RunRecord) -> bool:
+    """Whether a run has AYSS samples: ``ayss.csv``, else ``ayss_bins.csv``."""
+    read = run.ayss if run.ayss is not None else run.ayss_bins
+    return read is not None and len(read) > 0
+
+
+def _vut_bins(
+    runs: Sequence[RunRecord], edges: NDArray[np.float64], level: float
+) -> tuple[SeedBands, BinnedStats]:
+    """The between-seed bands and the pooled per-bin stats of one VUT's runs: from the
+    samples, or from every run's per-cell moments when one has only ``ayss_bins.csv``."""
+    samples = [r.ayss for r in runs if r.ayss is not None and len(r.ayss) > 0]
+    if len(samples) == len(runs):
+        bands = binned_seed_means([(a.h, a.indicator) for a in samples], edges, level, 2)
+        h = np.concatenate([a.h for a in samples])
+        y = np.concatenate([a.indicator for a in samples])
+        return bands, binned_mean_ci(h, y, edges, level=level, min_count=2)
+    cells = [c for r in runs if (c := r.ayss_cells) is not None]
+    per_seed = [binned_stats_from_cells([c], edges, level, 2) for c in cells]
+    return seed_bands(per_seed, edges, level), binned_stats_from_cells(cells, edges, level, 2)
 
 
 def band_kind(bands: SeedBands) -> str:
@@ -301,12 +325,11 @@ def indicator_figure(
         n_vut = max(1, len(runs_by_vut))
         for v, (vut, members) in enumerate(runs_by_vut.items()):
             color = colors[vut]
-            with_data = [(r, a) for r, a in ((r, _seed_arrays(r)) for r in members) if a]
-            in_range += [(vut, f"{r.label}\n(none)", 0) for r in members if _seed_arrays(r) is None]
+            with_data = [r for r in members if has_ayss(r)]
+            in_range += [(vut, f"{r.label}\n(none)", 0) for r in members if not has_ayss(r)]
             if not with_data:
                 continue
-            arrays = [a for _, a in with_data]
-            bands = binned_seed_means(arrays, edges, level=level, min_count=2)
+            bands, pooled = _vut_bins(with_data, edges, level)
             kinds.add(band_kind(bands))
             _band(
                 ax_seeds,
@@ -315,9 +338,9 @@ def indicator_figure(
                 bands.lo,
                 bands.hi,
                 color,
-                f"{vut} (mean of {len(arrays)} seeds)",
+                f"{vut} (mean of {len(with_data)} seeds)",
             )
-            for pos, ((run, _), stats) in enumerate(zip(with_data, bands.per_seed, strict=True)):
+            for pos, (run, stats) in enumerate(zip(with_data, bands.per_seed, strict=True)):
                 ls, marker = seed_style(pos)
                 ax_seeds.plot(
                     centers,
@@ -331,9 +354,6 @@ def indicator_figure(
                     label=run.label,
                 )
                 in_range.append((vut, run.label, int(stats.counts.sum())))
-            h = np.concatenate([a[0] for a in arrays])
-            y = np.concatenate([a[1] for a in arrays])
-            pooled = binned_mean_ci(h, y, edges, level=level, min_count=2)
             n_in = int(pooled.counts.sum())
             _band(
                 ax_pool, centers, pooled.means, pooled.lo, pooled.hi, color, f"{vut} (n = {n_in})"

@@ -27,7 +27,7 @@ from sumo_ayss.report.blocks import (
 
 __all__ = ["RENDERER_VERSION", "render_html", "render_markdown", "renderer_stamp"]
 
-RENDERER_VERSION = 3
+RENDERER_VERSION = 4
 """The report's renderer version. Bump it whenever what a report says or shows changes (a
 statistic, a table, a sentence), then regenerate the committed reports
 (``scripts/regenerate_reports.sh``): a test fails while a committed ``summary.md`` carries

@@ -22,6 +22,12 @@ file                    writer / reader              what
 ``outcome.json``        write_/read_outcome_json     rates and means with 95 % intervals
 ``ayss.csv``            write_/read_table            one row per kept AYSS sample
                         (:data:`AYSS_SCHEMA`)
+``ayss_bins.csv``       write_/read_ayss_bins        the AYSS samples as moments (n, mean,
+                        (:data:`AYSS_BINS_SCHEMA`)   m2) per 1/32 m headway cell: small,
+                                                     committed where ``ayss.csv`` is not;
+                                                     the AYSS figures, table and paper mode
+                                                     read it when ``ayss.csv`` is absent
+                                                     (:mod:`.ayss_bins`)
 ``ayss.json``           write_/read_ayss_json        filter counts, settings, throughput
 ``evaluate.done.json``  write_/read_done_marker      the pipeline's evaluation marker
 ``job.log``             (logging)                    the pipeline job's log
@@ -69,6 +75,13 @@ from sumo_ayss.run_folder.adaptive import (
     read_adaptive,
     write_adaptive,
 )
+from sumo_ayss.run_folder.ayss_bins import (
+    AyssCells,
+    ayss_cells,
+    backfill_ayss_bins,
+    read_ayss_bins,
+    write_ayss_bins,
+)
 from sumo_ayss.run_folder.crossplay import (
     CrossplayOpponent,
     CrossplayRecord,
@@ -111,6 +124,7 @@ from sumo_ayss.run_folder.record import (
     read_run,
 )
 from sumo_ayss.run_folder.schemas import (
+    AYSS_BINS_SCHEMA,
     AYSS_SCHEMA,
     CROSSPLAY_SCHEMA,
     OUTCOME_SCHEMA,
@@ -147,12 +161,14 @@ from sumo_ayss.run_folder.table import (
 )
 
 __all__ = [
+    "AYSS_BINS_SCHEMA",
     "AYSS_SCHEMA",
     "CROSSPLAY_SCHEMA",
     "EVAL_SCHEMA",
     "OUTCOME_SCHEMA",
     "AdaptiveLook",
     "AdaptiveRecord",
+    "AyssCells",
     "CaseFolder",
     "CellStore",
     "CrossplayOpponent",
@@ -169,12 +185,15 @@ __all__ = [
     "StageHeader",
     "StudyFolder",
     "Table",
+    "ayss_cells",
+    "backfill_ayss_bins",
     "case_of",
     "case_runs",
     "find_run_dirs",
     "group_runs",
     "load_runs",
     "read_adaptive",
+    "read_ayss_bins",
     "read_ayss_json",
     "read_crossplay_json",
     "read_discriminability_json",
@@ -189,6 +208,7 @@ __all__ = [
     "stored_experiment",
     "table_from_rows",
     "write_adaptive",
+    "write_ayss_bins",
     "write_ayss_json",
     "write_crossplay_json",
     "write_discriminability",

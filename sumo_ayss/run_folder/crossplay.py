@@ -10,7 +10,7 @@ It lies in the case folder ``<out>/<case>/`` (:class:`~.layout.CaseFolder`), bes
      "diagonal": [{"vut": "pi1", "seed": 0, "n": 200, "n_equal": 200}, ...],
      "vut_keys": {"pi1": "3f0c...", "pi2": "a91b..."}}
 
-``n`` and ``seed`` are the scenario set (:func:`~sumo_ayss.envs.odd.sample_initial_conditions`)
+``n`` and ``seed`` are the scenario set (:func:`~sumo_ayss.envs.odd.scenario_set`)
 and, with the opponents and ``rollout``, what a rerun compares before skipping the case.
 ``rollout`` names how the episodes were driven: ``"outcome"`` (the outcome stage's single
 env, :mod:`sumo_ayss.scenarios.crossplay`) or ``"pairs"`` (many pairs in one simulation,

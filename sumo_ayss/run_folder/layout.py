@@ -19,6 +19,7 @@ from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
     "ADAPTIVE_JSON",
+    "AYSS_BINS_CSV",
     "AYSS_CSV",
     "AYSS_JSON",
     "CHECKPOINTS_DIR",
@@ -81,6 +82,9 @@ OUTCOME_JSON = "outcome.json"
 """Outcome summary: rates and means with 95 % intervals (:mod:`.summaries`)."""
 AYSS_CSV = "ayss.csv"
 """One row per kept AYSS sample (:data:`~sumo_ayss.run_folder.schemas.AYSS_SCHEMA`)."""
+AYSS_BINS_CSV = "ayss_bins.csv"
+"""The AYSS samples as moments per headway cell, committed where ``ayss.csv`` is not
+(:mod:`~sumo_ayss.run_folder.ayss_bins`)."""
 AYSS_JSON = "ayss.json"
 """AYSS summary: filter counts, throughput, Monte Carlo settings, mean indicator."""
 EVALUATE_DONE_JSON = "evaluate.done.json"
@@ -169,6 +173,7 @@ class RunFolder:
     outcome_csv = FolderFile(OUTCOME_CSV)
     outcome_json = FolderFile(OUTCOME_JSON)
     ayss_csv = FolderFile(AYSS_CSV)
+    ayss_bins = FolderFile(AYSS_BINS_CSV)
     ayss_json = FolderFile(AYSS_JSON)
     evaluate_done = FolderFile(EVALUATE_DONE_JSON)
     job_log = FolderFile(JOB_LOG)

@@ -33,6 +33,7 @@ from sumo_ayss.cases import case_of_indicator
 from sumo_ayss.config import ExperimentConfig, RewardConfig, build, experiment_from_dict
 from sumo_ayss.config.env import decisions_of
 from sumo_ayss.config.identity import config_key
+from sumo_ayss.run_folder.ayss_bins import AyssCells, ayss_cells, read_ayss_bins
 from sumo_ayss.run_folder.eval_table import EVAL_SCHEMA
 from sumo_ayss.run_folder.layout import AYSS_CSV, CONFIG_YAML, EVAL_CSV, RunFolder, seed_of_dir
 from sumo_ayss.run_folder.metadata import RunConfig, SpcpChoice, read_run_config, read_spcp
@@ -122,6 +123,9 @@ class RunRecord:
         outcome_record: The outcome summary with its settings (``outcome.json``), or None.
         outcome_table: The outcome episodes (``outcome.csv``), or None.
         ayss: The AYSS samples (``ayss.csv``), or None.
+        ayss_bins: The samples' per-cell moments (``ayss_bins.csv``), or None; read by the
+            AYSS figures, table and paper mode where ``ayss.csv`` is absent
+            (:attr:`ayss_cells`).
         versions: Package versions the run used (``versions.json``), or empty.
         training: Training budget and SPCP state (from ``config.yaml``, ``eval.csv`` and
             ``spcp.json``; :func:`sumo_ayss.training.trust.training_of`).
@@ -142,6 +146,7 @@ class RunRecord:
     outcome_record: OutcomeRecord | None = None
     outcome_table: Table | None = None
     ayss: AyssSamples | None = None
+    ayss_bins: AyssCells | None = None
     versions: Mapping[str, str] = field(default_factory=dict)
     training: Training = field(default_factory=Training)
     problems: tuple[str, ...] = ()
@@ -155,6 +160,14 @@ class RunRecord:
     def outcome(self) -> Outcome | None:
         """The outcome summary (``outcome.json``), or None."""
         return self.outcome_record.outcome if self.outcome_record is not None else None
+
+    @cached_property
+    def ayss_cells(self) -> AyssCells | None:
+        """The AYSS samples as per-cell moments: of ``ayss.csv`` when it was read, else
+        ``ayss_bins.csv``; None (or empty) without either."""
+        if self.ayss is not None:
+            return ayss_cells(self.ayss.h, self.ayss.indicator, self.ayss.indicator_name)
+        return self.ayss_bins
 
     @property
     def label(self) -> str:
@@ -325,7 +338,8 @@ def read_run(path: str | Path) -> RunRecord:
     table = r.attempt(
         folder.outcome_csv, lambda p: read_table(p, OUTCOME_SCHEMA), needed=decisions is not None
     )
-    ayss = r.attempt(folder.ayss_csv, _ayss_samples)
+    ayss_bins = r.attempt(folder.ayss_bins, read_ayss_bins, needed=False)  # optional
+    ayss = r.attempt(folder.ayss_csv, _ayss_samples, needed=ayss_bins is None)
     versions = r.attempt(folder.versions, _read_versions, needed=False)  # optional
     if curve is not None and len(curve) == 0 and not n_dropped:
         r.problems.append(f"{EVAL_CSV}: no rows (header only), so no learning curve")
@@ -333,13 +347,12 @@ def read_run(path: str | Path) -> RunRecord:
         r.problems.append(same)
     if ayss is not None and len(ayss) == 0:
         r.problems.append(f"{AYSS_CSV}: no rows (header only), so no AYSS sample")
-    if ayss is not None and ayss.indicator_name is not None:
-        expected_case = case_of_indicator(ayss.indicator_name)
+    labels = [(AYSS_CSV, ayss.indicator_name if ayss is not None else None)]
+    labels.append((folder.ayss_bins.name, ayss_bins.indicator_name if ayss_bins else None))
+    for name, label in labels:
+        expected_case = case_of_indicator(label) if label else None
         if expected_case is not None and expected_case != case:
-            r.problems.append(
-                f"{AYSS_CSV}: indicator {ayss.indicator_name!r} belongs to {expected_case}, "
-                f"not {case}"
-            )
+            r.problems.append(f"{name}: indicator {label!r} belongs to {expected_case}, not {case}")
     return RunRecord(
         folder=folder,
         case=case,
@@ -354,6 +367,7 @@ def read_run(path: str | Path) -> RunRecord:
         outcome_record=outcome_record,
         outcome_table=table,
         ayss=ayss,
+        ayss_bins=ayss_bins,
         versions=versions or {},
         training=training_of(
             None if config is None else config.experiment.get("train") or {},

@@ -7,6 +7,8 @@ case folder's ``crossplay.csv``.
 * :data:`AYSS_SCHEMA` — ``<run>/ayss.csv``, one row per kept adversarial-yet-safe sample of
   the Monte Carlo stage (paper Fig. 4 and 6): the sampled observation, the SPCP's action,
   TTC and the aggressiveness indicator.
+* :data:`AYSS_BINS_SCHEMA` — ``<run>/ayss_bins.csv``, the same samples as per-headway-cell
+  moments (:mod:`~sumo_ayss.run_folder.ayss_bins`), small enough to commit.
 * :data:`CROSSPLAY_SCHEMA` — ``<out>/<case>/crossplay.csv``, one row per (VUT, opponent
   SPCP, scenario) of the cross-play stage (:mod:`sumo_ayss.crossplay`).
 
@@ -21,6 +23,7 @@ from sumo_ayss.run_folder.measure_columns import EPISODE_HAZARD_COLUMNS, EPISODE
 from sumo_ayss.run_folder.table import Column, TableSchema
 
 __all__ = [
+    "AYSS_BINS_SCHEMA",
     "AYSS_SCHEMA",
     "CROSSPLAY_SCHEMA",
     "OUTCOME_SCHEMA",
@@ -161,6 +164,38 @@ AYSS_SCHEMA = TableSchema(
             "cut-in: Δv̄ at the sampled state, before the action acts (no lateral speed); "
             "NaN in car-following",
             nullable=True,
+        ),
+    ),
+)
+
+
+#: ``<run>/ayss_bins.csv``: the AYSS samples as moments per headway cell (1/32 m open
+#: intervals and their edge points), :mod:`sumo_ayss.run_folder.ayss_bins`.
+AYSS_BINS_SCHEMA = TableSchema(
+    "ayss_bins",
+    (
+        Column("h_low_m", "float", "m", "lower end of the headway cell"),
+        Column(
+            "h_high_m",
+            "float",
+            "m",
+            "upper end: h_low_m + 1/32 for the open interval between them, h_low_m for the "
+            "edge point itself",
+        ),
+        Column("n", "int", "-", "AYSS samples in the cell"),
+        Column("mean", "float", "m/s² or m/s", "mean indicator of the cell's samples"),
+        Column(
+            "m2",
+            "float",
+            "(m/s²)² or (m/s)²",
+            "sum of squared deviations of the cell's indicator from its mean",
+        ),
+        Column(
+            "indicator_name",
+            "str",
+            "-",
+            "pov_accel_mps2 (car-following) or delta_v_bar_mps (cut-in)",
+            choices=indicator_columns,
         ),
     ),
 )

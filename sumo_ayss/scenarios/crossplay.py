@@ -42,7 +42,7 @@ import numpy as np
 from sumo_ayss.analysis.hazards import HAZARD_NAMES
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.config import EnvConfig
-from sumo_ayss.envs.odd import sample_initial_conditions, with_followers
+from sumo_ayss.envs.odd import scenario_set, with_followers
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, DiagonalCheck, Table, table_from_rows
 from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
@@ -124,7 +124,7 @@ def run_crossplay(
         envs: VUT name -> its env config (identical but for the VUT).
         opponents: The SPCP pool.
         n: Scenarios per (VUT, opponent), >= 1.
-        seed: Seed of :func:`~sumo_ayss.envs.odd.sample_initial_conditions` (the outcome
+        seed: Seed of :func:`~sumo_ayss.envs.odd.scenario_set` (the outcome
             stage's).
         progress: Called with one line per (VUT, opponent) done.
         reference: The reference driver that replays each crash to label it preventable
@@ -148,7 +148,7 @@ def run_crossplay(
     # SUMO): its greedy policy depends on the spaces only, the same for every VUT of the pool.
     policies: dict[int, Policy] = {}
     for vut, cfg in envs.items():
-        scenarios = with_followers(sample_initial_conditions(cfg.odd, n, seed), cfg.follower, seed)
+        scenarios = with_followers(scenario_set(cfg, n, seed), cfg.follower, seed)
         for k, opp in enumerate(opponents):
             key = (vut, repr(cfg), opp.vut, opp.seed, opp.identity, n, seed, reference)
             kept = cells.load(key) if cells is not None and opp.identity else None

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from sumo_ayss.analysis.stats import wilson_interval
 from sumo_ayss.cases import get_case
 from sumo_ayss.config import EnvConfig
-from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions
+from sumo_ayss.envs.odd import InitialCondition, scenario_set
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.vuts.catalog import ControllerSpec, VehicleType
 
@@ -127,7 +127,7 @@ def ics_flags(
 
 def ics_share(config: EnvConfig, n: int, seed: int, *, sumo_seed: int = 0) -> IcsShare:
     """The ICS share of ``n`` draws of ``config``'s ODD (seed ``seed``)."""
-    flags = ics_flags(config, sample_initial_conditions(config.odd, n, seed), sumo_seed=sumo_seed)
+    flags = ics_flags(config, scenario_set(config, n, seed), sumo_seed=sumo_seed)
     hits = sum(flags)
     lo, hi = wilson_interval(hits, n)
     return IcsShare(config.case, n, int(hits), lo, hi, tuple(pov_strategies(config.case)))

@@ -1,7 +1,7 @@
 """Overall safety outcome of an SPCP (paper Tables II and III), with confidence intervals.
 
 :func:`run_outcome` rolls a policy greedily over ``n`` initial conditions drawn from the
-env's ODD by :func:`~sumo_ayss.envs.odd.sample_initial_conditions` with a fixed seed, so
+env's ODD by :func:`~sumo_ayss.envs.odd.scenario_set` with a fixed seed, so
 every SPCP (every VUT, every training seed) meets the *same* scenarios (paper: 200). The
 default seed :data:`DEFAULT_OUTCOME_SEED` differs from the training's candidate-evaluation
 seed (``train.eval_seed``, 2024), so an SPCP is not scored on the scenarios it was selected
@@ -34,7 +34,7 @@ from tqdm import tqdm
 
 from sumo_ayss.analysis.stats import mean_ci, wilson_interval
 from sumo_ayss.cases import get_case
-from sumo_ayss.envs.odd import InitialCondition, sample_initial_conditions, with_followers
+from sumo_ayss.envs.odd import InitialCondition, scenario_set, with_followers
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.run_folder import OUTCOME_SCHEMA, Table
 from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, measure_columns, run_episode
@@ -243,7 +243,7 @@ def run_outcome(
             Its RNG is not consumed.
         policy: ``obs (N, d) float32 -> actions (N,)``; called with ``N = 1`` per step.
         n: Number of scenarios (episodes), >= 1.
-        seed: Seed of :func:`sample_initial_conditions`; keep it fixed across SPCPs.
+        seed: Seed of :func:`scenario_set`; keep it fixed across SPCPs.
         level: Confidence level of the summary's intervals.
         progress: Show a tqdm progress bar over the episodes.
 
@@ -255,7 +255,7 @@ def run_outcome(
     base = env.unwrapped
     assert isinstance(base, PairEnv)
     cfg = base.config
-    scenarios = with_followers(sample_initial_conditions(cfg.odd, n, seed), cfg.follower, seed)
+    scenarios = with_followers(scenario_set(cfg, n, seed), cfg.follower, seed)
     t0 = time.perf_counter()
     bar = tqdm(scenarios, desc="outcome", unit="ep", disable=not progress, leave=False)
     episodes = [run_episode(base, policy, ic) for ic in bar]
@@ -268,7 +268,8 @@ def run_outcome(
 def supporting_pov_summary(episodes: Sequence[EpisodeResult]) -> dict[str, Any] | None:
     """``outcome.json``'s ``supporting_pov`` section of a case with a second POV
     (``lead_and_cut_in``), else None: the share of episodes the POVs ended by a forbidden
-    contact, and per safety measure against the supporting POV its median and smallest
+    contact (and of them by kind: the supporting POV touched the VUT, the two POVs touched),
+    and per safety measure against the supporting POV its median and smallest
     value over the episodes (finite values only; None where there is none)."""
     support = [e.support_measures for e in episodes if e.support_measures is not None]
     if not support:
@@ -286,5 +287,7 @@ def supporting_pov_summary(episodes: Sequence[EpisodeResult]) -> dict[str, Any] 
     return {
         "n": len(episodes),
         "pov_failure_rate": float(np.mean([e.pov_failure for e in episodes])),
+        "support_vut_rate": float(np.mean([e.support_vut_contact for e in episodes])),
+        "pov_pov_rate": float(np.mean([e.pov_pov_contact for e in episodes])),
         "measures": measures,
     }

@@ -50,6 +50,8 @@ class EpisodeResult:
             (``lead_and_cut_in``); ``None`` in a case with one POV or where not recorded.
         pov_failure: The episode ended by a contact the POVs were not allowed (a supporting
             POV touching the VUT, or two POVs touching); always False with one POV.
+        support_vut_contact: Of those, the supporting POV touched the VUT.
+        pov_pov_contact: Of those, the two POVs touched (both kinds in one step: both true).
     """
 
     episode_return: float
@@ -65,6 +67,8 @@ class EpisodeResult:
     hazards: HazardMeasures | None = field(default=None, compare=False)
     support_measures: EpisodeMeasures | None = field(default=None, compare=False)
     pov_failure: bool = field(default=False, compare=False)
+    support_vut_contact: bool = field(default=False, compare=False)
+    pov_pov_contact: bool = field(default=False, compare=False)
 
     def measure_row(self) -> dict[str, float]:
         """The measures as table columns (NaN throughout when not recorded)."""
@@ -126,6 +130,8 @@ def run_episode(env: PairEnv, policy: Policy, ic: InitialCondition) -> EpisodeRe
         hazards=hazards,
         support_measures=support_measures_of(base.config, reset_info, infos),
         pov_failure=bool(infos[-1].get("pov_failure", False)),
+        support_vut_contact=bool(infos[-1].get("support_vut_contact", False)),
+        pov_pov_contact=bool(infos[-1].get("pov_pov_contact", False)),
     )
 
 

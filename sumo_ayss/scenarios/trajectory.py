@@ -117,7 +117,9 @@ def hazards_of(
     """The hazards the VUT caused in one episode
     (:func:`~sumo_ayss.analysis.hazards.episode_hazards`)."""
     tr = trajectory_from_infos(config, reset_info, infos)
-    return episode_hazards(tr, follower_of(reset_info, infos))
+    support = support_trajectory(config, reset_info, infos)
+    others = () if support is None else (support,)
+    return episode_hazards(tr, follower_of(reset_info, infos), others)
 
 
 class SecondPovTrack(NamedTuple):
@@ -148,12 +150,21 @@ def support_measures_of(
 ) -> EpisodeMeasures | None:
     """The safety measures of the VUT against the supporting POV (the case's second POV,
     in the POV's body), or None in a case with one POV: the measures per POV (issue 39)."""
+    tr = support_trajectory(config, reset_info, infos)
+    return None if tr is None else episode_measures(tr)
+
+
+def support_trajectory(
+    config: EnvConfig, reset_info: Mapping[str, Any], infos: Sequence[Mapping[str, Any]]
+) -> PairTrajectory | None:
+    """The episode as a pair of the VUT and the supporting POV (in the POV's fields), or
+    None in a case with one POV."""
     track = second_pov_of(reset_info, infos)
     if track is None:
         return None
     samples = [reset_info, *infos]
     lateral = np.array([float(s.get("support_lateral_speed_mps", 0.0)) for s in samples])
-    tr = dataclasses.replace(
+    return dataclasses.replace(
         trajectory_from_infos(config, reset_info, infos),
         pov_x_m=track.x_m,
         pov_y_m=track.y_m,
@@ -161,4 +172,3 @@ def support_measures_of(
         pov_lat_speed_mps=lateral,
         collided=bool(infos[-1].get("support_vut_contact", False)) if infos else False,
     )
-    return episode_measures(tr)

@@ -161,7 +161,7 @@ class EvaluateStage:
     @property
     def outputs(self) -> tuple[Path, ...]:
         f = self.folder
-        return (f.outcome_csv, f.outcome_json, f.ayss_csv, f.ayss_json)
+        return (f.outcome_csv, f.outcome_json, f.ayss_csv, f.ayss_bins, f.ayss_json)
 
     def key(self) -> str:
         """Raises :class:`OSError` without ``spcp.zip``."""
@@ -236,7 +236,7 @@ class AyssStage(_SettingsStage):
 
     @property
     def outputs(self) -> tuple[Path, ...]:
-        return (self.folder.ayss_csv, self.folder.ayss_json)
+        return (self.folder.ayss_csv, self.folder.ayss_bins, self.folder.ayss_json)
 
     def settings(self) -> Any:
         """The settings asked for now, as stored."""

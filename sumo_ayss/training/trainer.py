@@ -58,7 +58,7 @@ from sumo_ayss.config import (
     check_out_dir,
     check_seed,
 )
-from sumo_ayss.envs.odd import sample_initial_conditions
+from sumo_ayss.envs.odd import scenario_set
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.envs.vec_env import PairVecEnv
 from sumo_ayss.run_folder import EVAL_SCHEMA, RunFolder, StudyFolder, write_eval_table, write_spcp
@@ -115,9 +115,7 @@ class Trainer:
         self.folder = RunFolder(run_dir)
         self.ckpt_dir = self.folder.checkpoints
         self.eval_path = self.folder.eval_table
-        self.scenarios = sample_initial_conditions(
-            cfg.env.odd, cfg.train.n_eval_scenarios, cfg.train.eval_seed
-        )
+        self.scenarios = scenario_set(cfg.env, cfg.train.n_eval_scenarios, cfg.train.eval_seed)
         self.rows: list[dict[str, Any]] = []
         self.next_eval = cfg.train.eval_every
         self.n_envs = cfg.train.n_envs

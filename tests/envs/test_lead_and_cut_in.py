@@ -193,6 +193,7 @@ def test_supporting_pov_touching_the_vut_is_the_povs_failure(
     env = make()
     rewards, info = run(env, start, encode_action(HOLD, CUT_LANE_CHANGE))
     assert info["pov_failure"] and info["vut_contact"] and not info["collision"]
+    assert info["support_vut_contact"] and not info["pov_pov_contact"]
     assert rewards[-1] == -ALPHA_C and info["reward_adversarial"] == 0.0
     assert env.replays == 0 and "crash_unpreventable" not in info
 
@@ -207,6 +208,7 @@ def test_pov_pov_contact_is_the_povs_failure_with_both_safe_terms(
     env = make()
     rewards, info = run(env, start, encode_action(HOLD, CUT_LANE_CHANGE))
     assert info["pov_failure"] and not info["collision"] and not info["vut_contact"]
+    assert info["pov_pov_contact"] and not info["support_vut_contact"]
     assert rewards[-1] == -2 * ALPHA_C
 
 
@@ -248,6 +250,7 @@ def test_safety_measures_are_read_per_pov(make: Callable[..., LeadAndCutInEnv]) 
     action = encode_action(HOLD, CUT_LANE_CHANGE)
     episode = run_episode(make(), lambda obs: np.full(len(obs), action), start)
     assert episode.pov_failure and not episode.collided
+    assert episode.support_vut_contact and not episode.pov_pov_contact
     assert episode.support_measures is not None and episode.measures is not None
     assert episode.support_measures.min_ttc_s == 0.0
     assert episode.measures.min_ttc_s > 1.0
@@ -270,3 +273,67 @@ def test_inevitable_collision_states_use_the_cases_own_worst_plays() -> None:
         20.0, 20.0, 40.0, support_speed_mps=20.0, support_gap_m=60.0, primary=PRIMARY_LEAD
     )
     assert ics_flags(config(), [near, far]) == [True, False]
+
+
+def test_braking_for_the_supporting_pov_is_not_unjustified(
+    make: Callable[..., LeadAndCutInEnv],
+) -> None:
+    """The supporting lead 8 m ahead brakes hard, the cut-in primary holds its lane 60 m
+    ahead: the VUT's hard braking answers the supporting POV, so it is justified; read
+    against the primary alone (session 10's reading) it would count as unjustified."""
+    from sumo_ayss.analysis.hazards import episode_hazards
+    from sumo_ayss.scenarios.trajectory import trajectory_from_infos
+
+    start = TwoPovStart(
+        20.0, 20.0, 60.0, support_speed_mps=20.0, support_gap_m=8.0, primary=PRIMARY_CUT_IN
+    )
+    env = make()
+    action = encode_action(BRAKE, 1 + HOLD)
+    episode = run_episode(env, lambda obs: np.full(len(obs), action), start)
+    assert episode.hazards is not None and not episode.collided and not episode.pov_failure
+    assert episode.hazards.unjustified_braking == 0.0
+    # The same episode against the primary only: the braking reads as for nothing.
+    _, reset_info = env.reset(options={"initial_condition": start})
+    infos = []
+    while True:
+        *_, term, trunc, info = env.step(action)
+        infos.append(info)
+        if term or trunc:
+            break
+    primary_only = episode_hazards(trajectory_from_infos(env.config, reset_info, infos), None)
+    assert primary_only.unjustified_braking == 1.0
+
+
+@pytest.mark.parametrize("penalty", [0.0, 2.0])
+def test_a_forbidden_contact_costs_the_failure_penalty(penalty: float) -> None:
+    """``env.reward.pov_failure_penalty`` (α_F, in α_C): the supporting POV's cut-in into
+    the VUT pays ``-(1 + α_F)·α_C``; the default 0 is session 10's reward."""
+    from sumo_ayss.config import RewardConfig
+
+    cfg = dataclasses.replace(config(), reward=RewardConfig(pov_failure_penalty=penalty))
+    start = TwoPovStart(
+        25.0, 25.0, 40.0, support_speed_mps=12.0, support_gap_m=0.5, primary=PRIMARY_LEAD
+    )
+    env = make_env(cfg, sumo_seed=7)
+    try:
+        assert isinstance(env, LeadAndCutInEnv)
+        rewards, info = run(env, start, encode_action(HOLD, CUT_LANE_CHANGE))
+    finally:
+        env.close()
+    assert info["pov_failure"] and info["support_vut_contact"]
+    assert rewards[-1] == pytest.approx(-(1.0 + penalty) * ALPHA_C)
+
+
+def test_the_failure_penalty_is_refused_with_one_pov_and_stored_only_when_set() -> None:
+    from sumo_ayss.config import RewardConfig
+    from sumo_ayss.config.mapping import to_dict
+
+    with pytest.raises(ConfigError, match="pov_failure_penalty"):
+        EnvConfig(case="cut_in", reward=RewardConfig(pov_failure_penalty=1.0))
+    with pytest.raises(ConfigError, match=">= 0"):
+        RewardConfig(pov_failure_penalty=-1.0)
+    assert "pov_failure_penalty" not in to_dict(EnvConfig())["reward"]
+    assert "pov_failure_penalty" not in repr(EnvConfig())
+    set_ = EnvConfig(case="lead_and_cut_in", reward=RewardConfig(pov_failure_penalty=2.0))
+    assert to_dict(set_)["reward"]["pov_failure_penalty"] == 2.0
+    assert "pov_failure_penalty=2.0" in repr(set_)

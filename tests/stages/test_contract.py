@@ -140,6 +140,8 @@ def test_outcome_and_ayss_stages_compare_the_settings_their_json_records(tmp_pat
     ayss = AyssConfig(n_samples=50, seed=3)
     write_ayss_json(folder.ayss_json, header, ayss.to_dict(), {"indicator_name": "x", "counts": {}})
     folder.ayss_csv.write_text("x")
+    assert not is_done(AyssStage(folder, ayss))  # ayss_bins.csv is an output too
+    folder.ayss_bins.write_text("x")
     assert is_done(AyssStage(folder, ayss))
     assert not is_done(AyssStage(folder, dataclasses.replace(ayss, n_samples=60)))
     folder.ayss_json.write_text("[]")

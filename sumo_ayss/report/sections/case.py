@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sumo_ayss.analysis.ayss_cells import inside_moments
 from sumo_ayss.analysis.case import CaseAnalysis
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.modes import get_mode, headline_text, registered_modes
@@ -165,15 +166,23 @@ def indicator_blocks(
     rows = []
     for vut, members in a.runs.items():
         for run in members:
-            if run.ayss is None:
+            if run.ayss is None and run.ayss_bins is None:
                 rows.append((vut, str(run.seed), "missing", "—", "—"))
                 continue
-            h, y = run.ayss.h, run.ayss.indicator
-            inside = (h >= 0) & (h <= options.h_max_m)
-            mean = float(np.mean(y[inside])) if inside.any() else math.nan
-            rows.append(
-                (vut, str(run.seed), str(len(run.ayss)), str(int(inside.sum())), fmt_num(mean))
-            )
+            if run.ayss is not None:
+                h, y = run.ayss.h, run.ayss.indicator
+                inside = (h >= 0) & (h <= options.h_max_m)
+                n_in, mean = (
+                    int(inside.sum()),
+                    float(np.mean(y[inside])) if inside.any() else math.nan,
+                )
+                n_all = len(run.ayss)
+            else:  # ayss_bins.csv only (ayss.csv is not committed)
+                cells = run.ayss_bins
+                assert cells is not None
+                n_in, mean = inside_moments(cells, 0.0, options.h_max_m)
+                n_all = len(cells)
+            rows.append((vut, str(run.seed), str(n_all), str(n_in), fmt_num(mean)))
     table = Table(
         "AYSS samples per SPCP",
         ("VUT", "seed", "samples", f"with h ≤ {options.h_max_m:g} m", f"mean {info.symbol}"),

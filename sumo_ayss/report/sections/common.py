@@ -46,7 +46,9 @@ def fmt_est(e: Estimate | None, digits: int = 2, scale: float = 1.0, unit: str =
 
 def seed_points_text(members: Sequence[RunRecord], idx: SafetyIndex) -> str:
     """Per-seed indices, labelled by seed when every seed with samples entered the index."""
-    seeds = [r.seed for r in members if r.ayss is not None and len(r.ayss) > 0]
+    seeds = [
+        r.seed for r in members if len(r.ayss if r.ayss is not None else r.ayss_bins or ()) > 0
+    ]
     if len(seeds) != len(idx.seed_points):
         return ", ".join(fmt_num(p) for p in idx.seed_points)
     return ", ".join(f"s{s}: {fmt_num(p)}" for s, p in zip(seeds, idx.seed_points, strict=True))

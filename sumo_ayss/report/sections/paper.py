@@ -58,6 +58,16 @@ def paper_blocks(
     result = paper_result(a)
     if not result.indices:
         return [*blocks, Paragraph("No safety index: no AYSS samples in this case yet.")]
+    if any(i.indicator_moments is not None for i in result.indices.values()):
+        blocks.append(
+            Paragraph(
+                "Read from each run's ayss_bins.csv (the samples' moments per 1/32 m headway "
+                "cell; ayss.csv is not kept): the indices, per-seed indices and sample counts "
+                "are the samples' own; the interval resamples the seeds and each bin's count "
+                "as the samples' bootstrap does, but draws each resampled bin sum from the "
+                "bin's mean and variance rather than from its samples."
+            )
+        )
     path = figures.safety_index_figure(
         result.indices,
         colors,
