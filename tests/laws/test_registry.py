@@ -68,7 +68,9 @@ def test_the_target_committed_run_folders_store_still_resolves() -> None:
     stored = "sumo_ayss.hwenv_laws:HighwayEnvIDM"
     assert HIGHWAY_ENV_IDM_TARGET == "highway_env_idm"
     root = Path(__file__).resolve().parents[2]
-    assert stored in (root / "results/paper/cut_in/pi1/seed_0/config.yaml").read_text()
+    # e.g. results/follower_ladders/reaction (results/paper was re-run in session 11 and
+    # stores the registered name)
+    assert any(stored in p.read_text() for p in (root / "results").glob("**/config.yaml"))
     assert not (root / "sumo_ayss/hwenv_laws.py").exists()
     spec = ControllerSpec(stored, 3.0, 6.0, params={})
     assert spec.target == HIGHWAY_ENV_IDM_TARGET and spec.resolve() is HighwayEnvIDM
