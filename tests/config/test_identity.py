@@ -151,7 +151,7 @@ def test_committed_configs_naming_a_controller_by_module_path_read_as_its_regist
     human075 = load_pipeline(ROOT / "configs/ladders/careful_human.yaml").vuts["human075"]
     studies = [
         (
-            "results/paper_fidelity/car_following/hwenv_pi1/seed_0",
+            "results/fidelity_ablation/clipped_pov/car_following/hwenv_pi1/seed_0",
             "sumo_ayss.hwenv_laws:HighwayEnvIDM",
             BUILTIN_VUTS["hwenv_pi1"],
         ),
