@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.jsonio import json_field, json_number, read_json, write_json
+from sumo_ayss.records.jsonio import json_field, json_number, read_json, write_json
 
 __all__ = [
     "AyssRecord",
