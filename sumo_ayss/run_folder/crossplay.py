@@ -135,26 +135,12 @@ class CrossplayRecord:
 
 
 def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
-    """Write ``crossplay.json``."""
-    write_json(
-        path,
-        {
-            "stage": "crossplay",
-            "case": record.case,
-            "n": record.n,
-            "seed": record.seed,
-            "opponents": [dataclasses.asdict(o) for o in record.opponents],
-            "vuts": list(record.vuts),
-            "wall_s": round(record.wall_s, 3),
-            "rollout": record.rollout,
-            "diagonal": [dataclasses.asdict(d) for d in record.diagonal],
-            **(
-                {"vut_keys": dict(zip(record.vuts, record.vut_keys, strict=True))}
-                if record.vut_keys
-                else {}
-            ),
-        },
-    )
+    """Write ``crossplay.json``: the record's fields (``wall_s`` to the millisecond),
+    ``vut_keys`` as ``{vut: key}`` and left out when empty."""
+    data = {"stage": "crossplay", **dataclasses.asdict(record), "wall_s": round(record.wall_s, 3)}
+    if keys := data.pop("vut_keys"):
+        data["vut_keys"] = dict(zip(record.vuts, keys, strict=True))
+    write_json(path, data)
 
 
 def read_crossplay_json(path: Path) -> CrossplayRecord:

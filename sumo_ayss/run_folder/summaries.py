@@ -26,6 +26,7 @@ Imports neither SUMO nor torch.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -67,14 +68,8 @@ class StageHeader:
     spcp_step: int | None
 
     def as_dict(self, stage: str) -> dict[str, Any]:
-        return {
-            "stage": stage,
-            "run_dir": self.run_dir,
-            "case": self.case,
-            "vut": self.vut,
-            "train_seed": self.train_seed,
-            "spcp_step": self.spcp_step,
-        }
+        """The header's fields and ``stage`` (the file's keys are sorted when written)."""
+        return {"stage": stage, **dataclasses.asdict(self)}
 
 
 @dataclass(frozen=True)
