@@ -352,7 +352,8 @@ def row_bytes(n: int = 20_000) -> dict[str, float]:
     import random
     import tracemalloc
 
-    from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, table_from_rows
+    from sumo_ayss.records.table import table_from_rows
+    from sumo_ayss.run_folder import CROSSPLAY_SCHEMA
 
     names = [c.name for c in CROSSPLAY_SCHEMA.columns]
     tracemalloc.start()

@@ -23,7 +23,8 @@ import numpy as np
 
 from sumo_ayss.agents.weights import load_spcp
 from sumo_ayss.envs import make_env
-from sumo_ayss.run_folder import OUTCOME_SCHEMA, RunRecord, read_run, write_table
+from sumo_ayss.records.table import write_table
+from sumo_ayss.run_folder import OUTCOME_SCHEMA, RunRecord, read_run
 from sumo_ayss.scenarios import rollout
 from sumo_ayss.scenarios.outcome import run_outcome
 

@@ -3,7 +3,7 @@ before the evaluate stage wrote it; the pipeline and evaluate do this too, for t
 
     python scripts/ayss_bins_from_csv.py <study> [<study> ...]
 
-:func:`sumo_ayss.run_folder.backfill_ayss_bins`: the evaluate stage's reduction of the table.
+:func:`sumo_ayss.evaluate.backfill_ayss_bins`: the evaluate stage's reduction of the table.
 Prints each file written.
 """
 
@@ -12,8 +12,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from sumo_ayss.evaluate import backfill_ayss_bins
 from sumo_ayss.run_folder import RunFolder, find_run_dirs
-from sumo_ayss.run_folder.ayss_bins import backfill_ayss_bins
 
 
 def main(studies: list[str]) -> None:

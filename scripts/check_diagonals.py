@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA, read_table
+from sumo_ayss.records.table import read_table
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA
 from sumo_ayss.run_folder.layout import seed_of_dir
 from sumo_ayss.scenarios.crossplay import diagonal_check
 

@@ -26,13 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from sumo_ayss.envs.odd import scenario_set
-from sumo_ayss.run_folder import (
-    CROSSPLAY_SCHEMA,
-    CaseFolder,
-    read_crossplay_json,
-    read_run,
-    read_table,
-)
+from sumo_ayss.records.table import read_table
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, CaseFolder, read_crossplay_json, read_run
 from sumo_ayss.scenarios.inevitable import ics_flags
 from sumo_ayss.util.atomic import atomic_write_text
 

@@ -42,6 +42,7 @@ from sumo_ayss.analysis.crossplay import BLOCKS
 from sumo_ayss.analysis.crossplay_scoring import case_matrix
 from sumo_ayss.cli import prog
 from sumo_ayss.config.identity import vut_key
+from sumo_ayss.records.table import Table, read_table, table_from_rows, write_table
 from sumo_ayss.run_folder import (
     CROSSPLAY_SCHEMA,
     OUTCOME_SCHEMA,
@@ -51,17 +52,13 @@ from sumo_ayss.run_folder import (
     CrossplayRecord,
     RunRecord,
     StudyFolder,
-    Table,
     case_of,
     read_crossplay_json,
     read_inevitable,
     read_outcome_json,
     read_run,
-    read_table,
-    table_from_rows,
     write_crossplay_json,
     write_inevitable,
-    write_table,
 )
 from sumo_ayss.stages import CellPlan, CrossplayStage, is_done, merged_rows, plan_cells
 from sumo_ayss.stages.crossplay_cells import same_scenarios

@@ -30,6 +30,7 @@ import dataclasses
 import logging
 import sys
 import time
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,21 +38,22 @@ from typing import Any
 
 import numpy as np
 
+from sumo_ayss.analysis.ayss_cells import cells_of
 from sumo_ayss.cli import prog
 from sumo_ayss.config import DEFAULT_AYSS_SEED, AyssConfig, to_dict
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.pair_env import PairEnv
 from sumo_ayss.grid.threads import set_torch_threads
+from sumo_ayss.records.table import Table, read_table, write_table
 from sumo_ayss.run_folder import (
+    AYSS_SCHEMA,
     RunRecord,
     StageHeader,
-    ayss_cells,
     read_run,
     write_ayss_json,
     write_outcome_json,
-    write_table,
 )
-from sumo_ayss.run_folder.ayss_bins import backfill_ayss_bins, write_ayss_bins
+from sumo_ayss.run_folder.ayss_bins import AyssCells, write_ayss_bins
 from sumo_ayss.scenarios.ayss import run_ayss
 from sumo_ayss.scenarios.outcome import (
     DEFAULT_OUTCOME_N,
@@ -181,15 +183,35 @@ def _ayss_stage(
     folder = run.folder
     write_table(folder.ayss_csv, result.table)
     table = result.table
-    write_ayss_bins(
-        folder.ayss_bins, ayss_cells(table["h_m"], table["indicator"], result.indicator_name)
-    )
+    _write_cells(folder.ayss_bins, table, result.indicator_name)
     summary = result.summary()
     settings = summary.pop("config")  # the AyssConfig used, compared on a later skip
     write_ayss_json(folder.ayss_json, _header(run), settings, summary)
     logger.info(
         "ayss: kept %d of %d samples in %.1f s", len(result.table), cfg.n_samples, result.wall_s
     )
+
+
+def _write_cells(path: Path, samples: Table, indicator_name: str | None) -> None:
+    """``ayss_bins.csv`` of an ``ayss.csv`` table: its samples as per-cell moments."""
+    c = cells_of(samples["h_m"], samples["indicator"])
+    write_ayss_bins(path, AyssCells(c.h_low_m, c.h_high_m, c.n, c.mean, c.m2, indicator_name))
+
+
+def backfill_ayss_bins(ayss_csv: Path, ayss_bins: Path) -> bool:
+    """Write ``ayss_bins`` from an existing ``ayss_csv`` that has none beside it (a run
+    evaluated before the evaluate stage wrote it): the stage's own reduction, no simulation
+    (``ayss.csv`` stores every float exactly, so the file is the one the stage writes).
+
+    Returns:
+        Whether it wrote the file.
+    """
+    if ayss_bins.is_file() or not ayss_csv.is_file():
+        return False
+    table = read_table(ayss_csv, AYSS_SCHEMA)
+    names = Counter(str(v) for v in table["indicator_name"])
+    _write_cells(ayss_bins, table, names.most_common(1)[0][0] if names else None)
+    return True
 
 
 def evaluate_run(

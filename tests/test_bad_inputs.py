@@ -1083,8 +1083,9 @@ def test_pipeline_warns_on_the_console_and_fails_under_strict(
 
 
 def test_a_garbled_table_or_json_file_is_a_table_error_naming_it(tmp_path: Path) -> None:
-    from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, read_table
-    from sumo_ayss.run_folder.jsonio import read_json
+    from sumo_ayss.records.jsonio import read_json
+    from sumo_ayss.records.table import read_table
+    from sumo_ayss.run_folder import CROSSPLAY_SCHEMA
     from sumo_ayss.util.errors import TableError
 
     path = tmp_path / "crossplay.csv"

@@ -55,6 +55,10 @@ NO_IMPORTS = (
     ("sumo_ayss.analysis", "sumo_ayss.run_folder"),
     ("sumo_ayss.run_folder", "sumo_ayss.analysis"),
 )
+#: What :mod:`sumo_ayss.records` (the generic CSV and JSON record formats) may import from the
+#: package: itself and :mod:`sumo_ayss.util`. It knows no file of a study; the run folder's
+#: names and schemas sit above it (:mod:`sumo_ayss.run_folder`).
+RECORDS_MAY_IMPORT = ("sumo_ayss.records", "sumo_ayss.util")
 #: The stages that import nothing of the report at any level (issue 34: data flows one way,
 #: the report is the end of it): the commands that end in documents sit above both
 #: (:mod:`sumo_ayss.commands`).
@@ -66,7 +70,7 @@ REPORT_FREE = ("sumo_ayss.pipeline", "sumo_ayss.rank", "sumo_ayss.crossplay", "s
 COMMANDS_PACKAGE = "sumo_ayss.commands"
 #: Packages whose ``__init__`` is a docstring: importing one of their modules runs nothing
 #: else of them (checked below), so the package edge itself carries no import.
-PACKAGES_WITHOUT_CODE = frozenset({"sumo_ayss.util"})
+PACKAGES_WITHOUT_CODE = frozenset({"sumo_ayss.util", "sumo_ayss.records"})
 #: Calls that read or write files; none appears in :mod:`sumo_ayss.analysis`.
 FILE_CALLS = frozenset(
     {
@@ -273,6 +277,20 @@ def test_analysis_imports_no_loader_and_reads_no_file() -> None:
                 if called in FILE_CALLS:
                     calls.append(f"{name}:{node.lineno} {called}")
     assert calls == []
+
+
+def test_the_record_formats_know_no_file_of_a_study() -> None:
+    """records/ (the one CSV and the one JSON reader) imports nothing of the package but
+    util/, at any level: a file's name or schema lives in run_folder/, above it."""
+    modules = module_files()
+    assert "sumo_ayss.records.table" in modules
+    top, lazy = import_edges(modules)
+    outside = sorted(
+        (a, b)
+        for a, b in top | lazy
+        if _within(a, ("sumo_ayss.records",)) and not _within(b, RECORDS_MAY_IMPORT)
+    )
+    assert outside == []
 
 
 def test_layers_that_must_not_import_each_other() -> None:

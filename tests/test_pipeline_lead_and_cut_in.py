@@ -16,9 +16,10 @@ from sumo_ayss.commands.pipeline import run_pipeline
 from sumo_ayss.commands.rank import main as rank_main
 from sumo_ayss.config import PROJECT_ROOT
 from sumo_ayss.pipeline import load_pipeline
+from sumo_ayss.records.table import read_table
 from sumo_ayss.replay.record import export_scenario
 from sumo_ayss.replay.xosc import export_xosc
-from sumo_ayss.run_folder import AYSS_SCHEMA, CROSSPLAY_SCHEMA, OUTCOME_SCHEMA, read_table
+from sumo_ayss.run_folder import AYSS_SCHEMA, CROSSPLAY_SCHEMA, OUTCOME_SCHEMA
 from tests.helpers import TINY_AGENT
 
 pytestmark = pytest.mark.sumo

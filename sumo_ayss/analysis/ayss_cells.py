@@ -1,8 +1,10 @@
 """The AYSS statistics from per-headway-cell moments instead of the samples (numpy only).
 
-A run's ``ayss_bins.csv`` (:mod:`sumo_ayss.run_folder.ayss_bins`) holds, per headway cell
-(an open 1/32 m interval or one of its edge points), the count ``n``, the mean and ``m2``
-(sum of squared deviations from the mean) of the indicator. The bins of any grid whose
+:func:`cells_of` reduces a run's samples to cells: per headway cell (an open 1/32 m interval
+or one of its edge points) the count ``n``, the mean and ``m2`` (sum of squared deviations
+from the mean) of the indicator. The evaluate stage stores them as the run's
+``ayss_bins.csv`` (:mod:`sumo_ayss.run_folder.ayss_bins`); :func:`run_cells` gives a run's
+cells, of its samples when they were read, else as stored. The bins of any grid whose
 edges lie on that lattice are unions of cells, so every per-bin count, mean and standard
 deviation, hence :func:`~.stats.binned_mean_ci`, the between-seed bands, the safety index's
 point and per-seed values and Cohen's d, come out of the cells equal to what the samples
@@ -28,6 +30,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -40,14 +43,25 @@ from sumo_ayss.analysis.validate import check_level
 from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
+    "CELL_WIDTH_M",
+    "AyssLike",
+    "Cells",
     "CellsLike",
     "Moments",
     "binned_stats_from_cells",
+    "cells_of",
     "inside_moments",
     "pooled_moments",
     "rebin",
+    "run_cells",
     "safety_index_from_cells",
 ]
+
+CELL_WIDTH_M = 1.0 / 32.0
+"""Width of a headway cell [m]: a binary fraction, so every cell edge is exact, and so are
+the report's grids of 0.25 m and 0.5 m. The lattice ``ayss_bins.csv`` is stored on
+(:data:`sumo_ayss.run_folder.ayss_bins.CELL_WIDTH_M`, checked when read; storage imports no
+analysis, a test keeps the two equal)."""
 
 
 class CellsLike(Protocol):
@@ -67,6 +81,89 @@ class CellsLike(Protocol):
 
     @property
     def m2(self) -> NDArray[np.float64]: ...
+
+
+class AyssLike(Protocol):
+    """A run's AYSS samples: the indicator and the headway [m] of each."""
+
+    @property
+    def h(self) -> NDArray[np.float64]: ...
+
+    @property
+    def indicator(self) -> NDArray[np.float64]: ...
+
+    def __len__(self) -> int: ...
+
+
+class AyssSource(Protocol):
+    """A run's AYSS data as read (:class:`sumo_ayss.run_folder.RunRecord` is one): the
+    samples (``ayss.csv``) and the stored cells (``ayss_bins.csv``), each None when absent."""
+
+    @property
+    def ayss(self) -> AyssLike | None: ...
+
+    @property
+    def ayss_bins(self) -> CellsLike | None: ...
+
+
+@dataclass(frozen=True)
+class Cells:
+    """Per-cell moments of AYSS samples (:func:`cells_of`), cells sorted by headway.
+
+    Attributes:
+        h_low_m: Lower end of each cell [m], shape ``(c,)``.
+        h_high_m: Upper end [m]; equal to ``h_low_m`` for an edge-point cell.
+        n: Samples in the cell, shape ``(c,)``, >= 1.
+        mean: Mean indicator of the cell's samples (m/s² or m/s).
+        m2: Sum of squared deviations of the cell's indicator from ``mean`` (unit²).
+    """
+
+    h_low_m: NDArray[np.float64]
+    h_high_m: NDArray[np.float64]
+    n: NDArray[np.int64]
+    mean: NDArray[np.float64]
+    m2: NDArray[np.float64]
+
+
+def cells_of(h: ArrayLike, indicator: ArrayLike) -> Cells:
+    """The cells of samples ``(h, indicator)``: what ``ayss_bins.csv`` stores of them.
+
+    Args:
+        h: Headway of each sample [m], shape ``(n,)``, finite.
+        indicator: Indicator of each sample, shape ``(n,)``, finite.
+
+    Returns:
+        The non-empty cells, sorted by headway (edge point ``k/32`` before the open interval
+        that starts at it).
+    """
+    hs = np.asarray(h, dtype=np.float64)
+    ys = np.asarray(indicator, dtype=np.float64)
+    scaled = hs / CELL_WIDTH_M  # exact: a power of two
+    k = np.floor(scaled)
+    point = scaled == k
+    # sort key: 2k for the point {k/32}, 2k + 1 for the open interval (k/32, (k+1)/32)
+    key = (2 * k + np.where(point, 0, 1)).astype(np.int64)
+    order = np.argsort(key, kind="stable")
+    key, ys = key[order], ys[order]
+    uniq, start, counts = np.unique(key, return_index=True, return_counts=True)
+    means = np.array([float(ys[s : s + c].mean()) for s, c in zip(start, counts, strict=True)])
+    m2 = np.array(
+        [
+            float(np.sum((ys[s : s + c] - m) ** 2))
+            for s, c, m in zip(start, counts, means, strict=True)
+        ]
+    )
+    low = (uniq // 2).astype(np.float64) * CELL_WIDTH_M
+    high = low + np.where(uniq % 2 == 1, CELL_WIDTH_M, 0.0)
+    return Cells(low, high, counts.astype(np.int64), means.reshape(-1), m2.reshape(-1))
+
+
+def run_cells(run: AyssSource) -> CellsLike | None:
+    """A run's AYSS samples as per-cell moments: of ``ayss.csv`` when it was read, else
+    ``ayss_bins.csv`` as stored; None without either."""
+    if run.ayss is not None:
+        return cells_of(run.ayss.h, run.ayss.indicator)
+    return run.ayss_bins
 
 
 class Moments:

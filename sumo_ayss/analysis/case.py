@@ -22,9 +22,13 @@ from dataclasses import dataclass, field
 from typing import Generic, Protocol, TypeVar
 
 import numpy as np
-from numpy.typing import NDArray
 
-from sumo_ayss.analysis.ayss_cells import CellsLike, safety_index_from_cells
+from sumo_ayss.analysis.ayss_cells import (
+    AyssLike,
+    CellsLike,
+    run_cells,
+    safety_index_from_cells,
+)
 from sumo_ayss.analysis.case_verdict import CaseVerdict
 from sumo_ayss.analysis.crossplay import CrossplayInput
 from sumo_ayss.analysis.harm import ColumnsLike, RewardLike
@@ -100,18 +104,6 @@ class OutcomeLike(Protocol):
     def mean_final_headway_m(self) -> _Estimate: ...
 
 
-class AyssLike(Protocol):
-    """A run's AYSS samples: the indicator and the headway [m] of each."""
-
-    @property
-    def h(self) -> NDArray[np.float64]: ...
-
-    @property
-    def indicator(self) -> NDArray[np.float64]: ...
-
-    def __len__(self) -> int: ...
-
-
 class RunLike(Protocol):
     """What the analysis reads of a run (:class:`sumo_ayss.run_folder.RunRecord` is one, as
     :func:`sumo_ayss.run_folder.read_run` returns it): analysis imports no file reader, the
@@ -133,7 +125,7 @@ class RunLike(Protocol):
     def ayss(self) -> AyssLike | None: ...
 
     @property
-    def ayss_cells(self) -> CellsLike | None: ...
+    def ayss_bins(self) -> CellsLike | None: ...
 
     @property
     def outcome(self) -> OutcomeLike | None: ...
@@ -177,11 +169,14 @@ def vut_safety_index(
         The :class:`SafetyIndex`, or None if no run has a sample in the headway range.
     """
     seeds = [r.ayss for r in runs if r.ayss is not None and len(r.ayss) > 0]
-    cells = [c for r in runs if (c := r.ayss_cells) is not None and int(c.n.sum()) > 0]
-    if not cells:
+    bins_only = [
+        c for r in runs if r.ayss is None and (c := r.ayss_bins) is not None and int(c.n.sum())
+    ]
+    if not seeds and not bins_only:
         return None
     try:
-        if len(cells) > len(seeds):  # a run without ayss.csv: its ayss_bins.csv
+        if bins_only:  # a run without ayss.csv: its ayss_bins.csv, the others' samples as cells
+            cells = [c for r in runs if (c := run_cells(r)) is not None and int(c.n.sum()) > 0]
             return safety_index_from_cells(
                 cells,
                 options.h_range,

@@ -39,6 +39,8 @@ class CrossplayTablesLike(Protocol):
     @property
     def problem(self) -> str: ...
     @property
+    def vuts(self) -> tuple[str, ...] | None: ...
+    @property
     def diagonal(self) -> tuple[tuple[str, int, int, int], ...]: ...
     @property
     def reference(self) -> ColumnsLike | None: ...
@@ -86,11 +88,37 @@ def _scale(runs: Mapping[str, Sequence[ScorableRun]]) -> HarmScale | None:
     return next(iter(scales)) if len(scales) == 1 else None
 
 
+def _stale(tables: CrossplayTablesLike, runs: Mapping[str, Sequence[object]]) -> bool:
+    return tables.vuts is not None and sorted(tables.vuts) != sorted(runs)
+
+
+def refusal(tables: CrossplayTablesLike, runs: Mapping[str, Sequence[object]]) -> str:
+    """Why a case's stored cross-play table must not be ranked, or "": its record drove
+    other VUTs than the runs' (a study whose VUTs changed and whose cross-play could not run
+    yet), or its diagonal did not reproduce the outcome tables of some runs."""
+    if tables.vuts is not None and _stale(tables, runs):
+        return (
+            f"the cross-play table is stale: it drove VUTs {', '.join(tables.vuts)}, the "
+            f"runs are of {', '.join(runs)} (the pipeline drives the missing cells when "
+            "every job of the case is done)"
+        )
+    bad = [(vut, seed, n - n_equal, n) for vut, seed, n, n_equal in tables.diagonal if n_equal != n]
+    if not bad:
+        return ""
+    names = ", ".join(f"{vut} (seed {seed}: {differ}/{n})" for vut, seed, differ, n in bad)
+    return (
+        "the cross-play table is refused: its diagonal did not reproduce the outcome "
+        f"tables of {names}; it would rank another vehicle than the one the opponents "
+        "were trained against"
+    )
+
+
 def crossplay_input(
     tables: CrossplayTablesLike, runs: Mapping[str, Sequence[ScorableRun]]
 ) -> CrossplayInput:
     """The cross-play input of one case: its tables as read, scored on its runs' harm
-    scale, or why there is none; never raises.
+    scale, or why there is none (:func:`refusal`: a table that must not be ranked); never
+    raises.
 
     Args:
         tables: The case's files (:func:`sumo_ayss.run_folder.load_crossplay`).
@@ -107,10 +135,11 @@ def crossplay_input(
         )
     scale = _scale(runs)
     assert scale is not None
+    if why := refusal(tables, runs):  # checked before the table, whether it reads or not
+        diagonal = () if _stale(tables, runs) else tables.diagonal
+        return CrossplayInput(path=path, missing=why, problem=f"{path}: {why}", diagonal=diagonal)
     if tables.table is None:
-        return CrossplayInput(
-            path=path, missing=tables.missing, problem=tables.problem, diagonal=tables.diagonal
-        )
+        return CrossplayInput(path=path, missing=tables.missing, problem=tables.problem)
     try:
         matrix = score_crossplay(tables.table.columns, scale)
     except ConfigError as exc:

@@ -253,7 +253,7 @@ class RewardLike(Protocol):
 
 
 class ColumnsLike(Protocol):
-    """A table as read: ``name -> array`` (:class:`sumo_ayss.run_folder.Table`)."""
+    """A table as read: ``name -> array`` (:class:`sumo_ayss.records.table.Table`)."""
 
     @property
     def columns(self) -> Mapping[str, Any]: ...

@@ -141,7 +141,7 @@ POOL_IGNORED = (("seed",), ("vut",), ("env", "vut"), ("env", "vuts"), ("train", 
 def config_key(config: Mapping[str, Any]) -> str:
     """12 hex digits of :func:`~sumo_ayss.util.fingerprint.fingerprint` of a resolved
     ``config.yaml`` without :data:`POOL_IGNORED`: runs with different keys in one case must
-    not be pooled (:func:`sumo_ayss.run_folder.study_runs.mixing_problems`)."""
+    not be pooled (:func:`sumo_ayss.training.trust.mixing_problems`)."""
     data = json.loads(json.dumps(config, default=str))
     for key in POOL_IGNORED:
         node: Any = data

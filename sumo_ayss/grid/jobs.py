@@ -21,7 +21,6 @@ from sumo_ayss.run_folder import (
     read_run,
     write_progress,
 )
-from sumo_ayss.run_folder.ayss_bins import backfill_ayss_bins
 from sumo_ayss.stages import EvaluateStage, TrainStage, is_done
 from sumo_ayss.util.errors import ControllerError, DiskFullError
 from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
@@ -88,7 +87,7 @@ def is_finished(spec: JobSpec) -> bool:
 
 def run_job(spec: JobSpec) -> dict[str, Any]:
     """Train (or resume, or skip) and evaluate one job. Runs in a worker process."""
-    from sumo_ayss.evaluate import evaluate_run
+    from sumo_ayss.evaluate import backfill_ayss_bins, evaluate_run
     from sumo_ayss.grid.threads import set_torch_threads
     from sumo_ayss.training.trainer import train
 

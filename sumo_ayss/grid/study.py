@@ -42,6 +42,7 @@ from sumo_ayss.config.identity import (
     vut_key,
 )
 from sumo_ayss.grid.jobs import JobSpec
+from sumo_ayss.records.jsonio import write_json
 from sumo_ayss.run_folder import (
     RunConfig,
     RunFolder,
@@ -49,7 +50,6 @@ from sumo_ayss.run_folder import (
     stored_experiment,
     write_run_config,
 )
-from sumo_ayss.run_folder.jsonio import write_json
 from sumo_ayss.util.errors import AyssError, ConfigError
 
 __all__ = [

@@ -9,7 +9,8 @@ from typing import Any, Literal
 from sumo_ayss.cases import get_case
 from sumo_ayss.envs import make_env
 from sumo_ayss.envs.odd import InitialCondition, with_follower_at
-from sumo_ayss.run_folder import AYSS_SCHEMA, OUTCOME_SCHEMA, RunFolder, RunRecord, read_table
+from sumo_ayss.records.table import read_table
+from sumo_ayss.run_folder import AYSS_SCHEMA, OUTCOME_SCHEMA, RunFolder, RunRecord
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.util.errors import CheckpointError, ConfigError
 

@@ -25,7 +25,7 @@ from matplotlib.ticker import FuncFormatter
 from numpy.typing import NDArray
 
 from sumo_ayss.analysis import binned_mean_ci
-from sumo_ayss.analysis.ayss_cells import binned_stats_from_cells
+from sumo_ayss.analysis.ayss_cells import binned_stats_from_cells, run_cells
 from sumo_ayss.analysis.ranking import SafetyIndex
 from sumo_ayss.analysis.seed_intervals import (
     MIN_SEEDS_FOR_INTERVAL,
@@ -147,7 +147,7 @@ def learning_curves_figure(
     """
     runs = [r for rs in runs_by_vut.values() for r in rs]
     has_lc = any(
-        r.eval_curve is not None and np.isfinite(r.eval_curve.lane_change_rate).any()
+        r.eval_curve is not None and np.isfinite(r.eval_curve["lane_change_rate"]).any()
         for r in runs
         if case_info(r.case).lane_change
     )
@@ -192,16 +192,16 @@ def _draw_curve(ax: Axes, run: RunRecord, column: str, scale: float, color: str,
     curve = run.eval_curve
     if curve is None or len(curve) == 0:
         return False
-    y = getattr(curve, column) * scale
+    y = curve[column] * scale
     if not np.isfinite(y).any():
         return False
     ls, marker = seed_style(pos)
-    ax.plot(curve.step, y, color=color, ls=ls, lw=1.6, marker=marker, ms=3.5, alpha=0.9)
+    ax.plot(curve["step"], y, color=color, ls=ls, lw=1.6, marker=marker, ms=3.5, alpha=0.9)
     if run.spcp is not None:
-        hit = np.flatnonzero(curve.step == run.spcp.step)
+        hit = np.flatnonzero(curve["step"] == run.spcp.step)
         if hit.size:
             ax.plot(
-                curve.step[hit[0]],
+                curve["step"][hit[0]],
                 y[hit[0]],
                 marker="*",
                 ms=17,
@@ -252,7 +252,7 @@ def _vut_bins(
         h = np.concatenate([a.h for a in samples])
         y = np.concatenate([a.indicator for a in samples])
         return bands, binned_mean_ci(h, y, edges, level=level, min_count=2)
-    cells = [c for r in runs if (c := r.ayss_cells) is not None]
+    cells = [c for r in runs if (c := run_cells(r)) is not None]
     per_seed = [binned_stats_from_cells([c], edges, level, 2) for c in cells]
     return seed_bands(per_seed, edges, level), binned_stats_from_cells(cells, edges, level, 2)
 

@@ -34,13 +34,8 @@ from sumo_ayss.analysis.r157 import R157_TIME_MARGIN_S, R157_TIME_S, must_avoid_
 from sumo_ayss.modes import CROSSPLAY, EXPOSURE
 from sumo_ayss.modes.crossplay import crossplay_result
 from sumo_ayss.modes.exposure import exposure_result
-from sumo_ayss.run_folder import (
-    CROSSPLAY_SCHEMA,
-    RunRecord,
-    StudyFolder,
-    read_table,
-    write_measures_csv,
-)
+from sumo_ayss.records.table import read_table
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, RunRecord, StudyFolder, write_measures_csv
 from sumo_ayss.util.errors import AyssError
 
 __all__ = ["CaseMeasures", "case_measures", "write_measures"]

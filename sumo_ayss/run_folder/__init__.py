@@ -64,7 +64,9 @@ Whether a stage is done with the inputs asked for now is decided above the files
 (:mod:`sumo_ayss.stages`), from the markers read here.
 
 Every file is written atomically (:mod:`sumo_ayss.util.atomic`). No other module spells one of
-these names or parses one of these files. Imports neither SUMO nor torch.
+these names or parses one of these files: the tables go through the one CSV reader and writer,
+the JSON files through the one JSON reader (:mod:`sumo_ayss.records`, which knows no file of
+the run folder; the schemas are here). Imports neither SUMO nor torch.
 """
 
 from __future__ import annotations
@@ -75,7 +77,6 @@ from sumo_ayss.run_folder.adaptive import (
     read_adaptive,
     write_adaptive,
 )
-from sumo_ayss.run_folder.ayss_bins import ayss_cells
 from sumo_ayss.run_folder.crossplay import (
     CrossplayOpponent,
     CrossplayRecord,
@@ -146,12 +147,6 @@ from sumo_ayss.run_folder.summaries import (
     write_ayss_json,
     write_outcome_json,
 )
-from sumo_ayss.run_folder.table import (
-    Table,
-    read_table,
-    table_from_rows,
-    write_table,
-)
 
 __all__ = [
     "AYSS_SCHEMA",
@@ -175,8 +170,6 @@ __all__ = [
     "Seeds",
     "StageHeader",
     "StudyFolder",
-    "Table",
-    "ayss_cells",
     "case_of",
     "case_runs",
     "find_run_dirs",
@@ -193,9 +186,7 @@ __all__ = [
     "read_progress",
     "read_run",
     "read_run_config",
-    "read_table",
     "stored_experiment",
-    "table_from_rows",
     "write_adaptive",
     "write_ayss_json",
     "write_crossplay_json",
@@ -212,5 +203,4 @@ __all__ = [
     "write_ranking_csv",
     "write_run_config",
     "write_spcp",
-    "write_table",
 ]

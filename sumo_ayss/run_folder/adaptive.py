@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from sumo_ayss.run_folder.jsonio import json_field, json_list, json_records, read_json, write_json
+from sumo_ayss.records.jsonio import json_field, json_list, json_records, read_json, write_json
 from sumo_ayss.util.errors import TableError
 
 __all__ = ["ADAPTIVE_FORMAT", "AdaptiveLook", "AdaptiveRecord", "read_adaptive", "write_adaptive"]

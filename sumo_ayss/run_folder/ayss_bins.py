@@ -14,13 +14,16 @@ closed, are exactly a union of cells. Per non-empty cell the file holds the samp
 ``n``, the mean of the indicator and ``m2``, the sum of squared deviations from that mean:
 what a bin's count, mean and standard deviation (the figures' t-intervals), the safety
 index's bin means and its seeds' own indices, and Cohen's d need, combined with Chan's
-parallel formula (:func:`sumo_ayss.analysis.ayss_cells.combine`). What the cells cannot
+parallel formula (:mod:`sumo_ayss.analysis.ayss_cells`). What the cells cannot
 give is the within-seed resampling of individual samples of the safety index's bootstrap;
 from cells it is drawn from each bin's first two moments (documented there).
 
-Written by the evaluate stage with ``ayss.csv`` (:func:`write_ayss_bins`), read by
-:func:`read_ayss_bins` into an :class:`AyssCells`. Imports neither SUMO nor torch, nor
-the analysis.
+The samples are reduced to cells by the analysis (:func:`sumo_ayss.analysis.ayss_cells.cells_of`)
+and written by the evaluate stage with ``ayss.csv`` (:func:`write_ayss_bins`; a run evaluated
+before the file existed gets it from its ``ayss.csv``,
+:func:`sumo_ayss.evaluate.backfill_ayss_bins`); :func:`read_ayss_bins` reads it into an
+:class:`AyssCells`, checking the cells against the lattice. Imports neither SUMO nor torch,
+nor the analysis.
 """
 
 from __future__ import annotations
@@ -31,23 +34,17 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from sumo_ayss.run_folder.schemas import AYSS_BINS_SCHEMA, AYSS_SCHEMA
-from sumo_ayss.run_folder.table import Table, read_table, write_table
+from sumo_ayss.records.table import Table, read_table, write_table
+from sumo_ayss.run_folder.schemas import AYSS_BINS_SCHEMA
 from sumo_ayss.util.errors import AyssError
 
-__all__ = [
-    "CELL_WIDTH_M",
-    "AyssCells",
-    "ayss_cells",
-    "backfill_ayss_bins",
-    "read_ayss_bins",
-    "write_ayss_bins",
-]
+__all__ = ["CELL_WIDTH_M", "AyssCells", "read_ayss_bins", "write_ayss_bins"]
 
 CELL_WIDTH_M = 1.0 / 32.0
-"""Width of a headway cell [m]: a binary fraction, so every cell edge is exact."""
+"""Width of a headway cell [m]: a binary fraction, so every cell edge is exact (the
+analysis's reduction uses the same, :data:`sumo_ayss.analysis.ayss_cells.CELL_WIDTH_M`)."""
 
 
 @dataclass(frozen=True)
@@ -76,42 +73,6 @@ class AyssCells:
         return int(self.n.sum())
 
 
-def ayss_cells(h: ArrayLike, indicator: ArrayLike, indicator_name: str | None) -> AyssCells:
-    """The cells of samples ``(h, indicator)``.
-
-    Args:
-        h: Headway of each sample [m], shape ``(n,)``, finite.
-        indicator: Indicator of each sample, shape ``(n,)``, finite.
-        indicator_name: The samples' ``indicator_name``.
-
-    Returns:
-        The non-empty cells, sorted by headway (edge point ``k/32`` before the open interval
-        that starts at it).
-    """
-    hs = np.asarray(h, dtype=np.float64)
-    ys = np.asarray(indicator, dtype=np.float64)
-    scaled = hs / CELL_WIDTH_M  # exact: a power of two
-    k = np.floor(scaled)
-    point = scaled == k
-    # sort key: 2k for the point {k/32}, 2k + 1 for the open interval (k/32, (k+1)/32)
-    key = (2 * k + np.where(point, 0, 1)).astype(np.int64)
-    order = np.argsort(key, kind="stable")
-    key, ys = key[order], ys[order]
-    uniq, start, counts = np.unique(key, return_index=True, return_counts=True)
-    means = np.array([float(ys[s : s + c].mean()) for s, c in zip(start, counts, strict=True)])
-    m2 = np.array(
-        [
-            float(np.sum((ys[s : s + c] - m) ** 2))
-            for s, c, m in zip(start, counts, means, strict=True)
-        ]
-    )
-    low = (uniq // 2).astype(np.float64) * CELL_WIDTH_M
-    high = low + np.where(uniq % 2 == 1, CELL_WIDTH_M, 0.0)
-    return AyssCells(
-        low, high, counts.astype(np.int64), means.reshape(-1), m2.reshape(-1), indicator_name
-    )
-
-
 def write_ayss_bins(path: Path, cells: AyssCells) -> None:
     """Write ``cells`` as ``ayss_bins.csv`` (:data:`AYSS_BINS_SCHEMA`), atomically."""
     c = len(cells.n)
@@ -127,23 +88,6 @@ def write_ayss_bins(path: Path, cells: AyssCells) -> None:
         },
     )
     write_table(path, table)
-
-
-def backfill_ayss_bins(ayss_csv: Path, ayss_bins: Path) -> bool:
-    """Write ``ayss_bins`` from an existing ``ayss_csv`` that has none beside it (a run
-    evaluated before the evaluate stage wrote it): the stage's own reduction, no simulation
-    (``ayss.csv`` stores every float exactly, so the file is the one the stage writes).
-
-    Returns:
-        Whether it wrote the file.
-    """
-    if ayss_bins.is_file() or not ayss_csv.is_file():
-        return False
-    table = read_table(ayss_csv, AYSS_SCHEMA)
-    names = Counter(str(v) for v in table["indicator_name"])
-    name = names.most_common(1)[0][0] if names else None
-    write_ayss_bins(ayss_bins, ayss_cells(table["h_m"], table["indicator"], name))
-    return True
 
 
 def read_ayss_bins(path: Path) -> AyssCells:

@@ -2,7 +2,7 @@
 
 It lies in the case folder ``<out>/<case>/`` (:class:`~.layout.CaseFolder`), beside
 ``crossplay.csv`` (:data:`~.schemas.CROSSPLAY_SCHEMA`, written and read with
-:func:`~.table.write_table` / :func:`~.table.read_table`)::
+:func:`~sumo_ayss.records.table.write_table` / :func:`~sumo_ayss.records.table.read_table`)::
 
     {"stage": "crossplay", "case": "cut_in", "n": 200, "seed": 4242,
      "opponents": [{"vut": "pi1", "seed": 0, "spcp_sha256": "..."}, ...],
@@ -24,7 +24,7 @@ keeps the cells whose VUT and opponent are unchanged
 
 :func:`load_crossplay` reads a case's table and record back for the analysis, as stored
 (:class:`CrossplayTables`); the analysis scores them on the runs' harm scale
-(:func:`sumo_ayss.analysis.crossplay.crossplay_input`).
+(:func:`sumo_ayss.analysis.crossplay_scoring.crossplay_input`).
 
 Imports neither SUMO nor torch, nor the analysis.
 """
@@ -37,10 +37,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from sumo_ayss.run_folder.jsonio import json_field, json_records, read_json, write_json
+from sumo_ayss.records.jsonio import json_field, json_list, json_records, read_json, write_json
+from sumo_ayss.records.table import Table, read_table
 from sumo_ayss.run_folder.layout import CaseFolder
 from sumo_ayss.run_folder.schemas import CROSSPLAY_SCHEMA
-from sumo_ayss.run_folder.table import Table, read_table
 from sumo_ayss.util.errors import TableError
 
 if TYPE_CHECKING:
@@ -135,26 +135,12 @@ class CrossplayRecord:
 
 
 def write_crossplay_json(path: Path, record: CrossplayRecord) -> None:
-    """Write ``crossplay.json``."""
-    write_json(
-        path,
-        {
-            "stage": "crossplay",
-            "case": record.case,
-            "n": record.n,
-            "seed": record.seed,
-            "opponents": [dataclasses.asdict(o) for o in record.opponents],
-            "vuts": list(record.vuts),
-            "wall_s": round(record.wall_s, 3),
-            "rollout": record.rollout,
-            "diagonal": [dataclasses.asdict(d) for d in record.diagonal],
-            **(
-                {"vut_keys": dict(zip(record.vuts, record.vut_keys, strict=True))}
-                if record.vut_keys
-                else {}
-            ),
-        },
-    )
+    """Write ``crossplay.json``: the record's fields (``wall_s`` to the millisecond),
+    ``vut_keys`` as ``{vut: key}`` and left out when empty."""
+    data = {"stage": "crossplay", **dataclasses.asdict(record), "wall_s": round(record.wall_s, 3)}
+    if keys := data.pop("vut_keys"):
+        data["vut_keys"] = dict(zip(record.vuts, keys, strict=True))
+    write_json(path, data)
 
 
 def read_crossplay_json(path: Path) -> CrossplayRecord:
@@ -167,30 +153,26 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
     data = read_json(path)
     where = str(path)
     opponents = json_records(data, "opponents", CrossplayOpponent, where)
-    vuts = json_field(data, "vuts", list, where)
-    if not all(isinstance(v, str) for v in vuts):
-        raise TableError(f"{where}: vuts: expected a list of names, got {vuts!r}")
+    vuts = json_list(data, "vuts", str, where)
     diagonal = (
         json_records(data, "diagonal", DiagonalCheck, where)
         if "diagonal" in data
         else ()  # a record from before the check
     )
-    rollout = data.get("rollout", _LEGACY_ROLLOUT)
-    if not isinstance(rollout, str):
-        raise TableError(f"{where}: rollout: expected str, got {rollout!r}")
+    rollout = json_field(data, "rollout", str, where) if "rollout" in data else _LEGACY_ROLLOUT
     keys = data.get("vut_keys", {})  # absent in records written before them
     if (
         not isinstance(keys, Mapping)
         or (keys and sorted(keys) != sorted(vuts))
         or not all(isinstance(k, str) for k in keys.values())
     ):
-        raise TableError(f"{where}: vut_keys: expected a key per VUT of {vuts}, got {keys!r}")
+        raise TableError(f"{where}: vut_keys: expected a key per VUT of {list(vuts)}, got {keys!r}")
     return CrossplayRecord(
         case=json_field(data, "case", str, where),
         n=json_field(data, "n", int, where),
         seed=json_field(data, "seed", int, where),
         opponents=opponents,
-        vuts=tuple(vuts),
+        vuts=vuts,
         wall_s=float(json_field(data, "wall_s", (int, float), where)),
         rollout=rollout,
         diagonal=diagonal,
@@ -204,7 +186,7 @@ def read_crossplay_json(path: Path) -> CrossplayRecord:
 def read_crossplay_table(path: Path) -> Table:
     """A case folder's ``crossplay.csv`` (or ``crossplay_reference.csv``), read against
     :data:`~.schemas.CROSSPLAY_SCHEMA`; the analysis scores it
-    (:func:`sumo_ayss.analysis.crossplay.score_crossplay`).
+    (:func:`sumo_ayss.analysis.crossplay_scoring.score_crossplay`).
 
     Raises:
         TableError: If the file is missing or does not follow the schema.
@@ -215,14 +197,16 @@ def read_crossplay_table(path: Path) -> Table:
 @dataclass(frozen=True)
 class CrossplayTables:
     """A case's cross-play files as found, stored data only: the analysis scores them
-    (:func:`sumo_ayss.analysis.crossplay.crossplay_input`).
+    (:func:`sumo_ayss.analysis.crossplay_scoring.crossplay_input`).
 
     Attributes:
         case_dir: The case folder the runs lie in, or None (several).
         path: ``crossplay.csv``, or None (not found, or the runs lie in several folders).
         table: ``crossplay.csv`` read, or None.
-        missing: Why there is no usable table (one sentence), "" with no problem.
+        missing: Why there is no table (one sentence: a file unreadable, or the runs in
+            several case folders), "" with no problem.
         problem: A line for the case's problem list, or "".
+        vuts: The VUTs the record says the table drove, or None (no ``crossplay.json``).
         diagonal: The record's diagonal check, ``(vut, seed, n, n_equal)`` per run.
         reference: ``crossplay_reference.csv`` read, or None.
         reference_problem: Why that file is unreadable, or "".
@@ -235,6 +219,7 @@ class CrossplayTables:
     table: Table | None = None
     missing: str = ""
     problem: str = ""
+    vuts: tuple[str, ...] | None = None
     diagonal: tuple[tuple[str, int, int, int], ...] = ()
     reference: Table | None = None
     reference_problem: str = ""
@@ -282,11 +267,11 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayTables:
         runs: ``{vut: runs}`` of one case (:func:`~.record.read_run`).
 
     Returns:
-        The :class:`CrossplayTables`: the tables as read, or why there is none (no table,
-        runs in several case folders, an unreadable record or table, a table whose
-        diagonal did not reproduce the outcome tables, or one of other VUTs than the runs':
-        a study whose VUTs changed and whose cross-play could not run). Scoring them is the
-        analysis's (:func:`sumo_ayss.analysis.crossplay.crossplay_input`).
+        The :class:`CrossplayTables`: the tables and the record's VUTs and diagonal as
+        read, or why there is none (no table, runs in several case folders, an unreadable
+        record or table). Whether a table may be ranked (its record drove other VUTs than
+        the runs', or its diagonal did not reproduce the outcome tables) and scoring it are
+        the analysis's (:func:`sumo_ayss.analysis.crossplay_scoring.crossplay_input`).
     """
     case_dirs = sorted({r.path.parent.parent for rs in runs.values() for r in rs})
     if len(case_dirs) != 1:
@@ -308,36 +293,15 @@ def load_crossplay(runs: Mapping[str, Sequence[RunRecord]]) -> CrossplayTables:
                 missing=f"the cross-play record is unreadable ({exc})",
                 problem=str(exc),  # names the file
             )
-        if sorted(record.vuts) != sorted(runs):
-            why = (
-                f"the cross-play table is stale: it drove VUTs {', '.join(record.vuts)}, the "
-                f"runs are of {', '.join(runs)} (the pipeline drives the missing cells when "
-                "every job of the case is done)"
-            )
-            return dataclasses.replace(found, missing=why, problem=f"{path}: {why}")
         diagonal = tuple((d.vut, d.seed, d.n, d.n_equal) for d in record.diagonal)
-        bad = [d for d in record.diagonal if not d.ok]
-        if bad:
-            names = ", ".join(f"{d.vut} (seed {d.seed}: {d.n - d.n_equal}/{d.n})" for d in bad)
-            why = (
-                "the cross-play table is refused: its diagonal did not reproduce the outcome "
-                f"tables of {names}; it would rank another vehicle than the one the opponents "
-                "were trained against"
-            )
-            return dataclasses.replace(
-                found, missing=why, problem=f"{path}: {why}", diagonal=diagonal
-            )
-        found = dataclasses.replace(found, diagonal=diagonal)
+        found = dataclasses.replace(found, vuts=record.vuts, diagonal=diagonal)
     try:
         found = dataclasses.replace(found, table=read_crossplay_table(path))
     except TableError as exc:
         text = str(exc)  # a TableError names the file already
         problem = text if text.startswith(str(path)) else f"{path}: {text}"
-        return CrossplayTables(
-            case_dir=folder.path,
-            path=path,
-            missing=f"the cross-play table is unreadable ({problem})",
-            problem=problem,
+        return dataclasses.replace(
+            found, missing=f"the cross-play table is unreadable ({problem})", problem=problem
         )
     if folder.crossplay_reference_csv.is_file():
         try:

@@ -29,8 +29,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sumo_ayss.records.table import read_table, table_from_rows, write_table
 from sumo_ayss.run_folder.schemas import CROSSPLAY_SCHEMA
-from sumo_ayss.run_folder.table import read_table, table_from_rows, write_table
 from sumo_ayss.util.errors import TableError
 from sumo_ayss.util.fingerprint import fingerprint
 

@@ -15,9 +15,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.jsonio import read_json
+from sumo_ayss.records.jsonio import read_json
+from sumo_ayss.records.table import write_rows
 from sumo_ayss.run_folder.layout import CaseFolder
-from sumo_ayss.run_folder.table import write_rows
 from sumo_ayss.util.atomic import atomic_write_json
 from sumo_ayss.util.errors import TableError
 

@@ -2,7 +2,8 @@
 
 Its schema is :data:`EVAL_SCHEMA` (``step`` and ``n_episodes`` ints, ``checkpoint`` text, the
 other columns finite floats but ``std_return``, NaN with one scenario). It is written by
-:func:`write_eval_table` and read by the one CSV reader (:func:`~.table.read_table`), raising
+:func:`write_eval_table` and read by the one CSV reader
+(:func:`~sumo_ayss.records.table.read_table`), raising
 :class:`~sumo_ayss.util.errors.CheckpointError` (a run's own record) naming the file, the
 column and the row.
 """
@@ -13,7 +14,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.table import Column, TableSchema, read_table, write_rows
+from sumo_ayss.records.table import Column, TableSchema, read_table, write_rows
 from sumo_ayss.util.errors import CheckpointError
 
 __all__ = ["EVAL_SCHEMA", "read_eval_table", "write_eval_table"]

@@ -1,8 +1,9 @@
 """Where each file of a run folder lives: the names, once, and the folder's paths.
 
 A run folder is ``<out>/<case>/<vut>/seed_<k>/`` (:meth:`~.study.StudyFolder.run`).
-:class:`RunFolder` gives the path of every file in it; no other module spells a file name of
-a run folder.
+:class:`RunFolder` gives the path of every file in it, each file named once, as the folder's
+attribute (``RunFolder.config.name`` is ``"config.yaml"``); no other module spells a file
+name of a run folder.
 The case folder ``<out>/<case>/`` above a case's runs holds the cross-play and
 discriminability files (:class:`CaseFolder`).
 """
@@ -18,30 +19,7 @@ from typing import Any, overload
 from sumo_ayss.util.errors import ConfigError
 
 __all__ = [
-    "ADAPTIVE_JSON",
-    "AYSS_BINS_CSV",
-    "AYSS_CSV",
-    "AYSS_JSON",
-    "CHECKPOINTS_DIR",
-    "COMMAND_TXT",
-    "CONFIG_YAML",
-    "CROSSPLAY_CSV",
-    "CROSSPLAY_JSON",
-    "DISCRIMINABILITY_CSV",
-    "DISCRIMINABILITY_JSON",
-    "DISCRIMINABILITY_PNG",
-    "EVALUATE_DONE_JSON",
-    "EVAL_CSV",
-    "JOB_LOG",
     "MODEL_ZIP",
-    "OUTCOME_CSV",
-    "OUTCOME_JSON",
-    "PROGRESS_JSON",
-    "SEEDS_JSON",
-    "SPCP_JSON",
-    "SPCP_ZIP",
-    "TB_DIR",
-    "VERSIONS_JSON",
     "CaseFolder",
     "FolderFile",
     "RunFolder",
@@ -50,71 +28,8 @@ __all__ = [
     "seed_of_dir",
 ]
 
-# -- written by train ----------------------------------------------------------------------
-CONFIG_YAML = "config.yaml"
-"""The resolved experiment configuration (VUT: ``env.vut``) and the run's ``seed``."""
-COMMAND_TXT = "command.txt"
-"""The command line that started the run."""
-VERSIONS_JSON = "versions.json"
-"""Python, platform and package versions."""
-SEEDS_JSON = "seeds.json"
-"""Training seed, SUMO seed and evaluation-scenario seed."""
-EVAL_CSV = "eval.csv"
-"""One row per SPCP candidate (:mod:`sumo_ayss.run_folder.eval_table`)."""
-SPCP_JSON = "spcp.json"
-"""The selected candidate and why."""
-SPCP_ZIP = "spcp.zip"
-"""The selected candidate's model (a copy of its ``model.zip``)."""
-PROGRESS_JSON = "progress.json"
-"""Progress for watchers: stage, step, total, rate; rewritten every few seconds."""
-TB_DIR = "tb"
-"""TensorBoard logs."""
-CHECKPOINTS_DIR = "checkpoints"
-"""``step_XXXXXXXXX/`` per candidate and ``latest.json`` (the checkpoints' own files are
-the trainer's: :mod:`sumo_ayss.training.checkpoint_files`)."""
 MODEL_ZIP = "model.zip"
 """In a checkpoint: the candidate's model."""
-
-# -- written by evaluate and the pipeline ------------------------------------------------------
-OUTCOME_CSV = "outcome.csv"
-"""One row per outcome episode (:data:`~sumo_ayss.run_folder.schemas.OUTCOME_SCHEMA`)."""
-OUTCOME_JSON = "outcome.json"
-"""Outcome summary: rates and means with 95 % intervals (:mod:`.summaries`)."""
-AYSS_CSV = "ayss.csv"
-"""One row per kept AYSS sample (:data:`~sumo_ayss.run_folder.schemas.AYSS_SCHEMA`)."""
-AYSS_BINS_CSV = "ayss_bins.csv"
-"""The AYSS samples as moments per headway cell, committed where ``ayss.csv`` is not
-(:mod:`~sumo_ayss.run_folder.ayss_bins`)."""
-AYSS_JSON = "ayss.json"
-"""AYSS summary: filter counts, throughput, Monte Carlo settings, mean indicator."""
-EVALUATE_DONE_JSON = "evaluate.done.json"
-"""The pipeline's marker: the inputs the evaluation was done for."""
-JOB_LOG = "job.log"
-"""The pipeline job's log."""
-
-# -- written by cross-play, in the case folder <out>/<case>/ above the run folders ----------
-CROSSPLAY_CSV = "crossplay.csv"
-"""One row per (VUT, opponent SPCP, scenario) (:data:`~.schemas.CROSSPLAY_SCHEMA`)."""
-CROSSPLAY_REFERENCE_CSV = "crossplay_reference.csv"
-"""The reference drivers against the same opponents and scenarios (same schema)."""
-INEVITABLE_JSON = "inevitable.json"
-"""Which of the case's scenarios are inevitable-collision states (written by cross-play)."""
-CROSSPLAY_JSON = "crossplay.json"
-"""Cross-play record: settings, opponents with their SPCP's SHA-256, wall time."""
-CROSSPLAY_PARTIAL = "crossplay.partial"
-"""The finished cells of a cross-play table not yet written whole (one file each)."""
-CROSSPLAY_REFERENCE_PARTIAL = "crossplay_reference.partial"
-"""The same for the reference drivers' table."""
-ADAPTIVE_JSON = "adaptive.json"
-
-# -- written by the discriminability stage, in the case folder too ------------------------
-DISCRIMINABILITY_JSON = "discriminability.json"
-"""Where the VUTs' one-step responses differ over the AYSS box, with the fingerprint of the
-inputs (:mod:`.discriminability`)."""
-DISCRIMINABILITY_CSV = "discriminability.csv"
-"""The same shares as a long table: one row per (VUT pair, dimension, bin)."""
-DISCRIMINABILITY_PNG = "discriminability.png"
-"""Its figure (drawn by the report's discriminability section)."""
 
 _SEED_DIR = re.compile(r"^seed_(-?\d+)$")
 
@@ -160,23 +75,44 @@ class RunFolder:
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
 
-    config = FolderFile(CONFIG_YAML)
-    command = FolderFile(COMMAND_TXT)
-    versions = FolderFile(VERSIONS_JSON)
-    seeds = FolderFile(SEEDS_JSON)
-    eval_table = FolderFile(EVAL_CSV)
-    spcp_json = FolderFile(SPCP_JSON)
-    spcp_zip = FolderFile(SPCP_ZIP)
-    progress = FolderFile(PROGRESS_JSON)
-    tb = FolderFile(TB_DIR)
-    checkpoints = FolderFile(CHECKPOINTS_DIR)
-    outcome_csv = FolderFile(OUTCOME_CSV)
-    outcome_json = FolderFile(OUTCOME_JSON)
-    ayss_csv = FolderFile(AYSS_CSV)
-    ayss_bins = FolderFile(AYSS_BINS_CSV)
-    ayss_json = FolderFile(AYSS_JSON)
-    evaluate_done = FolderFile(EVALUATE_DONE_JSON)
-    job_log = FolderFile(JOB_LOG)
+    # -- written by train
+    #: The resolved experiment configuration (VUT: ``env.vut``) and the run's ``seed``.
+    config = FolderFile("config.yaml")
+    #: The command line that started the run.
+    command = FolderFile("command.txt")
+    #: Python, platform and package versions.
+    versions = FolderFile("versions.json")
+    #: Training seed, SUMO seed and evaluation-scenario seed.
+    seeds = FolderFile("seeds.json")
+    #: One row per SPCP candidate (:mod:`sumo_ayss.run_folder.eval_table`).
+    eval_table = FolderFile("eval.csv")
+    #: The selected candidate and why.
+    spcp_json = FolderFile("spcp.json")
+    #: The selected candidate's model (a copy of its ``model.zip``).
+    spcp_zip = FolderFile("spcp.zip")
+    #: Progress for watchers: stage, step, total, rate; rewritten every few seconds.
+    progress = FolderFile("progress.json")
+    #: TensorBoard logs.
+    tb = FolderFile("tb")
+    #: ``step_XXXXXXXXX/`` per candidate and ``latest.json`` (the checkpoints' own files are
+    #: the trainer's: :mod:`sumo_ayss.training.checkpoint_files`).
+    checkpoints = FolderFile("checkpoints")
+    # -- written by evaluate and the pipeline
+    #: One row per outcome episode (:data:`~sumo_ayss.run_folder.schemas.OUTCOME_SCHEMA`).
+    outcome_csv = FolderFile("outcome.csv")
+    #: Outcome summary: rates and means with 95 % intervals (:mod:`.summaries`).
+    outcome_json = FolderFile("outcome.json")
+    #: One row per kept AYSS sample (:data:`~sumo_ayss.run_folder.schemas.AYSS_SCHEMA`).
+    ayss_csv = FolderFile("ayss.csv")
+    #: The AYSS samples as moments per headway cell, committed where ``ayss.csv`` is not
+    #: (:mod:`~sumo_ayss.run_folder.ayss_bins`).
+    ayss_bins = FolderFile("ayss_bins.csv")
+    #: AYSS summary: filter counts, throughput, Monte Carlo settings, mean indicator.
+    ayss_json = FolderFile("ayss.json")
+    #: The pipeline's marker: the inputs the evaluation was done for.
+    evaluate_done = FolderFile("evaluate.done.json")
+    #: The pipeline job's log.
+    job_log = FolderFile("job.log")
 
     def step_dir(self, step: int) -> Path:
         """The checkpoint folder of the candidate at training step ``step``."""
@@ -206,32 +142,37 @@ class CaseFolder:
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
 
-    crossplay_csv = FolderFile(CROSSPLAY_CSV)
-    crossplay_json = FolderFile(CROSSPLAY_JSON)
-    #: ``inevitable.json``: the scenarios no braking survives (:func:`read_inevitable`).
-    inevitable_json = FolderFile(INEVITABLE_JSON)
-    #: ``crossplay.partial/``: the finished cells of a cross-play table not yet written whole
+    # -- written by cross-play
+    #: One row per (VUT, opponent SPCP, scenario) (:data:`~.schemas.CROSSPLAY_SCHEMA`).
+    crossplay_csv = FolderFile("crossplay.csv")
+    #: Cross-play record: settings, opponents with their SPCP's SHA-256, wall time.
+    crossplay_json = FolderFile("crossplay.json")
+    #: The scenarios no braking survives, inevitable-collision states (:func:`read_inevitable`).
+    inevitable_json = FolderFile("inevitable.json")
+    #: The finished cells of a cross-play table not yet written whole, one file each
     #: (:class:`~.crossplay_partial.CellStore`).
-    crossplay_partial = FolderFile(CROSSPLAY_PARTIAL)
-    #: ``crossplay_reference.partial/``: the same for ``crossplay_reference.csv``.
-    crossplay_reference_partial = FolderFile(CROSSPLAY_REFERENCE_PARTIAL)
-    #: ``crossplay_reference.csv``: the reference drivers against the same opponents and scenarios
+    crossplay_partial = FolderFile("crossplay.partial")
+    #: The same for ``crossplay_reference.csv``.
+    crossplay_reference_partial = FolderFile("crossplay_reference.partial")
+    #: The reference drivers against the same opponents and scenarios
     #: (:data:`~.schemas.CROSSPLAY_SCHEMA`; they have no SPCPs of their own).
-    crossplay_reference_csv = FolderFile(CROSSPLAY_REFERENCE_CSV)
-    #: ``adaptive.json`` (adaptive seeding's looks, :mod:`.adaptive`).
-    adaptive_json = FolderFile(ADAPTIVE_JSON)
-    discriminability_json = FolderFile(DISCRIMINABILITY_JSON)
-    discriminability_csv = FolderFile(DISCRIMINABILITY_CSV)
-    discriminability_png = FolderFile(DISCRIMINABILITY_PNG)
+    crossplay_reference_csv = FolderFile("crossplay_reference.csv")
+    #: Adaptive seeding's looks (:mod:`.adaptive`).
+    adaptive_json = FolderFile("adaptive.json")
+    # -- written by the discriminability stage
+    #: Where the VUTs' one-step responses differ over the AYSS box, with the fingerprint of
+    #: the inputs (:mod:`.discriminability`).
+    discriminability_json = FolderFile("discriminability.json")
+    #: The same shares as a long table: one row per (VUT pair, dimension, bin).
+    discriminability_csv = FolderFile("discriminability.csv")
+    #: Its figure (drawn by the report's discriminability section).
+    discriminability_png = FolderFile("discriminability.png")
 
 
 def is_run_dir(path: Path) -> bool:
     """A folder holding a run's config or evaluation table, or named ``seed_<k>``."""
-    return (
-        (path / CONFIG_YAML).is_file()
-        or (path / EVAL_CSV).is_file()
-        or seed_of_dir(path) is not None
-    )
+    folder = RunFolder(path)
+    return folder.config.is_file() or folder.eval_table.is_file() or seed_of_dir(path) is not None
 
 
 def find_run_dirs(paths: Iterable[str | Path]) -> list[Path]:

@@ -2,12 +2,12 @@
 
 One column per field of :class:`~sumo_ayss.analysis.safety_measures.EpisodeMeasures`
 (definitions, units, signs and references there). Files written before these columns read
-as NaN ("not recorded": :attr:`~sumo_ayss.run_folder.table.Column.since`).
+as NaN ("not recorded": :attr:`~sumo_ayss.records.table.Column.since`).
 """
 
 from __future__ import annotations
 
-from sumo_ayss.run_folder.table import Column
+from sumo_ayss.records.table import Column
 
 __all__ = ["EPISODE_HAZARD_COLUMNS", "EPISODE_MEASURE_COLUMNS"]
 

@@ -1,14 +1,6 @@
-"""The run folder's small files: one writer and one reader each.
-
-==========================  =============================================================
-``config.yaml``             :func:`write_run_config` / :func:`read_run_config`
-``command.txt``             :func:`write_command` / :func:`read_command`
-``versions.json``           :func:`write_versions` / :func:`read_versions`
-``seeds.json``              :func:`write_seeds` / :func:`read_seeds`
-``spcp.json``               :func:`write_spcp` / :func:`read_spcp`
-``progress.json``           :func:`write_progress` / :func:`read_progress`
-``evaluate.done.json``      :func:`write_done_marker` / :func:`read_done_marker`
-==========================  =============================================================
+"""The run folder's small files (``config.yaml``, ``command.txt``, ``versions.json``,
+``seeds.json``, ``spcp.json``, ``progress.json``, ``evaluate.done.json``): one writer and one
+reader each, named in the table of :mod:`sumo_ayss.run_folder`.
 
 The checkpoints' own files (``latest.json``, ``state.json``) are the trainer's
 (:mod:`sumo_ayss.training.checkpoint_files`). Readers raise
@@ -37,8 +29,8 @@ from sumo_ayss.config import (
     safe_load_yaml,
     write_yaml,
 )
-from sumo_ayss.run_folder.jsonio import json_field, read_json
-from sumo_ayss.run_folder.layout import PROGRESS_JSON, RunFolder
+from sumo_ayss.records.jsonio import json_field, read_json
+from sumo_ayss.run_folder.layout import RunFolder
 from sumo_ayss.util.atomic import atomic_write_json, atomic_write_text
 from sumo_ayss.util.errors import CheckpointError, ConfigError
 
@@ -133,17 +125,21 @@ def read_run_config(path: Path) -> RunConfig:
     return RunConfig(vut, seed, data)
 
 
-def stored_experiment(folder: RunFolder) -> tuple[ExperimentConfig, int]:
-    """The experiment and seed a run folder's ``config.yaml`` records.
+def stored_experiment(
+    folder: RunFolder, config: RunConfig | None = None
+) -> tuple[ExperimentConfig, int]:
+    """The experiment and seed a run folder's ``config.yaml`` records (the one build of an
+    experiment from a stored configuration; ``config``: the file as already read).
 
     Raises:
-        CheckpointError: If the file is missing or unreadable, naming it.
+        CheckpointError: If the file is missing or unreadable (:func:`read_run_config`), or
+            not a valid experiment (``<file>: invalid run configuration: ...``).
     """
-    stored = read_run_config(folder.config)
+    stored = config if config is not None else read_run_config(folder.config)
     try:
         return experiment_from_dict(stored.experiment, folder.path), stored.seed
     except ConfigError as e:
-        raise CheckpointError(f"{folder.config}: unreadable run configuration ({e})") from e
+        raise CheckpointError(f"{folder.config}: invalid run configuration: {e}") from e
 
 
 # --------------------------------------------------------------------------- command.txt
@@ -296,13 +292,13 @@ def write_progress(run_dir: Path, stage: str, **fields: Any) -> None:
     transitions per second of wall time since this process started training), ``evaluate``,
     ``done``. Only watchers (the pipeline's progress display) read it; nothing depends on it.
     """
-    atomic_write_json(run_dir / PROGRESS_JSON, {"stage": stage, "time": time.time(), **fields})
+    atomic_write_json(RunFolder(run_dir).progress, {"stage": stage, "time": time.time(), **fields})
 
 
 def read_progress(run_dir: Path) -> dict[str, Any] | None:
     """``<run_dir>/progress.json``, or None when it is missing or unreadable."""
     try:
-        return read_json(run_dir / PROGRESS_JSON, error=CheckpointError)
+        return read_json(RunFolder(run_dir).progress, error=CheckpointError)
     except CheckpointError:
         return None
 

@@ -20,67 +20,46 @@ torch, nor the analysis.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from sumo_ayss.cases import case_of_indicator
-from sumo_ayss.config import ExperimentConfig, RewardConfig, build, experiment_from_dict
+from sumo_ayss.config import ExperimentConfig, RewardConfig, build
 from sumo_ayss.config.env import decisions_of
 from sumo_ayss.config.identity import config_key
-from sumo_ayss.run_folder.ayss_bins import AyssCells, ayss_cells, read_ayss_bins
+from sumo_ayss.records.table import Table, read_table
+from sumo_ayss.run_folder.ayss_bins import AyssCells, read_ayss_bins
 from sumo_ayss.run_folder.eval_table import EVAL_SCHEMA
-from sumo_ayss.run_folder.layout import AYSS_CSV, CONFIG_YAML, EVAL_CSV, RunFolder, seed_of_dir
-from sumo_ayss.run_folder.metadata import RunConfig, SpcpChoice, read_run_config, read_spcp
+from sumo_ayss.run_folder.layout import RunFolder, seed_of_dir
+from sumo_ayss.run_folder.metadata import (
+    RunConfig,
+    SpcpChoice,
+    read_run_config,
+    read_spcp,
+    stored_experiment,
+)
 from sumo_ayss.run_folder.metadata import read_versions as _read_versions
 from sumo_ayss.run_folder.schemas import AYSS_SCHEMA, OUTCOME_SCHEMA
 from sumo_ayss.run_folder.summaries import Outcome, OutcomeRecord, read_outcome_json
-from sumo_ayss.run_folder.table import Table, read_table
-from sumo_ayss.training.trust import Training, training_of
+from sumo_ayss.training.trust import Training, all_same, training_of
 from sumo_ayss.util.errors import AyssError, CheckpointError, ConfigError
 from sumo_ayss.vuts.catalog import stored_description
 
-__all__ = [
-    "AyssSamples",
-    "EvalCurve",
-    "RunRecord",
-    "read_run",
-]
+__all__ = ["AyssSamples", "RunRecord", "read_run"]
 
 _T = TypeVar("_T")
-
-
-def _empty_f() -> NDArray[np.float64]:
-    return np.empty(0, dtype=np.float64)
-
-
-@dataclass(frozen=True)
-class EvalCurve:
-    """The SPCP-candidate evaluations of one run (``eval.csv``), sorted by step.
-
-    Attributes:
-        step: Training steps of each candidate, shape ``(k,)``.
-        mean_return: Mean evaluation episode reward, shape ``(k,)``.
-        crash_rate: Fraction of evaluation episodes with a collision, shape ``(k,)``.
-        lane_change_rate: Fraction with a lane change, shape ``(k,)`` (0 in car-following).
-        mean_final_headway_m: Mean final headway in m, shape ``(k,)``.
-        n_dropped: Rows skipped because a cell was not a (finite) number.
-    """
-
-    step: NDArray[np.float64] = field(default_factory=_empty_f)
-    mean_return: NDArray[np.float64] = field(default_factory=_empty_f)
-    crash_rate: NDArray[np.float64] = field(default_factory=_empty_f)
-    lane_change_rate: NDArray[np.float64] = field(default_factory=_empty_f)
-    mean_final_headway_m: NDArray[np.float64] = field(default_factory=_empty_f)
-    n_dropped: int = 0
-
-    def __len__(self) -> int:
-        return int(self.step.size)
+#: The names of the files a problem line starts with (named once, by the folder record).
+_CONFIG_YAML, _EVAL_CSV, _AYSS_CSV = (
+    RunFolder.config.name,
+    RunFolder.eval_table.name,
+    RunFolder.ayss_csv.name,
+)
 
 
 @dataclass(frozen=True)
@@ -118,14 +97,15 @@ class RunRecord:
         decisions_per_episode: Decisions per episode (``config.yaml``'s episode length over
             its decision period), or None; with the reward, what scores the outcome episodes
             (:func:`sumo_ayss.analysis.harm.run_episodes`: the analysis scores, not the reader).
-        eval_curve: The candidate evaluations (``eval.csv``), or None.
+        eval_curve: The candidate evaluations (``eval.csv``, :data:`~.eval_table.EVAL_SCHEMA`),
+            rows sorted by step, or None; ``n_dropped`` counts the damaged rows left out.
         spcp: The selected SPCP (``spcp.json``), or None.
         outcome_record: The outcome summary with its settings (``outcome.json``), or None.
         outcome_table: The outcome episodes (``outcome.csv``), or None.
         ayss: The AYSS samples (``ayss.csv``), or None.
         ayss_bins: The samples' per-cell moments (``ayss_bins.csv``), or None; read by the
             AYSS figures, table and paper mode where ``ayss.csv`` is absent
-            (:attr:`ayss_cells`).
+            (:func:`sumo_ayss.analysis.ayss_cells.run_cells`).
         versions: Package versions the run used (``versions.json``), or empty.
         training: Training budget and SPCP state (from ``config.yaml``, ``eval.csv`` and
             ``spcp.json``; :func:`sumo_ayss.training.trust.training_of`).
@@ -141,7 +121,7 @@ class RunRecord:
     vut_description: str = ""
     reward: RewardConfig | None = None
     decisions_per_episode: int | None = None
-    eval_curve: EvalCurve | None = None
+    eval_curve: Table | None = None
     spcp: SpcpChoice | None = None
     outcome_record: OutcomeRecord | None = None
     outcome_table: Table | None = None
@@ -161,14 +141,6 @@ class RunRecord:
         """The outcome summary (``outcome.json``), or None."""
         return self.outcome_record.outcome if self.outcome_record is not None else None
 
-    @cached_property
-    def ayss_cells(self) -> AyssCells | None:
-        """The AYSS samples as per-cell moments: of ``ayss.csv`` when it was read, else
-        ``ayss_bins.csv``; None (or empty) without either."""
-        if self.ayss is not None:
-            return ayss_cells(self.ayss.h, self.ayss.indicator, self.ayss.indicator_name)
-        return self.ayss_bins
-
     @property
     def label(self) -> str:
         """``"pi1 seed 0"``."""
@@ -184,13 +156,7 @@ class RunRecord:
             CheckpointError: If ``config.yaml`` is missing, unreadable or not a valid
                 experiment; the message names the file.
         """
-        config = self._stored_config()
-        try:
-            return experiment_from_dict(config.experiment, self.path)
-        except ConfigError as exc:
-            raise CheckpointError(
-                f"{self.folder.config}: invalid run configuration: {exc}"
-            ) from exc
+        return stored_experiment(self.folder, self._stored_config())[0]
 
     @property
     def config_seed(self) -> int:
@@ -206,45 +172,15 @@ class RunRecord:
         if self.config is not None:
             return self.config
         if not self.folder.config.is_file():
-            raise CheckpointError(f"{self.path}: not a run folder (no {CONFIG_YAML})")
+            raise CheckpointError(f"{self.path}: not a run folder (no {_CONFIG_YAML})")
         return read_run_config(self.folder.config)  # raises the reader's own message
 
 
-def _all_same(curve: EvalCurve | None, spcp: SpcpChoice | None) -> str | None:
-    """A sentence when two or more SPCP candidates all scored exactly the same (their mean
-    reward in ``eval.csv``, or the selection's criterion as ``spcp.json`` records): the
-    opponent's actions changed nothing it is paid for (e.g. an ODD that pins the VUT's speed
-    at 0), so which one is the SPCP is arbitrary; None otherwise."""
-    returns = curve.mean_return if curve is not None else np.array([])
-    if returns.size >= 2 and np.all(returns == returns[0]):
-        what, value, n = "mean reward", float(returns[0]), f" {returns.size}"
-    elif spcp is not None and spcp.no_signal:
-        what, value, n = spcp.criterion, spcp.score, ""
-    else:
-        return None
-    return (
-        f"{EVAL_CSV}: all{n} SPCP candidates scored exactly the same {what} ({value:.4f}): "
-        "the opponent's actions changed nothing it is paid for (e.g. an ODD that pins the "
-        "VUT's speed), so the SPCP is an arbitrary candidate and its scores carry no signal"
-    )
-
-
-def _eval_curve(rows: Sequence[Mapping[str, Any]], n_dropped: int) -> EvalCurve:
-    def col(name: str) -> NDArray[np.float64]:
-        return np.array([r[name] for r in rows], dtype=np.float64)
-
-    return EvalCurve(
-        step=col("step"),
-        mean_return=col("mean_return"),
-        crash_rate=col("crash_rate"),
-        lane_change_rate=col("lane_change_rate"),
-        mean_final_headway_m=col("mean_final_headway_m"),
-        n_dropped=n_dropped,
-    )
-
-
-def _eval_rows(path: Path) -> Table:
-    return read_table(path, EVAL_SCHEMA, error=CheckpointError, skip_bad_rows=True)
+def _eval_table(path: Path) -> Table:
+    """``eval.csv`` with its rows sorted by step (a damaged row left out: ``n_dropped``)."""
+    table = read_table(path, EVAL_SCHEMA, error=CheckpointError, skip_bad_rows=True)
+    order = np.argsort(table["step"], kind="stable")
+    return Table(EVAL_SCHEMA, {n: table[n][order] for n in EVAL_SCHEMA.names}, table.n_dropped)
 
 
 def _ayss_samples(path: Path) -> AyssSamples:
@@ -302,12 +238,12 @@ def read_run(path: str | Path) -> RunRecord:
     )
     config = description = reward = decisions = None
     if not folder.config.is_file():
-        r.problems.append(f"{CONFIG_YAML} missing (case, VUT and seed taken from the folder path)")
+        r.problems.append(f"{_CONFIG_YAML} missing (case, VUT and seed taken from the folder path)")
     else:
         try:
             config = read_run_config(folder.config)
         except AyssError as exc:
-            r.problems.append(f"{CONFIG_YAML} unreadable ({exc})")
+            r.problems.append(f"{_CONFIG_YAML} unreadable ({exc})")
     if config is not None:
         env = config.experiment["env"]  # a mapping: read_run_config checks it
         case, vut, seed = str(env.get("case", case)), config.vut, config.seed
@@ -316,20 +252,19 @@ def read_run(path: str | Path) -> RunRecord:
             # Only the reward section is rebuilt: a report does not need the experiment.
             reward = build(RewardConfig, env.get("reward") or {}, "env.reward", run_dir)
         except (ConfigError, TypeError) as exc:
-            r.problems.append(f"{CONFIG_YAML}: reward section invalid ({exc})")
+            r.problems.append(f"{_CONFIG_YAML}: reward section invalid ({exc})")
         else:
             try:
                 decisions = decisions_of(env)
             except (ConfigError, TypeError, ValueError, ArithmeticError) as exc:
-                r.problems.append(f"{CONFIG_YAML}: episode timing invalid ({exc})")
+                r.problems.append(f"{_CONFIG_YAML}: episode timing invalid ({exc})")
 
-    evals = r.attempt(folder.eval_table, _eval_rows)
-    rows, n_dropped = (list(evals.rows()), evals.n_dropped) if evals is not None else ([], 0)
-    rows.sort(key=lambda row: row["step"])
-    curve = _eval_curve(rows, n_dropped) if evals is not None else None
+    curve = r.attempt(folder.eval_table, _eval_table)
+    rows, n_dropped = (list(curve.rows()), curve.n_dropped) if curve is not None else ([], 0)
     if n_dropped:
         r.problems.append(
-            f"{EVAL_CSV}: {n_dropped} candidate row(s) without a finite step or mean_return dropped"
+            f"{_EVAL_CSV}: {n_dropped} candidate row(s) without a finite step or mean_return "
+            "dropped"
         )
     spcp = r.attempt(folder.spcp_json, read_spcp)
     outcome_record = r.attempt(folder.outcome_json, read_outcome_json)
@@ -342,12 +277,14 @@ def read_run(path: str | Path) -> RunRecord:
     ayss = r.attempt(folder.ayss_csv, _ayss_samples, needed=ayss_bins is None)
     versions = r.attempt(folder.versions, _read_versions, needed=False)  # optional
     if curve is not None and len(curve) == 0 and not n_dropped:
-        r.problems.append(f"{EVAL_CSV}: no rows (header only), so no learning curve")
-    if (same := _all_same(curve, spcp)) is not None:
-        r.problems.append(same)
+        r.problems.append(f"{_EVAL_CSV}: no rows (header only), so no learning curve")
+    no_signal = (spcp.criterion, spcp.score) if spcp is not None and spcp.no_signal else None
+    returns = curve["mean_return"] if curve is not None else np.array([])
+    if (same := all_same(returns, no_signal)) is not None:
+        r.problems.append(f"{_EVAL_CSV}: {same}")
     if ayss is not None and len(ayss) == 0:
-        r.problems.append(f"{AYSS_CSV}: no rows (header only), so no AYSS sample")
-    labels = [(AYSS_CSV, ayss.indicator_name if ayss is not None else None)]
+        r.problems.append(f"{_AYSS_CSV}: no rows (header only), so no AYSS sample")
+    labels = [(_AYSS_CSV, ayss.indicator_name if ayss is not None else None)]
     labels.append((folder.ayss_bins.name, ayss_bins.indicator_name if ayss_bins else None))
     for name, label in labels:
         expected_case = case_of_indicator(label) if label else None

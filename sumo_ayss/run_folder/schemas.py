@@ -12,15 +12,15 @@ case folder's ``crossplay.csv``.
 * :data:`CROSSPLAY_SCHEMA` — ``<out>/<case>/crossplay.csv``, one row per (VUT, opponent
   SPCP, scenario) of the cross-play stage (:mod:`sumo_ayss.crossplay`).
 
-Written and read with :func:`~sumo_ayss.run_folder.table.write_table` /
-:func:`~sumo_ayss.run_folder.table.read_table`.
+Written and read with :func:`~sumo_ayss.records.table.write_table` /
+:func:`~sumo_ayss.records.table.read_table`.
 """
 
 from __future__ import annotations
 
 from sumo_ayss.cases import indicator_columns
+from sumo_ayss.records.table import Column, TableSchema
 from sumo_ayss.run_folder.measure_columns import EPISODE_HAZARD_COLUMNS, EPISODE_MEASURE_COLUMNS
-from sumo_ayss.run_folder.table import Column, TableSchema
 
 __all__ = [
     "AYSS_BINS_SCHEMA",

@@ -18,8 +18,9 @@ file                    writer / reader                   what
 ======================  ================================  ====================================
 
 Every file is written atomically. The CSV files are read by the one CSV reader
-(:func:`~.table.read_table`) with a schema of text columns: the cells as written, so a script
-that writes a file back (``scripts/keep_paper_rows.py``) keeps every digit.
+(:func:`~sumo_ayss.records.table.read_table`) with a schema of text columns: the cells as
+written, so a script that writes a file back (``scripts/keep_paper_rows.py``) keeps every
+digit.
 Imports neither SUMO nor torch.
 """
 
@@ -31,25 +32,19 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.jsonio import json_list, json_records, read_json
+from sumo_ayss.records.jsonio import json_list, json_records, read_json
+from sumo_ayss.records.table import read_table, text_schema, write_rows
 from sumo_ayss.run_folder.layout import (
     CaseFolder,
     FolderFile,
     RunFolder,
 )
-from sumo_ayss.run_folder.table import read_table, text_schema, write_rows
 from sumo_ayss.util.atomic import atomic_write_json
 
 __all__ = [
     "MEASURES_COLUMNS",
-    "MEASURES_CSV",
-    "ORDER_CHECK_JSON",
-    "PIPELINE_JSON",
     "RANKING_COLUMNS",
-    "RANKING_CSV",
     "RANKING_HAZARD_COLUMNS",
-    "RANKING_MD",
-    "REPORT_DIR",
     "OrderCheck",
     "OrderChecks",
     "StudyFolder",
@@ -62,19 +57,6 @@ __all__ = [
     "write_pipeline_json",
     "write_ranking_csv",
 ]
-
-PIPELINE_JSON = "pipeline.json"
-"""The resolved pipeline configuration (paths relative to the study folder)."""
-RANKING_CSV = "ranking.csv"
-"""One row per (case, mode, VUT), safest first (:data:`RANKING_COLUMNS`)."""
-RANKING_MD = "ranking.md"
-"""The ranking as a Markdown table, with the known-order check in words."""
-ORDER_CHECK_JSON = "order_check.json"
-"""Per (case, mode), the ranking against a known order (:class:`OrderCheck`)."""
-MEASURES_CSV = "measures.csv"
-"""One row per (case, measure, VUT): the safety measures (:data:`MEASURES_COLUMNS`)."""
-REPORT_DIR = "report"
-"""The HTML and Markdown report."""
 
 RANKING_COLUMNS = (
     "case",
@@ -173,12 +155,18 @@ class StudyFolder:
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
 
-    pipeline_json = FolderFile(PIPELINE_JSON)
-    ranking_csv = FolderFile(RANKING_CSV)
-    ranking_md = FolderFile(RANKING_MD)
-    order_check_json = FolderFile(ORDER_CHECK_JSON)
-    measures_csv = FolderFile(MEASURES_CSV)
-    report_dir = FolderFile(REPORT_DIR)
+    #: The resolved pipeline configuration (paths relative to the study folder).
+    pipeline_json = FolderFile("pipeline.json")
+    #: One row per (case, mode, VUT), safest first (:data:`RANKING_COLUMNS`).
+    ranking_csv = FolderFile("ranking.csv")
+    #: The ranking as a Markdown table, with the known-order check in words.
+    ranking_md = FolderFile("ranking.md")
+    #: Per (case, mode), the ranking against a known order (:class:`OrderCheck`).
+    order_check_json = FolderFile("order_check.json")
+    #: One row per (case, measure, VUT): the safety measures (:data:`MEASURES_COLUMNS`).
+    measures_csv = FolderFile("measures.csv")
+    #: The HTML and Markdown report.
+    report_dir = FolderFile("report")
 
     def case(self, case: str) -> CaseFolder:
         """The case folder ``<out>/<case>/``."""
@@ -232,7 +220,8 @@ def read_ranking_csv(path: Path) -> list[dict[str, str]]:
     """
     columns = RANKING_COLUMNS + RANKING_HAZARD_COLUMNS
     added = _RANKING_ADDED + RANKING_HAZARD_COLUMNS
-    return list(read_table(path, text_schema(RANKING_CSV, columns, added)).rows())
+    schema = text_schema(StudyFolder.ranking_csv.name, columns, added)
+    return list(read_table(path, schema).rows())
 
 
 def write_measures_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
@@ -246,7 +235,8 @@ def read_measures_csv(path: Path) -> list[dict[str, str]]:
     Raises:
         TableError: As :func:`read_ranking_csv`, for :data:`MEASURES_COLUMNS`.
     """
-    return list(read_table(path, text_schema(MEASURES_CSV, MEASURES_COLUMNS)).rows())
+    schema = text_schema(StudyFolder.measures_csv.name, MEASURES_COLUMNS)
+    return list(read_table(path, schema).rows())
 
 
 # --------------------------------------------------------------------------- order_check.json

@@ -1,19 +1,19 @@
-"""A study's runs, read: found under paths, checked to be poolable, grouped by case and VUT,
-each case with its cross-play table (:func:`load_runs`, :func:`group_runs`,
-:func:`case_runs`). Analysing them is :func:`sumo_ayss.modes.analyse_cases`'s."""
+"""A study's runs, read: found under paths, checked to be poolable (the check is
+:func:`sumo_ayss.training.trust.mixing_problems`), grouped by case and VUT, each case with its
+cross-play table (:func:`load_runs`, :func:`group_runs`, :func:`case_runs`). Analysing them is
+:func:`sumo_ayss.modes.analyse_cases`'s."""
 
 from __future__ import annotations
 
-from collections import defaultdict
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from sumo_ayss.cases import case_names
 from sumo_ayss.run_folder.crossplay import CrossplayTables, load_crossplay
-from sumo_ayss.run_folder.layout import CONFIG_YAML, find_run_dirs
+from sumo_ayss.run_folder.layout import RunFolder, find_run_dirs
 from sumo_ayss.run_folder.record import RunRecord, read_run
-from sumo_ayss.training.trust import Training
+from sumo_ayss.training.trust import mixing_problems
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.paths import display_path
 
@@ -23,7 +23,6 @@ __all__ = [
     "case_runs",
     "group_runs",
     "load_runs",
-    "mixing_problems",
 ]
 
 
@@ -54,13 +53,16 @@ def load_runs(paths: Sequence[str | Path]) -> list[RunRecord]:
 
     Raises:
         ConfigError: If ``paths`` is empty, a path is not a folder, no run folder is found,
-            or the runs must not be pooled into one report (:func:`mixing_problems`).
+            or the runs must not be pooled into one report
+            (:func:`sumo_ayss.training.trust.mixing_problems`).
     """
     if not paths:
         raise ConfigError("paths: expected at least one run folder or root")
     run_dirs = find_run_dirs(paths)
     if not run_dirs:
-        raise ConfigError(f"no run folder (with {CONFIG_YAML}) under {list(map(str, paths))}")
+        raise ConfigError(
+            f"no run folder (with {RunFolder.config.name}) under {list(map(str, paths))}"
+        )
     runs = [read_run(d) for d in run_dirs]
     problems = mixing_problems(
         [(r.case, r.vut, r.seed, display_path(r.path, Path.cwd()), r.training) for r in runs]
@@ -107,45 +109,3 @@ def case_of(runs: Sequence[RunRecord]) -> CaseRuns:
     its matrix is :func:`sumo_ayss.analysis.crossplay_scoring.case_matrix`'s."""
     case, by_vut = next(iter(group_runs(runs).items()))
     return CaseRuns(case, by_vut, load_crossplay(by_vut))
-
-
-def mixing_problems(
-    runs: Sequence[tuple[str, str, int | None, str | Path, Training]],
-) -> list[str]:
-    """Sentences naming runs that must not be pooled into one report.
-
-    Args:
-        runs: ``(case, vut, seed, path, training)`` per run.
-
-    Returns:
-        One sentence per duplicate (case, VUT, seed) and per case whose runs have different
-        budgets or configurations (besides VUT and seed); empty when the runs can be pooled.
-    """
-    out = []
-    by_key: dict[tuple[str, str, int | None], list[str | Path]] = defaultdict(list)
-    for case, vut, seed, path, _ in runs:
-        by_key[(case, vut, seed)].append(path)
-    for (case, vut, seed), paths in by_key.items():
-        if len(paths) > 1:
-            out.append(
-                f"{case} {vut} seed {seed} appears {len(paths)} times: "
-                + ", ".join(str(p) for p in paths)
-            )
-    by_case: dict[str, dict[tuple[int | None, int | None, str], list[str | Path]]] = defaultdict(
-        lambda: defaultdict(list)
-    )
-    for case, _, _, path, t in runs:
-        by_case[case][(t.total_timesteps, t.eval_every, t.config_key)].append(path)
-    for case, groups in by_case.items():
-        if len(groups) < 2:
-            continue
-        parts = []
-        for (total, every, key), paths in groups.items():
-            parts.append(
-                f"total_timesteps={total}, eval_every={every}, config {key or '?'}: "
-                + ", ".join(str(p) for p in paths)
-            )
-        out.append(
-            f"{case}: runs with different training budgets or configurations — " + "; ".join(parts)
-        )
-    return out

@@ -26,13 +26,14 @@ Imports neither SUMO nor torch.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.jsonio import json_field, json_number, read_json, write_json
+from sumo_ayss.records.jsonio import json_field, json_number, read_json, write_json
 
 __all__ = [
     "AyssRecord",
@@ -67,14 +68,8 @@ class StageHeader:
     spcp_step: int | None
 
     def as_dict(self, stage: str) -> dict[str, Any]:
-        return {
-            "stage": stage,
-            "run_dir": self.run_dir,
-            "case": self.case,
-            "vut": self.vut,
-            "train_seed": self.train_seed,
-            "spcp_step": self.spcp_step,
-        }
+        """The header's fields and ``stage`` (the file's keys are sorted when written)."""
+        return {"stage": stage, **dataclasses.asdict(self)}
 
 
 @dataclass(frozen=True)

@@ -56,7 +56,8 @@ from sumo_ayss.envs.car_following import target_speed_mps as cf_target_speed_mps
 from sumo_ayss.envs.cut_in import LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.run_folder import AYSS_SCHEMA, Table
+from sumo_ayss.records.table import Table
+from sumo_ayss.run_folder import AYSS_SCHEMA
 from sumo_ayss.scenarios.outcome import MeanInterval
 from sumo_ayss.scenarios.rollout import Policy
 from sumo_ayss.sim.actuator import pov_acceleration

@@ -19,7 +19,7 @@ from tqdm import tqdm
 from sumo_ayss.cases.lead_and_cut_in import INDICATOR_COLUMN
 from sumo_ayss.envs.lead_and_cut_in import LeadAndCutInEnv, TwoPovStart
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.run_folder import Table
+from sumo_ayss.records.table import Table
 from sumo_ayss.scenarios.ayss import ayss_rows_table
 from sumo_ayss.util.errors import SimulationError
 

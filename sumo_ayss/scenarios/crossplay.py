@@ -44,7 +44,8 @@ from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.config import EnvConfig
 from sumo_ayss.envs.odd import scenario_set, with_followers
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, DiagonalCheck, Table, table_from_rows
+from sumo_ayss.records.table import Table, table_from_rows
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, DiagonalCheck
 from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
 from sumo_ayss.scenarios.rollout import Policy, run_episodes
 from sumo_ayss.util.errors import ConfigError, DiagonalMismatchError

@@ -36,7 +36,8 @@ from sumo_ayss.analysis.stats import mean_ci, wilson_interval
 from sumo_ayss.cases import get_case
 from sumo_ayss.envs.odd import InitialCondition, scenario_set, with_followers
 from sumo_ayss.envs.pair_env import PairEnv
-from sumo_ayss.run_folder import OUTCOME_SCHEMA, Table
+from sumo_ayss.records.table import Table
+from sumo_ayss.run_folder import OUTCOME_SCHEMA
 from sumo_ayss.scenarios.rollout import EpisodeResult, Policy, measure_columns, run_episode
 from sumo_ayss.util.errors import ConfigError
 

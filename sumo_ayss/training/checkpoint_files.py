@@ -5,7 +5,7 @@
 checkpoint also holds the resume state (:data:`RESUME_FILES`, :data:`STATE_JSON`,
 :data:`TORCH_RNG_PT`), and ``checkpoints/latest.json`` (:data:`LATEST_JSON`, written last)
 names it. This module holds those names and the one writer and reader of the two JSON files
-(through :func:`sumo_ayss.run_folder.jsonio.read_json`, raising
+(through :func:`sumo_ayss.records.jsonio.read_json`, raising
 :class:`~sumo_ayss.util.errors.CheckpointError` naming the file and the field); the SB3/torch
 serialisation is :mod:`sumo_ayss.training.checkpoint`. Imports neither SUMO nor torch.
 """
@@ -16,7 +16,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder.jsonio import json_field, read_json
+from sumo_ayss.records.jsonio import json_field, read_json
 from sumo_ayss.util.atomic import atomic_write_json
 from sumo_ayss.util.errors import CheckpointError
 

@@ -10,6 +10,11 @@ at its top, the pipeline and ``rank`` print them on the terminal.
   improving), the last candidate's mean evaluation reward is within :data:`NOISE_SE`
   standard errors of the SPCP's (a plateau: the SPCP is one of several candidates equal
   within noise), or it is clearly below (the curve peaked earlier).
+- :func:`all_same` — a run whose SPCP candidates all scored the same (the choice of SPCP is
+  arbitrary: one line of its problems, :func:`sumo_ayss.run_folder.read_run`);
+  :func:`mixing_problems` — runs that must not be pooled into one report (a run twice, or
+  one case's runs at different budgets or configurations;
+  :func:`sumo_ayss.run_folder.load_runs` refuses them).
 - :func:`trust_warnings` — sentences for the top of a report (and the terminal) when the
   budget is below :data:`TRUSTED_TIMESTEPS`, the seeds too few for it (no named budget of
   :mod:`sumo_ayss.config.budget` covers the protocol), or SPCPs may still be improving at
@@ -22,10 +27,14 @@ Imports neither SUMO nor torch.
 from __future__ import annotations
 
 import math
-from collections import Counter
+from collections import Counter, defaultdict
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
 
 from sumo_ayss.config.budget import BUDGETS, Budget
 
@@ -82,6 +91,68 @@ def training_of(
         gap = diff / se if se > 0 else (0.0 if diff == 0 else math.inf)
     improving = int(last["step"]) == spcp_step
     return Training(total, every, key, len(rows), spcp_step, int(last["step"]), gap, improving)
+
+
+def all_same(returns: NDArray[np.float64], no_signal: tuple[str, float] | None) -> str | None:
+    """A sentence (after the file's name) when two or more SPCP candidates all scored exactly
+    the same: their mean reward in ``eval.csv`` (``returns``), or the selection's criterion
+    and score as ``spcp.json`` records it when it found no signal (``no_signal``; None when it
+    did, or without the file). The opponent's actions changed nothing it is paid for (e.g. an
+    ODD that pins the VUT's speed at 0), so which one is the SPCP is arbitrary; None
+    otherwise."""
+    if returns.size >= 2 and np.all(returns == returns[0]):
+        what, value, n = "mean reward", float(returns[0]), f" {returns.size}"
+    elif no_signal is not None:
+        (what, value), n = no_signal, ""
+    else:
+        return None
+    return (
+        f"all{n} SPCP candidates scored exactly the same {what} ({value:.4f}): "
+        "the opponent's actions changed nothing it is paid for (e.g. an ODD that pins the "
+        "VUT's speed), so the SPCP is an arbitrary candidate and its scores carry no signal"
+    )
+
+
+def mixing_problems(
+    runs: Sequence[tuple[str, str, int | None, str | Path, Training]],
+) -> list[str]:
+    """Sentences naming runs that must not be pooled into one report.
+
+    Args:
+        runs: ``(case, vut, seed, path, training)`` per run.
+
+    Returns:
+        One sentence per duplicate (case, VUT, seed) and per case whose runs have different
+        budgets or configurations (besides VUT and seed); empty when the runs can be pooled.
+    """
+    out = []
+    by_key: dict[tuple[str, str, int | None], list[str | Path]] = defaultdict(list)
+    for case, vut, seed, path, _ in runs:
+        by_key[(case, vut, seed)].append(path)
+    for (case, vut, seed), paths in by_key.items():
+        if len(paths) > 1:
+            out.append(
+                f"{case} {vut} seed {seed} appears {len(paths)} times: "
+                + ", ".join(str(p) for p in paths)
+            )
+    by_case: dict[str, dict[tuple[int | None, int | None, str], list[str | Path]]] = defaultdict(
+        lambda: defaultdict(list)
+    )
+    for case, _, _, path, t in runs:
+        by_case[case][(t.total_timesteps, t.eval_every, t.config_key)].append(path)
+    for case, groups in by_case.items():
+        if len(groups) < 2:
+            continue
+        parts = []
+        for (total, every, key), paths in groups.items():
+            parts.append(
+                f"total_timesteps={total}, eval_every={every}, config {key or '?'}: "
+                + ", ".join(str(p) for p in paths)
+            )
+        out.append(
+            f"{case}: runs with different training budgets or configurations — " + "; ".join(parts)
+        )
+    return out
 
 
 TRUSTED_TIMESTEPS = min(b.total_timesteps for b in BUDGETS.values())

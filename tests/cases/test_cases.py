@@ -33,7 +33,8 @@ from sumo_ayss.config import (
     PipelineConfig,
     SimConfig,
 )
-from sumo_ayss.run_folder import AYSS_SCHEMA, RunFolder, Table, write_table
+from sumo_ayss.records.table import Table, write_table
+from sumo_ayss.run_folder import AYSS_SCHEMA, RunFolder
 from sumo_ayss.util.errors import ConfigError
 
 BUILTIN = ("car_following", "cut_in", "lead_and_cut_in")

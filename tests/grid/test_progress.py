@@ -12,7 +12,6 @@ import pytest
 from sumo_ayss.config import ExperimentConfig, TrainConfig
 from sumo_ayss.grid.progress import GridProgress, JobStatus, format_duration
 from sumo_ayss.run_folder import RunFolder, read_run, write_eval_table, write_progress
-from sumo_ayss.run_folder.layout import PROGRESS_JSON
 
 
 @dataclass(frozen=True)
@@ -74,7 +73,7 @@ def test_events_from_run_folder_files(tmp_path: Path) -> None:
 def test_stale_progress_file_of_an_earlier_invocation_is_ignored(tmp_path: Path) -> None:
     [job] = _grid(tmp_path, 1)
     _write(
-        job.spec.run_dir / PROGRESS_JSON,
+        RunFolder(job.spec.run_dir).progress,
         {"stage": "train", "time": 0.0, "step": 9000, "rate_steps_per_s": 1.0},
     )
     job.start()

@@ -21,6 +21,7 @@ import yaml
 
 from sumo_ayss.config import AyssConfig, load_experiment
 from sumo_ayss.evaluate import evaluate_run
+from sumo_ayss.records.table import read_table
 from sumo_ayss.replay import (
     POSITION_TOL_M,
     SPEED_TOL_MPS,
@@ -28,7 +29,7 @@ from sumo_ayss.replay import (
     main,
     replay_headless,
 )
-from sumo_ayss.run_folder import AYSS_SCHEMA, OUTCOME_SCHEMA, read_table
+from sumo_ayss.run_folder import AYSS_SCHEMA, OUTCOME_SCHEMA
 from sumo_ayss.sim.export import read_fcd
 from sumo_ayss.train import train
 from sumo_ayss.util.errors import ConfigError

@@ -13,9 +13,10 @@ import yaml
 
 from sumo_ayss.config import AyssConfig
 from sumo_ayss.evaluate import evaluate_run
+from sumo_ayss.records.table import read_table
 from sumo_ayss.replay import export_scenario, replay_headless
 from sumo_ayss.replay.xosc import XOSC_FILE, export_xosc
-from sumo_ayss.run_folder import OUTCOME_SCHEMA, read_table
+from sumo_ayss.run_folder import OUTCOME_SCHEMA
 from sumo_ayss.sim.export import read_fcd
 
 pytestmark = pytest.mark.sumo

@@ -18,9 +18,10 @@ from lxml import etree
 
 from sumo_ayss.config import AyssConfig, load_experiment
 from sumo_ayss.evaluate import evaluate_run
+from sumo_ayss.records.table import read_table
 from sumo_ayss.replay import main
 from sumo_ayss.replay.xosc import OVERHANG_M, XODR_FILE, XOSC_FILE, export_xosc
-from sumo_ayss.run_folder import OUTCOME_SCHEMA, read_table
+from sumo_ayss.run_folder import OUTCOME_SCHEMA
 from sumo_ayss.train import train
 from tests.helpers import tiny_experiment
 

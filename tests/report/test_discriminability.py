@@ -17,7 +17,6 @@ from sumo_ayss.report.sections.discriminability import (
     read_record,
 )
 from sumo_ayss.run_folder import CaseFolder
-from sumo_ayss.run_folder.layout import DISCRIMINABILITY_JSON
 from tests.report.test_report import FAST, make_run
 
 
@@ -84,7 +83,7 @@ def test_report_shows_the_section_when_a_record_is_beside_the_runs(tmp_path: Pat
             make_run(root, "car_following", vut, seed, n_samples=60)
     html_path = write_report([root], tmp_path / "r0", options=FAST)
     assert "not computed for these vuts" in html_path.read_text(encoding="utf-8").lower()
-    (root / "car_following" / DISCRIMINABILITY_JSON).write_text(json.dumps(_record()))
+    (CaseFolder(root / "car_following").discriminability_json).write_text(json.dumps(_record()))
     html_path = write_report([root], tmp_path / "r1", options=FAST)
     html = html_path.read_text(encoding="utf-8")
     assert "(h) Discriminability before training" in html

@@ -9,10 +9,10 @@ import numpy as np
 
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.rank import analyse
+from sumo_ayss.records.table import Table, read_table, write_table
 from sumo_ayss.report import write_report
 from sumo_ayss.report.measures import write_measures
-from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA, Table, read_table, write_table
-from sumo_ayss.run_folder.study import MEASURES_CSV
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA, StudyFolder
 from tests.report.test_report import FAST, make_crossplay, make_run
 
 
@@ -60,7 +60,7 @@ def test_measures_csv(tmp_path: Path) -> None:
     root = _study(tmp_path / "runs", measures=True)
     analyses = analyse(sorted(root.glob("car_following/*/seed_*")), FAST)
     path = write_measures(tmp_path, analyses)
-    assert path == tmp_path / MEASURES_CSV
+    assert path == StudyFolder(tmp_path).measures_csv
     rows = list(csv.DictReader(path.open()))
     ttc = {r["vut"]: r for r in rows if r["measure"] == "min_ttc_s"}
     assert (ttc["pi2"]["rank"], ttc["pi1"]["rank"]) == ("1", "2")

@@ -20,6 +20,7 @@ from sumo_ayss.config import RewardConfig, to_dict
 from sumo_ayss.modes import headline_text
 from sumo_ayss.modes.crossplay import crossplay_gap_text, crossplay_result
 from sumo_ayss.modes.paper import pair_sentence
+from sumo_ayss.records.table import Table, write_table
 from sumo_ayss.report import (
     ReportOptions,
     pair_verdict,
@@ -35,17 +36,14 @@ from sumo_ayss.run_folder import (
     RunConfig,
     RunFolder,
     StageHeader,
-    Table,
     find_run_dirs,
     read_run,
     write_eval_table,
     write_outcome_json,
     write_run_config,
     write_spcp,
-    write_table,
 )
 from sumo_ayss.run_folder.crossplay import load_crossplay
-from sumo_ayss.run_folder.layout import AYSS_CSV, EVAL_CSV, OUTCOME_JSON
 from sumo_ayss.run_folder.metadata import write_versions
 from sumo_ayss.scenarios.outcome import MeanInterval, OutcomeSummary, Proportion
 from sumo_ayss.training.selection import Selection
@@ -366,7 +364,7 @@ def test_outcome_reader_refuses_shapes_no_writer_produces(tmp_path: Path) -> Non
         "lane_change_rate": 0.98,
         "mean_return": {"value": 20.1, "lo": 19.9, "hi": 20.3},
     }
-    (run_dir / OUTCOME_JSON).write_text(json.dumps(outcome))
+    (RunFolder(run_dir).outcome_json).write_text(json.dumps(outcome))
     run = read_run(run_dir)
     assert run.outcome is None
     text = " | ".join(run.problems)
@@ -377,9 +375,9 @@ def test_outcome_reader_refuses_shapes_no_writer_produces(tmp_path: Path) -> Non
 
 def test_unreadable_files_are_reported_not_fatal(tmp_path: Path) -> None:
     run_dir = make_run(tmp_path, "car_following", "pi1", 0, files=())
-    (run_dir / OUTCOME_JSON).write_text("{not json")
-    (run_dir / AYSS_CSV).write_text("h_m,indicator,indicator_name\n1.0,-2.0,x\nnan,1,x\n")
-    (run_dir / EVAL_CSV).write_text("step,other\n1,2\n")
+    (RunFolder(run_dir).outcome_json).write_text("{not json")
+    (RunFolder(run_dir).ayss_csv).write_text("h_m,indicator,indicator_name\n1.0,-2.0,x\nnan,1,x\n")
+    (RunFolder(run_dir).eval_table).write_text("step,other\n1,2\n")
     run = read_run(run_dir)
     assert run.case == "car_following" and run.vut == "pi1" and run.seed == 0
     assert run.outcome is None and run.eval_curve is None and run.ayss is None
@@ -391,7 +389,7 @@ def test_unreadable_files_are_reported_not_fatal(tmp_path: Path) -> None:
 
 def test_ayss_of_the_other_case_is_reported(tmp_path: Path) -> None:
     run_dir = make_run(tmp_path, "car_following", "pi1", 0, files=("config",))
-    _write_ayss(run_dir / AYSS_CSV, "cut_in", "pi1", np.random.default_rng(0), 10)
+    _write_ayss(RunFolder(run_dir).ayss_csv, "cut_in", "pi1", np.random.default_rng(0), 10)
     run = read_run(run_dir)
     assert run.ayss is not None and len(run.ayss) == 10
     assert any("belongs to cut_in, not car_following" in p for p in run.problems)

@@ -16,9 +16,12 @@ import numpy as np
 import pytest
 import yaml
 
+from sumo_ayss.analysis import ayss_cells as analysis_cells
 from sumo_ayss.analysis.ayss_cells import (
     binned_stats_from_cells,
+    cells_of,
     inside_moments,
+    run_cells,
     safety_index_from_cells,
 )
 from sumo_ayss.analysis.case import vut_safety_index
@@ -30,7 +33,8 @@ from sumo_ayss.config import AyssConfig, load_experiment
 from sumo_ayss.config.report import ReportOptions
 from sumo_ayss.evaluate import evaluate_run
 from sumo_ayss.report import figures
-from sumo_ayss.run_folder import ayss_cells, read_run
+from sumo_ayss.run_folder import ayss_bins as stored_cells
+from sumo_ayss.run_folder import read_run
 from sumo_ayss.run_folder.ayss_bins import AyssCells, read_ayss_bins, write_ayss_bins
 from sumo_ayss.train import train
 from sumo_ayss.util.errors import ConfigError
@@ -54,8 +58,8 @@ def _close(a: np.ndarray, b: np.ndarray) -> None:
 
 def test_cells_give_the_figures_bins_and_the_safety_index_of_the_samples() -> None:
     seeds = [_samples(s) for s in range(3)]
-    cells = [ayss_cells(h, y, "pov_accel_mps2") for h, y in seeds]
-    assert [len(c) for c in cells] == [len(h) for h, _ in seeds]
+    cells = [cells_of(h, y) for h, y in seeds]
+    assert [int(c.n.sum()) for c in cells] == [len(h) for h, _ in seeds]
     for (h, y), c in zip(seeds, cells, strict=True):
         a, b = binned_mean_ci(h, y, REPORT_EDGES), binned_stats_from_cells([c], REPORT_EDGES)
         assert np.array_equal(a.counts, b.counts)
@@ -88,9 +92,15 @@ def test_cells_give_the_figures_bins_and_the_safety_index_of_the_samples() -> No
     assert _moments_cohens_d((n, m, s), moments_b) == pytest.approx(cohens_d(-ya, -yb), RTOL)
 
 
+def test_the_reduction_and_the_file_share_one_lattice() -> None:
+    """The analysis reduces on the lattice the reader checks (storage imports no analysis)."""
+    assert analysis_cells.CELL_WIDTH_M == stored_cells.CELL_WIDTH_M == 1.0 / 32.0
+
+
 def test_a_grid_off_the_cells_lattice_is_refused(tmp_path: Path) -> None:
     h, y = _samples(0)
-    cells = ayss_cells(h, y, "pov_accel_mps2")
+    c = cells_of(h, y)
+    cells = AyssCells(c.h_low_m, c.h_high_m, c.n, c.mean, c.m2, "pov_accel_mps2")
     with pytest.raises(ConfigError, match="lattice"):
         binned_stats_from_cells([cells], np.arange(0.0, 5.01, 0.3))
     write_ayss_bins(tmp_path / "ayss_bins.csv", cells)
@@ -121,7 +131,8 @@ def test_a_run_with_only_ayss_bins_reads_and_draws_as_with_its_samples(
     summary = read_run(only_bins)
     assert summary.ayss is None and isinstance(summary.ayss_bins, AyssCells)
     assert not any("ayss.csv" in p for p in summary.problems)
-    assert summary.ayss_cells is not None and len(summary.ayss_cells) == len(with_samples.ayss)
+    cells = run_cells(summary)
+    assert cells is not None and int(cells.n.sum()) == len(with_samples.ayss)
 
     # the figures' data: bands between seeds and the pooled bins
     a_bands, a_pooled = figures._vut_bins([with_samples], REPORT_EDGES, 0.95)

@@ -11,8 +11,7 @@ import pytest
 import yaml
 
 from sumo_ayss.analysis.harm import harm_scale_of, run_episodes
-from sumo_ayss.run_folder import RunRecord, read_run
-from sumo_ayss.run_folder.layout import OUTCOME_CSV
+from sumo_ayss.run_folder import RunFolder, RunRecord, read_run
 from sumo_ayss.util.errors import CheckpointError
 from tests.report.test_report import make_run
 
@@ -39,7 +38,8 @@ def test_missing_files_are_problems_and_the_stages_get_an_error(tmp_path: Path) 
     run = read_run(bare)
     assert (run.case, run.vut, run.seed) == ("cut_in", "pi1", 0)  # from the folder path
     assert run.problems[0].startswith("config.yaml missing")
-    assert not any(p.startswith(OUTCOME_CSV) for p in run.problems)  # no harm scale to use
+    outcome_csv = RunFolder.outcome_csv.name
+    assert not any(p.startswith(outcome_csv) for p in run.problems)  # no harm scale to use
     with pytest.raises(CheckpointError, match=r"seed_0: not a run folder \(no config\.yaml\)"):
         run.experiment  # noqa: B018
     with pytest.raises(CheckpointError, match="not a run folder"):
@@ -47,7 +47,9 @@ def test_missing_files_are_problems_and_the_stages_get_an_error(tmp_path: Path) 
     (bare / "config.yaml").write_text("seed: 0\nenv: {case: cut_in, vut: pi1}\nagent: {gamma: 7}\n")
     run = read_run(bare)
     assert run.config is not None and run.seed == 0
-    assert f"{OUTCOME_CSV} missing" in run.problems  # scorable now, so its absence counts
+    assert (
+        f"{RunFolder.outcome_csv.name} missing" in run.problems
+    )  # scorable now, so its absence counts
     with pytest.raises(CheckpointError, match=r"config\.yaml: invalid run configuration: .*gamma"):
         run.experiment  # noqa: B018
     (bare / "config.yaml").write_text("seed: [\n")
@@ -97,7 +99,7 @@ def test_a_cut_in_whose_odd_pins_the_vut_at_rest_is_a_problem_of_its_record(
     path.write_text(yaml.safe_dump(exp))
     train(load_experiment(path), seed=0, out=tmp_path / "runs")
     run = read_run(tmp_path / "runs" / "cut_in" / "pi1" / "seed_0")
-    assert run.eval_curve is not None and set(run.eval_curve.mean_return.tolist()) == {0.0}
+    assert run.eval_curve is not None and set(run.eval_curve["mean_return"].tolist()) == {0.0}
     same = [p for p in run.problems if "scored exactly the same" in p]
     assert same == [
         "eval.csv: all 3 SPCP candidates scored exactly the same mean reward (0.0000): the "

@@ -13,6 +13,7 @@ import yaml
 
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
 from sumo_ayss.config import RewardConfig, to_dict
+from sumo_ayss.records.table import Table, read_table, write_table
 from sumo_ayss.run_folder import (
     AYSS_SCHEMA,
     CROSSPLAY_SCHEMA,
@@ -25,7 +26,6 @@ from sumo_ayss.run_folder import (
     Seeds,
     StageHeader,
     StudyFolder,
-    Table,
     find_run_dirs,
     read_ayss_json,
     read_crossplay_json,
@@ -35,7 +35,6 @@ from sumo_ayss.run_folder import (
     read_progress,
     read_run,
     read_run_config,
-    read_table,
     write_ayss_json,
     write_crossplay_json,
     write_done_marker,
@@ -45,7 +44,6 @@ from sumo_ayss.run_folder import (
     write_provenance,
     write_run_config,
     write_spcp,
-    write_table,
 )
 from sumo_ayss.run_folder.metadata import (
     read_command,
@@ -225,8 +223,8 @@ def test_report_loads_what_the_writers_wrote(run_folder: RunFolder, tmp_path: Pa
     assert (run.case, run.vut, run.seed) == ("cut_in", "pi2", 3)
     assert run.reward == RewardConfig() and run.vut_description
     assert run.versions == {"python": "3.11.2", "numpy": "2.0.0"}
-    assert run.eval_curve is not None and run.eval_curve.step.tolist() == [5000, 10000]
-    assert run.eval_curve.mean_return.tolist() == [10.0, 11.0]
+    assert run.eval_curve is not None and run.eval_curve["step"].tolist() == [5000, 10000]
+    assert run.eval_curve["mean_return"].tolist() == [10.0, 11.0]
     assert run.spcp is not None and run.spcp.step == 10000
     assert run.outcome is not None and run.outcome.crash_rate.value == 0.105
     assert run.outcome.lane_change_no_collision is not None

@@ -13,7 +13,8 @@ from sumo_ayss.config import ActuatorConfig, AyssConfig
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.cut_in import FIRST_SPEED_ACTION, LANE_CHANGE, CutInEnv
 from sumo_ayss.envs.odd import InitialCondition
-from sumo_ayss.run_folder import AYSS_SCHEMA, read_table, write_table
+from sumo_ayss.records.table import read_table, write_table
+from sumo_ayss.run_folder import AYSS_SCHEMA
 from sumo_ayss.scenarios.ayss import (
     car_following_indicator,
     cut_in_mask,

@@ -15,7 +15,8 @@ from sumo_ayss.config import AyssConfig, EnvConfig, OddConfig, load_experiment
 from sumo_ayss.crossplay import main
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.evaluate import evaluate_run
-from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, case_of, read_run, table_from_rows
+from sumo_ayss.records.table import table_from_rows
+from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, case_of, read_run
 from sumo_ayss.scenarios.crossplay import (
     DIAGONAL_COLUMNS,
     Opponent,

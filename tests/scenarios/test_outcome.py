@@ -17,12 +17,8 @@ from sumo_ayss.config import AyssConfig, load_experiment
 from sumo_ayss.envs.car_following import CarFollowingEnv
 from sumo_ayss.envs.odd import sample_initial_conditions
 from sumo_ayss.evaluate import evaluate_run, main
-from sumo_ayss.run_folder import (
-    AYSS_SCHEMA,
-    OUTCOME_SCHEMA,
-    read_table,
-    table_from_rows,
-)
+from sumo_ayss.records.table import read_table, table_from_rows
+from sumo_ayss.run_folder import AYSS_SCHEMA, OUTCOME_SCHEMA
 from sumo_ayss.scenarios.outcome import (
     MeanInterval,
     Proportion,

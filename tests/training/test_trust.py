@@ -17,7 +17,13 @@ from sumo_ayss.run_folder import (
     write_spcp,
 )
 from sumo_ayss.training.selection import Selection
-from sumo_ayss.training.trust import Training, fewest_seeds, training_status, trust_warnings
+from sumo_ayss.training.trust import (
+    Training,
+    fewest_seeds,
+    mixing_problems,
+    training_status,
+    trust_warnings,
+)
 from sumo_ayss.util.errors import ConfigError
 from tests.report.test_report import FAST, make_run
 
@@ -159,3 +165,16 @@ def test_unvalidated_budget_still_warns_about_improving_spcps() -> None:
     assert warnings[0].startswith("Few training seeds")
     assert "more training could change them" in warnings[-1]
     assert trust_warnings([("a", improving)], seeds_per_vut=4) == []
+
+
+def test_runs_that_must_not_be_pooled_are_named() -> None:
+    t = Training(total_timesteps=1000, eval_every=500, config_key="k")
+    ok = [("car_following", v, s, f"{v}/{s}", t) for v in ("pi1", "pi2") for s in (0, 1)]
+    assert mixing_problems(ok) == []
+    twice = [*ok, ("car_following", "pi1", 0, "elsewhere/pi1/0", t)]
+    assert mixing_problems(twice) == [
+        "car_following pi1 seed 0 appears 2 times: pi1/0, elsewhere/pi1/0"
+    ]
+    other = Training(total_timesteps=2000, eval_every=500, config_key="k")
+    budgets = mixing_problems([*ok, ("car_following", "pi3", 0, "pi3/0", other)])
+    assert len(budgets) == 1 and "different training budgets" in budgets[0]

@@ -11,16 +11,9 @@ import pytest
 
 from sumo_ayss.analysis.hazards import HAZARD_NAMES
 from sumo_ayss.analysis.safety_measures import MEASURE_NAMES
-from sumo_ayss.run_folder import (
-    AYSS_SCHEMA,
-    OUTCOME_SCHEMA,
-    Table,
-    read_table,
-    table_from_rows,
-    write_table,
-)
-from sumo_ayss.run_folder.jsonio import read_json, write_json
-from sumo_ayss.run_folder.table import schema_markdown
+from sumo_ayss.records.jsonio import read_json, write_json
+from sumo_ayss.records.table import Table, read_table, schema_markdown, table_from_rows, write_table
+from sumo_ayss.run_folder import AYSS_SCHEMA, OUTCOME_SCHEMA
 from sumo_ayss.util.errors import AyssError, TableError
 
 

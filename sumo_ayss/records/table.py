@@ -16,13 +16,15 @@ Every column has a name, a dtype, a unit and a meaning (:class:`Column`);
 :func:`write_table` writes atomically (temporary file in the same folder, then
 :func:`os.replace`), so a reader never sees half a table; :func:`write_rows` writes rows of
 Python values under a header (the study files, ``eval.csv``, ``discriminability.csv``).
-:func:`read_table` is the one CSV reader of the run folder: it checks the header (missing and
+:func:`read_table` is the one CSV reader of the package: it checks the header (missing and
 extra columns), every cell's dtype, NaN / inf where they are not allowed, and the choices,
 and raises a :class:`~sumo_ayss.util.errors.StoredFileError` (:class:`TableError` unless the
 caller names another, e.g. ``eval.csv``'s :class:`CheckpointError`) naming the file, column
 and row.
 
-The schemas of the run folder's tables are in :mod:`sumo_ayss.run_folder.schemas`.
+Nothing here knows a file: the schemas of the run folder's tables are in
+:mod:`sumo_ayss.run_folder.schemas` (and ``eval.csv``'s in
+:mod:`sumo_ayss.run_folder.eval_table`, the study files' in :mod:`sumo_ayss.run_folder.study`).
 """
 
 from __future__ import annotations
@@ -348,7 +350,7 @@ def read_table(
     error: type[StoredFileError] = TableError,
     skip_bad_rows: bool = False,
 ) -> Table:
-    """Read a CSV file of the run folder and validate it against ``schema``: the one reader.
+    """Read a CSV file and validate it against ``schema``: the one CSV reader.
 
     Args:
         path: The CSV file.

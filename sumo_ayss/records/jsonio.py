@@ -1,10 +1,11 @@
-"""JSON summaries of the run folder (``outcome.json``, ``ayss.json``): strict JSON, one
-writer, one reader.
+"""Stored JSON objects: strict JSON, one writer, one reader.
 
-:func:`read_json` is the one JSON reader of :mod:`sumo_ayss.run_folder` and
-:func:`json_field` its one field check: every stored JSON file is read through them, and every
-error they raise names the file and the field (:class:`~sumo_ayss.util.errors.StoredFileError`,
-the common base of the ``TableError`` and ``CheckpointError`` callers catch).
+:func:`read_json` is the one JSON reader of the package and :func:`json_field` its one field
+check: every stored JSON file (the run folder's summaries and records,
+:mod:`sumo_ayss.run_folder`; the checkpoints' own, :mod:`sumo_ayss.training.checkpoint_files`)
+is read through them, and every error they raise names the file and the field
+(:class:`~sumo_ayss.util.errors.StoredFileError`, the common base of the ``TableError`` and
+``CheckpointError`` callers catch). Nothing here knows a file.
 
 Non-finite floats are written as ``null`` (strict JSON has no NaN); numpy scalars and arrays
 become Python numbers and lists; paths become strings. Files are indented, key-sorted and
@@ -58,7 +59,7 @@ def write_json(path: str | Path, data: Mapping[str, Any]) -> None:
 
 
 def read_json(path: str | Path, *, error: type[StoredFileError] = TableError) -> dict[str, Any]:
-    """Read a JSON object from a stored file: the one JSON reader of the run folder.
+    """Read a JSON object from a stored file: the one JSON reader.
 
     Args:
         path: The file.
