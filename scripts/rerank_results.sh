@@ -50,7 +50,7 @@ rank configs/overbraking.yaml --out results/overbraking  # issue 33
 # issue 33: the default-budget ladders re-run with the follower (results/follower_ladders/README.md)
 for study in braking reaction acc_time_gap min_gap; do
   if [ -d "results/follower_ladders/$study" ]; then
-    rank "configs/ladders/$study.yaml" --budget verdict20k --seeds 401 402 403 404 --max-seeds 4 \
+    rank "configs/ladders/$study.yaml" --budget verdict --seeds 401 402 403 404 --max-seeds 4 \
       --out "results/follower_ladders/$study"
   fi
 done

@@ -73,18 +73,10 @@ class Budget:
 BUDGETS: Mapping[str, Budget] = MappingProxyType(
     {
         "verdict": Budget(
-            10_000,
-            5_000,
-            5,
-            "the least compute that ordered every validation ladder right (docs/performance.md)",
-            n_ayss=20_000,
-            max_seeds=7,
-        ),
-        "verdict20k": Budget(
             20_000,
             5_000,
             4,
-            "the default of sessions 6 to 11, what the studies that named 'verdict' then ran",
+            "the least compute that ordered every validation ladder right (docs/performance.md)",
             n_ayss=20_000,
             max_seeds=6,
         ),

@@ -100,30 +100,6 @@ def test_committed_studies_still_train_what_they_ran(config: str) -> None:
     assert seeds == tuple(sorted(yaml.safe_load(path.read_text())["grid"]["seeds"]))
 
 
-@pytest.mark.parametrize(
-    "config",
-    [
-        "overbraking.yaml",
-        "ladders/careful_human.yaml",
-        "ladders/braking_lead_and_cut_in.yaml",
-        "ladders/braking_lead_and_cut_in_penalty.yaml",
-        "ladders/braking_lead_and_cut_in_safe.yaml",
-        "ladders/acc_time_gap_lead_and_cut_in.yaml",
-    ],
-)
-def test_studies_of_the_earlier_default_still_train_what_they_ran(config: str) -> None:
-    """They ran at the default of sessions 6-11 (20,000 transitions, a candidate every
-    5,000, 4 seeds adaptive to 6), now the named budget ``verdict20k``."""
-    path = PROJECT_ROOT / "configs" / config
-    cfg = load_pipeline(path)
-    total, every, seeds = _trained(path)
-    assert (total, every) == ({20_000}, {5_000})
-    named = yaml.safe_load(path.read_text())["grid"].get("seeds")
-    assert seeds == (tuple(sorted(named)) if named else (0, 1, 2, 3))
-    if not named:
-        assert cfg.max_seeds == 6
-
-
 def test_the_verdict_budget_draws_fewer_ayss_samples_unless_told(tmp_path: Path) -> None:
     verdict = load_pipeline(_yaml(tmp_path))
     assert verdict.evaluate.ayss.n_samples == BUDGETS["verdict"].n_ayss == 20_000
@@ -139,14 +115,14 @@ def test_adaptive_seeding_cap_comes_with_the_budgets_seeds_only(tmp_path: Path) 
     max_seeds is given; a cap below the seeds is refused by name."""
     path = _yaml(tmp_path)
     cfg = load_pipeline(path)
-    assert cfg.seeds == (0, 1, 2, 3, 4) and cfg.max_seeds == BUDGETS["verdict"].max_seeds == 7
-    assert cfg.added_seeds == (5, 6)
+    assert cfg.seeds == (0, 1, 2, 3) and cfg.max_seeds == BUDGETS["verdict"].max_seeds == 6
+    assert cfg.added_seeds == (4, 5)
     fixed = load_pipeline(path, seeds=[401, 402, 403, 404])
     assert fixed.max_seeds == 4 and fixed.added_seeds == ()
     grown = load_pipeline(path, seeds=[401, 402, 403, 404], max_seeds=6)
     assert grown.added_seeds == (405, 406)
     assert load_pipeline(path, budget="paper").added_seeds == ()
-    with pytest.raises(ConfigError, match=r"max_seeds must be an integer from the 5 seeds"):
+    with pytest.raises(ConfigError, match=r"max_seeds must be an integer from the 4 seeds"):
         load_pipeline(path, max_seeds=3)
     assert (
         load_pipeline(
