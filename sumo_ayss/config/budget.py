@@ -16,6 +16,13 @@ every experiment's ``train`` section as its file says (the behaviour before budg
   four seeds (minGap, car-following: p 0.11); adaptive seeding settled it at five (p 0.037).
   The AYSS draws feed only the paper's reading (``report.mode: paper``), not the cross-play
   verdict; that reading wants the paper budget.
+* ``quick``: 10,000 transitions per run, a candidate every 5,000, five seeds per VUT to start
+  with, adaptive up to seven, 20,000 AYSS draws: about 0.6 of ``verdict``'s training
+  transitions. Chosen from the frontier (issue 40): on fresh seeds it ordered every ladder as
+  ``verdict`` does (τ = 1 where the known order is recovered, the known ends significant),
+  but its leaderboard tells fewer adjacent VUTs apart (braking and minGap car-following: none
+  under Holm, where ``verdict`` tells all): faster, weaker claims; not the default
+  (docs/performance.md, results/budget_validation/).
 * ``paper``: the paper's protocol, 100,000 transitions, a candidate every 10,000, three
   seeds: what every committed study before budgets ran.
 
@@ -79,6 +86,15 @@ BUDGETS: Mapping[str, Budget] = MappingProxyType(
             "the least compute that ordered every validation ladder right (docs/performance.md)",
             n_ayss=20_000,
             max_seeds=6,
+        ),
+        "quick": Budget(
+            10_000,
+            5_000,
+            5,
+            "half the transitions, one more seed: every ladder ordered right with the ends "
+            "significant, fewer adjacent pairs told apart (docs/performance.md)",
+            n_ayss=20_000,
+            max_seeds=7,
         ),
         "paper": Budget(100_000, 10_000, 3, "the paper's protocol"),
     }

@@ -132,3 +132,14 @@ def test_adaptive_seeding_cap_comes_with_the_budgets_seeds_only(tmp_path: Path) 
     )
     with pytest.raises(ConfigError, match="max_seeds"):
         load_pipeline(_yaml(tmp_path, max_seeds="six"))
+
+
+def test_the_quick_budget_trains_half_the_transitions_with_one_seed_more(tmp_path: Path) -> None:
+    """``quick`` (issue 40): 10,000 transitions, a candidate every 5,000, seeds 0-4 growing to
+    7 where the ranking has not settled; the default stays ``verdict``."""
+    path = _yaml(tmp_path, budget="quick")
+    assert _trained(path) == ({10_000}, {5_000}, (0, 1, 2, 3, 4))
+    cfg = load_pipeline(path)
+    assert cfg.max_seeds == 7 and cfg.added_seeds == (5, 6)
+    assert cfg.evaluate.ayss.n_samples == 20_000
+    assert _trained(_yaml(tmp_path))[0] == {20_000}  # the default is unchanged

@@ -77,13 +77,14 @@ def test_spcp_state_from_the_learning_curve(tmp_path: Path) -> None:
 def test_small_budget_report_says_so_first(tmp_path: Path) -> None:
     for vut in ("pi1", "pi2"):
         for seed in (0, 1):
-            _set_budget(make_run(tmp_path / "runs", "car_following", vut, seed), 10_000, 5_000)
+            _set_budget(make_run(tmp_path / "runs", "car_following", vut, seed), 5_000, 2_500)
     html = write_report([tmp_path / "runs"], tmp_path / "out", options=FAST)
     md = (tmp_path / "out" / "summary.md").read_text()
     first = md.split("## Verdicts")[0]
-    assert "Small training budget: 10,000 transitions per run" in first
+    assert "Small training budget: 5,000 transitions per run" in first
+    assert "below the 10,000 of the smallest budget" in first  # 'quick' (issue 40)
     assert "NOT to be trusted" in first
-    assert "| total_timesteps | eval_every |" in md and "| 10,000 | 5,000 |" in md
+    assert "| total_timesteps | eval_every |" in md and "| 5,000 | 2,500 |" in md
     assert "NOT to be trusted" in html.read_text()
     assert str(tmp_path) not in md  # run folders relative to the report
     assert "../runs/car_following/pi1/seed_0" in md
@@ -128,6 +129,10 @@ def test_too_few_seeds_for_the_budget_are_named() -> None:
     few = trust_warnings([("a", t20)], seeds_per_vut=2)
     assert len(few) == 1 and few[0].startswith("Few training seeds: 2 per VUT at 20,000")
     assert "4 at 20,000 (verdict)" in few[0] and "3 at 100,000 (paper)" in few[0]
+    assert "5 at 10,000 (quick)" in few[0]
+    t10 = Training(10_000, 5_000, "k", 2, 10_000, 10_000, 0.0, False)
+    assert trust_warnings([("a", t10)], seeds_per_vut=5) == []
+    assert trust_warnings([("a", t10)], seeds_per_vut=4)[0].startswith("Few training seeds")
     assert trust_warnings([("a", t20)], seeds_per_vut=4) == []
     assert trust_warnings([("a", t100)], seeds_per_vut=3) == []
     assert trust_warnings([("a", t100)], seeds_per_vut=2)[0].startswith("Few training seeds")
