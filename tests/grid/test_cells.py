@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import re
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import pytest
@@ -15,9 +16,11 @@ from sumo_ayss.crossplay import case_runs, run_case
 from sumo_ayss.evaluate import evaluate_run
 from sumo_ayss.grid.cells import CellPool, cell_pool
 from sumo_ayss.run_folder import CaseFolder, RunRecord
+from sumo_ayss.scenarios.crossplay import CellDone, CellTask, Opponent, drive_cell, run_crossplay
 from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
 from sumo_ayss.train import train
-from sumo_ayss.util.errors import CheckpointError
+from sumo_ayss.util.errors import CheckpointError, ConfigError
+from sumo_ayss.vuts.controller_spec import controller_imports
 from tests.helpers import tiny_experiment
 
 N = 6
@@ -146,3 +149,36 @@ def test_a_workers_error_is_raised_with_its_type_naming_the_cell(
     assert "not a saved policy" in str(here.value)
     assert "vs SPCP pi2/seed_0: " in str(pooled.value)  # whichever cell met it first
     assert str(pooled.value).split(": ", 1)[1] == str(here.value).split(": ", 1)[1]
+
+
+class _Refuse:
+    """A runner that records the tasks handed to it and drives none."""
+
+    def drive(self, tasks: Sequence[CellTask]) -> Iterator[CellDone]:
+        self.tasks = list(tasks)
+        raise _Handed
+
+
+class _Handed(Exception):
+    pass
+
+
+@pytest.mark.sumo
+def test_a_worker_drives_under_the_callers_trust(tmp_path: Path) -> None:
+    """An untrusted caller's cells carry its trust to the worker, which refuses to run the
+    run folder's controller (as the caller's own process would)."""
+    exp = tmp_path / "exp.yaml"
+    exp.write_text(
+        "env:\n  vut: p\n  vuts:\n    p:\n      process:\n"
+        "        command: [python, client.py]\n        signals: [speed_mps, gap_m]\n"
+        "        max_accel_mps2: 3.0\n        max_decel_mps2: 6.0\n"
+    )
+    cfg = load_experiment(exp).env
+    opponent = Opponent("p", 0, lambda env: None, "sha")
+    runner = _Refuse()
+    with controller_imports(False), pytest.raises(_Handed):
+        run_crossplay({"p": cfg}, [opponent], n=2, seed=1, reference=None, runner=runner)
+    (task,) = runner.tasks
+    assert not task.trusted
+    with pytest.raises(ConfigError, match=r"^cross-play cell p vs SPCP p/seed_0: .*--trust-contr"):
+        drive_cell(task)  # what the worker runs, in a process that trusts by default
