@@ -33,10 +33,9 @@ import functools
 import hashlib
 import logging
 import time
-from collections import Counter
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sumo_ayss.analysis.crossplay import BLOCKS
 from sumo_ayss.analysis.crossplay_scoring import case_matrix
@@ -61,10 +60,13 @@ from sumo_ayss.run_folder import (
     write_inevitable,
 )
 from sumo_ayss.stages import CellPlan, CrossplayStage, is_done, merged_rows, plan_cells
-from sumo_ayss.stages.crossplay_cells import same_scenarios
+from sumo_ayss.stages.crossplay_cells import cell_groups, kept_reference_rows, same_scenarios
 from sumo_ayss.util.errors import AyssError, CheckpointError, TableError
 from sumo_ayss.vuts.catalog import controller_imports
 from sumo_ayss.vuts.reference_types import DEFAULT_REFERENCE
+
+if TYPE_CHECKING:
+    from sumo_ayss.scenarios.crossplay import CellRunner, Opponent
 
 logger = logging.getLogger(__name__)
 
@@ -101,6 +103,7 @@ def run_case(
     progress: Callable[[str], None] | None = None,
     reference: str | None = DEFAULT_REFERENCE,
     references: Sequence[str] = (DEFAULT_REFERENCE,),
+    pool: CellRunner | None = None,
 ) -> Path:
     """Cross-play of one case's runs; writes and returns the case folder's ``crossplay.csv``.
 
@@ -119,22 +122,23 @@ def run_case(
     (:mod:`sumo_ayss.scenarios.preventability`; None: no labels). It is not part of the
     stage's settings: a table made without labels is kept (``--force`` relabels).
 
+    ``pool``: drives the cells on worker processes (:func:`sumo_ayss.grid.cells.cell_pool`,
+    the pipeline's ``workers``); None: in this process. The tables are the same either way.
+
     Raises:
         DiagonalMismatchError: If an SPCP did not reproduce its outcome table (the table
             and the record are written first, for inspection; loaders refuse to rank it).
         TableError: If a run's outcome table is missing or was run on other scenarios.
         CheckpointError: If a run's configuration or SPCP cannot be read.
     """
-    from sumo_ayss.agents.weights import load_spcp
     from sumo_ayss.scenarios.crossplay import (
-        Opponent,
         check_diagonal,
         check_one_world,
         diagonal_check,
         run_crossplay,
     )
 
-    pool = tuple(
+    opps = tuple(
         CrossplayOpponent(r.experiment.env.vut, r.config_seed, _sha256(r.folder.spcp_zip))
         for r in runs
     )
@@ -145,13 +149,23 @@ def run_case(
         envs.setdefault(r.experiment.env.vut, r.experiment.env)
     check_one_world(envs)  # also across kept and new VUTs, driven apart
     keys = tuple(vut_key(env.vut_type) for env in envs.values())
-    requested = CrossplayRecord(case, n, seed, pool, tuple(envs), 0.0, vut_keys=keys)
+    requested = CrossplayRecord(case, n, seed, opps, tuple(envs), 0.0, vut_keys=keys)
     if not force and _done(CrossplayStage(folder, requested)):
         logger.info("%s: cross-play done with these settings and SPCPs; skipped", case_dir)
         done = read_crossplay_json(folder.crossplay_json)
         check_diagonal(done.diagonal, case)
         _reference_rows(
-            runs, folder, references, n, seed, trust_controller, progress, reference, done, pool
+            runs,
+            folder,
+            references,
+            n,
+            seed,
+            trust_controller,
+            progress,
+            reference,
+            done,
+            opps,
+            pool,
         )
         return folder.crossplay_csv
     plan = None if force else _reusable(folder, requested)
@@ -165,41 +179,46 @@ def run_case(
             "".join(f"; {new} is {old} renamed: its cells kept" for old, new in plan.renamed),
         )
     else:
-        to_drive = {v: pool for v in envs}
-    by_run = {(o.vut, o.seed): r for o, r in zip(pool, runs, strict=True)}
-    own = [o for o in pool if o in to_drive.get(o.vut, ())]  # diagonal cells driven now
+        to_drive = {v: opps for v in envs}
+    by_run = {(o.vut, o.seed): r for o, r in zip(opps, runs, strict=True)}
+    own = [o for o in opps if o in to_drive.get(o.vut, ())]  # diagonal cells driven now
     outcomes = {o: _outcome_table(by_run[(o.vut, o.seed)], n, seed) for o in own}
     rows: list[Any] = [] if plan is None else list(plan.kept_rows)
     cells = CellStore.resume(folder.crossplay_partial, force=force)
     t0 = time.perf_counter()
-    for opps, vuts in _groups(to_drive).items():
-        opponents = [
-            Opponent(
-                o.vut, o.seed, functools.partial(load_spcp, by_run[(o.vut, o.seed)]), o.spcp_sha256
-            )
-            for o in opps
-        ]
+    for group, vuts in cell_groups(to_drive).items():
         with controller_imports(trust_controller):
             part = run_crossplay(
                 {v: envs[v] for v in vuts},
-                opponents,
+                _opponents(group, by_run),
                 n=n,
                 seed=seed,
                 progress=progress,
                 reference=reference,
                 cells=cells,
+                runner=pool,
             )
         rows += part.rows()
     wall_s = time.perf_counter() - t0 + (plan.wall_s if plan is not None else 0.0)
-    table = table_from_rows(CROSSPLAY_SCHEMA, merged_rows(rows, tuple(envs), pool))
+    table = table_from_rows(CROSSPLAY_SCHEMA, merged_rows(rows, tuple(envs), opps))
     found = {(c.vut, c.seed): c for c in (plan.kept_checks if plan is not None else ())}
     for o, out in outcomes.items():
         found[(o.vut, o.seed)] = diagonal_check(table, o.vut, o.seed, out)
-    checks = tuple(found[(o.vut, o.seed)] for o in pool if (o.vut, o.seed) in found)
+    checks = tuple(found[(o.vut, o.seed)] for o in opps if (o.vut, o.seed) in found)
     # The reference table first: its cells are matched through the record written after it.
     earlier = None if force else _record(folder)
     _reference_rows(
-        runs, folder, references, n, seed, trust_controller, progress, reference, earlier, pool
+        runs,
+        folder,
+        references,
+        n,
+        seed,
+        trust_controller,
+        progress,
+        reference,
+        earlier,
+        opps,
+        pool,
     )
     folder.path.mkdir(parents=True, exist_ok=True)
     write_table(folder.crossplay_csv, table)
@@ -238,6 +257,7 @@ def _reference_rows(
     label_with: str | None,
     earlier: CrossplayRecord | None,
     pool: tuple[CrossplayOpponent, ...],
+    runner: CellRunner | None,
 ) -> None:
     """Drive the reference drivers against the whole pool (``crossplay_reference.csv``):
     seconds, since they need no opponents of their own. Each (reference, opponent) cell the
@@ -245,15 +265,14 @@ def _reference_rows(
     ``earlier``, the case's record, which is written after this file: a kill between the
     two drives a cell again, never keeps a stale one); only the others are driven, and the
     file is written in the order a run over the whole pool writes it."""
-    from sumo_ayss.agents.weights import load_spcp
-    from sumo_ayss.scenarios.crossplay import Opponent, run_crossplay
+    from sumo_ayss.scenarios.crossplay import run_crossplay
     from sumo_ayss.scenarios.preventability import reference_config
 
     _inevitable(runs[0].experiment.env, folder, n, seed)
     path = folder.crossplay_reference_csv
     if not references:
         return
-    kept = _kept_reference_rows(path, references, n, seed, earlier, pool)
+    kept = kept_reference_rows(path, references, n, seed, earlier, pool)
     cells = {(r["vut"], r["opponent_vut"], r["opponent_seed"]) for r in kept}
     to_drive = {
         name: tuple(o for o in pool if (name, o.vut, o.seed) not in cells) for name in references
@@ -270,23 +289,18 @@ def _reference_rows(
     rows = list(kept)
     store = CellStore.resume(folder.crossplay_reference_partial)
     t0 = time.perf_counter()
-    for opps, names in _groups(to_drive).items():
+    for opps, names in cell_groups(to_drive).items():
         envs = {name: dataclasses.replace(base, vut=name) for name in names}
-        opponents = [
-            Opponent(
-                o.vut, o.seed, functools.partial(load_spcp, by_run[(o.vut, o.seed)]), o.spcp_sha256
-            )
-            for o in opps
-        ]
         with controller_imports(trust_controller):
             part = run_crossplay(
                 envs,
-                opponents,
+                _opponents(opps, by_run),
                 n=n,
                 seed=seed,
                 progress=progress,
                 reference=label_with,
                 cells=store,
+                runner=runner,
             )
         rows += part.rows()
     write_table(path, table_from_rows(CROSSPLAY_SCHEMA, merged_rows(rows, references, pool)))
@@ -299,35 +313,6 @@ def _reference_rows(
         time.perf_counter() - t0,
         len(cells),
     )
-
-
-def _kept_reference_rows(
-    path: Path,
-    references: Sequence[str],
-    n: int,
-    seed: int,
-    earlier: CrossplayRecord | None,
-    pool: tuple[CrossplayOpponent, ...],
-) -> list[dict[str, Any]]:
-    """The rows of ``crossplay_reference.csv`` whose reference is asked for and whose
-    opponent is, by ``earlier``'s SHA-256, an SPCP of ``pool`` (under its current name);
-    none without a usable file or record of this scenario set."""
-    if earlier is None or (earlier.n, earlier.seed) != (n, seed) or not path.is_file():
-        return []
-    try:
-        old = read_table(path, CROSSPLAY_SCHEMA)
-    except TableError:
-        return []
-    then = {(o.vut, o.seed): o.spcp_sha256 for o in earlier.opponents}
-    now = {(o.seed, o.spcp_sha256): o for o in pool}
-    kept = []
-    for row in old.rows():
-        sha = then.get((row["opponent_vut"], row["opponent_seed"]))
-        o = now.get((row["opponent_seed"], sha)) if sha is not None else None
-        if o is not None and row["vut"] in references:
-            kept.append({**row, "opponent_vut": o.vut})
-    per_cell = Counter((r["vut"], r["opponent_vut"], r["opponent_seed"]) for r in kept)
-    return [r for r in kept if per_cell[(r["vut"], r["opponent_vut"], r["opponent_seed"])] == n]
 
 
 def _done(stage: CrossplayStage) -> bool:
@@ -364,15 +349,17 @@ def _reusable(folder: CaseFolder, requested: CrossplayRecord) -> CellPlan | None
         return None
 
 
-def _groups(
-    to_drive: dict[str, tuple[CrossplayOpponent, ...]],
-) -> dict[tuple[CrossplayOpponent, ...], tuple[str, ...]]:
-    """The VUTs that meet the same opponents, together (one :func:`run_crossplay` each):
-    ``{opponents: VUTs}``, in the order of the VUTs."""
-    groups: dict[tuple[CrossplayOpponent, ...], list[str]] = {}
-    for vut, opps in to_drive.items():
-        groups.setdefault(opps, []).append(vut)
-    return {opps: tuple(vuts) for opps, vuts in groups.items()}
+def _opponents(
+    opps: Sequence[CrossplayOpponent], by_run: dict[tuple[str, int], RunRecord]
+) -> list[Opponent]:
+    """The opponents to drive, each loaded from its run's ``spcp.zip`` (a small loader that
+    travels to a worker process, :class:`~sumo_ayss.agents.weights.SpcpFile`)."""
+    from sumo_ayss.agents.weights import SpcpFile
+    from sumo_ayss.scenarios.crossplay import Opponent
+
+    return [
+        Opponent(o.vut, o.seed, SpcpFile.of(by_run[(o.vut, o.seed)]), o.spcp_sha256) for o in opps
+    ]
 
 
 def _outcome_table(run: RunRecord, n: int, seed: int) -> Table:
@@ -408,6 +395,9 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     p.add_argument("--seeds", type=int, nargs="+", default=None, help="replace grid.seeds")
     p.add_argument("--force", action="store_true", help="rerun even when done")
     p.add_argument(
+        "--workers", type=int, default=None, help="processes for the cells (default: the config's)"
+    )
+    p.add_argument(
         "--blocks",
         choices=BLOCKS,
         default="seed",
@@ -425,53 +415,59 @@ def main(argv: Sequence[str] | None = None) -> None:
     """Entry point of ``python -m sumo_ayss.crossplay``."""
     import sys
 
-    from sumo_ayss.analysis.crossplay import rank_crossplay
-    from sumo_ayss.analysis.seeds import kendall_tau
     from sumo_ayss.config import load_pipeline
-    from sumo_ayss.modes.crossplay import crossplay_sentence
-    from sumo_ayss.modes.formatting import seed_interval_text
-    from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
+    from sumo_ayss.grid.cells import cell_pool
 
     args = parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     try:
         out = Path(args.out) if args.out is not None else None
-        cfg = load_pipeline(args.config, out=out, seeds=args.seeds)
-        seeds = cfg.seeds
-        for case in cfg.grid.cases:
-            runs = case_runs(Path(cfg.out), case, cfg.grid.vuts, seeds)
-            run_case(
-                runs,
-                StudyFolder(cfg.out).case(case).path,
-                n=cfg.evaluate.n_outcome,
-                seed=DEFAULT_OUTCOME_SEED,
-                force=args.force,
-                trust_controller=args.trust_controller,
-                progress=functools.partial(print, f"{case}:", flush=True),
-                reference=cfg.evaluate.reference,
-                references=cfg.evaluate.reference_rows,
-            )
-            found = case_of(runs)
-            matrix = case_matrix(found.crossplay, found.runs)
-            rows, _pairs = rank_crossplay(matrix, blocks=args.blocks)
-            print(f"\n{case}: cross-play ranking, safest first (lower harm = safer)")
-            for r in rows:
-                crashes, episodes = matrix.crashes(r.name)
-                print(
-                    f"  {r.rank}. {r.name}: H = {r.mean:.3f} "
-                    f"({seed_interval_text(r.lo, r.hi, r.n_seeds, 3)}); "
-                    f"crashes {crashes}/{episodes}; mean speed "
-                    f"{matrix.vut_mobility(r.name):.1f} m/s"
-                )
-                if r.vs_next is not None:
-                    print(f"     {crossplay_sentence(r.vs_next, args.blocks)}")
-            if cfg.expected_order:
-                order = [r.name for r in rows]
-                print(
-                    f"  Kendall tau vs expected order: {kendall_tau(order, cfg.expected_order):.2f}"
-                )
+        cfg = load_pipeline(args.config, out=out, seeds=args.seeds, workers=args.workers)
+        with cell_pool(cfg.n_workers) as pool:  # one pool for every case
+            for case in cfg.grid.cases:
+                _main_case(cfg, case, args, pool)
     except AyssError as exc:
         sys.exit(f"error: {exc}")
+
+
+def _main_case(cfg: Any, case: str, args: argparse.Namespace, pool: CellRunner | None) -> None:
+    """Cross-play one case of :func:`main`'s config and print its ranking."""
+    from sumo_ayss.analysis.crossplay import rank_crossplay
+    from sumo_ayss.analysis.seeds import kendall_tau
+    from sumo_ayss.modes.crossplay import crossplay_sentence
+    from sumo_ayss.modes.formatting import seed_interval_text
+    from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
+
+    runs = case_runs(Path(cfg.out), case, cfg.grid.vuts, cfg.seeds)
+    run_case(
+        runs,
+        StudyFolder(cfg.out).case(case).path,
+        n=cfg.evaluate.n_outcome,
+        seed=DEFAULT_OUTCOME_SEED,
+        force=args.force,
+        trust_controller=args.trust_controller,
+        progress=functools.partial(print, f"{case}:", flush=True),
+        reference=cfg.evaluate.reference,
+        references=cfg.evaluate.reference_rows,
+        pool=pool,
+    )
+    found = case_of(runs)
+    matrix = case_matrix(found.crossplay, found.runs)
+    rows, _pairs = rank_crossplay(matrix, blocks=args.blocks)
+    print(f"\n{case}: cross-play ranking, safest first (lower harm = safer)")
+    for r in rows:
+        crashes, episodes = matrix.crashes(r.name)
+        print(
+            f"  {r.rank}. {r.name}: H = {r.mean:.3f} "
+            f"({seed_interval_text(r.lo, r.hi, r.n_seeds, 3)}); "
+            f"crashes {crashes}/{episodes}; mean speed "
+            f"{matrix.vut_mobility(r.name):.1f} m/s"
+        )
+        if r.vs_next is not None:
+            print(f"     {crossplay_sentence(r.vs_next, args.blocks)}")
+    if cfg.expected_order:
+        order = [r.name for r in rows]
+        print(f"  Kendall tau vs expected order: {kendall_tau(order, cfg.expected_order):.2f}")
 
 
 if __name__ == "__main__":

@@ -73,6 +73,7 @@ from sumo_ayss.util.errors import AyssError, DiskFullError
 if TYPE_CHECKING:
     from sumo_ayss.analysis.case import CaseAnalysis
     from sumo_ayss.config.report import ReportOptions
+    from sumo_ayss.scenarios.crossplay import CellRunner
 
 logger = logging.getLogger("sumo_ayss.pipeline")  # also when run as __main__
 
@@ -307,15 +308,29 @@ def run_crossplay_stage(
     VUT has no cross-play; a case with a failed job is skipped with a warning (its report
     then says that the cross-play table is missing); a failure of the stage itself is
     logged, never fatal. ``runs``: the finished jobs' records (:func:`~sumo_ayss.run_folder.
-    read_run`).
+    read_run`). The cells run on ``workers`` processes (:mod:`sumo_ayss.grid.cells`; one:
+    in this process), the tables the same either way.
     """
-    from sumo_ayss.crossplay import run_case
-    from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
-
     if len(cfg.grid.vuts) < 2:
         logger.info("cross-play skipped: the grid has one VUT (cross-play compares two or more)")
         return []
+
+    from sumo_ayss.grid.cells import cell_pool
+
+    with cell_pool(cfg.n_workers) as pool:  # one pool for every case's cells
+        return _crossplay_cases(cfg, statuses, runs, pool)
+
+
+def _crossplay_cases(
+    cfg: PipelineConfig,
+    statuses: Sequence[JobStatus],
+    runs: Sequence[RunRecord],
+    pool: CellRunner | None,
+) -> list[Path]:
+    """:func:`run_crossplay_stage`'s cases, their cells on ``pool`` (None: here)."""
+    from sumo_ayss.crossplay import run_case
     from sumo_ayss.grid.adaptive import case_seeds
+    from sumo_ayss.scenarios.outcome import DEFAULT_OUTCOME_SEED
 
     by_path = {r.path: r for r in runs}
     written = []
@@ -345,6 +360,7 @@ def run_crossplay_stage(
                 progress=functools.partial(_crossplay_progress, case),
                 reference=cfg.evaluate.reference,
                 references=cfg.evaluate.reference_rows,
+                pool=pool,
             )
         except DiskFullError:
             raise

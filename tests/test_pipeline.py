@@ -295,15 +295,17 @@ def test_adaptive_seeding_adds_seeds_until_the_cap_and_extends_crossplay(
 ) -> None:
     """A ranking that cannot settle (a significance level no test reaches) gets one seed at a
     time up to max_seeds; each look is recorded; cross-play drives only the new opponents and
-    its table equals a full rerun's; a rerun adds nothing."""
+    its table equals a full rerun's; a rerun adds nothing. On two workers: the grid's jobs
+    and cross-play's cells (issue 40), the table equal to a full rerun in one process."""
     from sumo_ayss.crossplay import run_case
     from sumo_ayss.run_folder import read_adaptive, read_run
 
-    path = write_configs(tmp_path, [0, 1], max_seeds=3, report={"welch_alpha": 1e-12})
+    path = write_configs(tmp_path, [0, 1], max_seeds=3, report={"welch_alpha": 1e-12}, workers=2)
     cfg = load_pipeline(path)
     assert cfg.added_seeds == (2,)
     with caplog.at_level(logging.INFO):
         statuses, report, runs, *_ = run_pipeline(cfg, live=False)
+    assert "cross-play: cells on 2 worker processes" in caplog.text
     assert "cross-play drives 4 new cells (VUT x SPCP) and keeps 8" in caplog.text
     assert "adaptive seeding, car_following: not settled at 2 seeds per VUT" in caplog.text
     assert sorted((s.spec.vut, s.spec.seed) for s in statuses) == [
@@ -339,7 +341,7 @@ def test_adaptive_seeding_adds_seeds_until_the_cap_and_extends_crossplay(
         n=10,
         seed=4242,
         force=True,
-    )
+    )  # in this process (no pool)
     assert (full / "crossplay.csv").read_bytes() == kept  # the extended table = a full run
     again = run_pipeline(cfg, live=False)  # resume: the same 6 jobs, nothing added
     assert len(again.statuses) == 6

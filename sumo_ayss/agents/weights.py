@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import io
 import zipfile
+from dataclasses import dataclass
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any, Protocol
@@ -142,3 +143,42 @@ def load_spcp(run: SpcpRun, env: gym.Env[Any, Any]) -> GreedyPolicy:
         env.observation_space,  # type: ignore[arg-type]
         env.action_space,  # type: ignore[arg-type]
     )
+
+
+@dataclass(frozen=True)
+class SpcpFile:
+    """A run's SPCP as what loading it needs (:func:`load_spcp` without the run's record):
+    small and picklable, so that a worker process loads it (cross-play's cells on the worker
+    pool, :mod:`sumo_ayss.grid.cells`). Called with an env, it returns the greedy policy.
+
+    Attributes:
+        run_path: The run folder (named in the error of a missing SPCP).
+        spcp_zip: Its ``spcp.zip``.
+        agent: The run's learner settings (its ``config.yaml``).
+    """
+
+    run_path: Path
+    spcp_zip: Path
+    agent: DQNHyperParams
+
+    @classmethod
+    def of(cls, run: SpcpRun) -> SpcpFile:
+        """The SPCP of ``run`` (reads the run's learner settings now)."""
+        return cls(run.path, run.folder.spcp_zip, run.experiment.agent)
+
+    def __call__(self, env: gym.Env[Any, Any]) -> GreedyPolicy:
+        """The greedy policy, as :func:`load_spcp` gives it.
+
+        Raises:
+            CheckpointError: If the ``spcp.zip`` is missing or unreadable.
+        """
+        if not self.spcp_zip.is_file():
+            raise CheckpointError(
+                f"{self.run_path}: no {self.spcp_zip.name} (was the SPCP selected?)"
+            )
+        return load_greedy_policy(
+            self.spcp_zip,
+            self.agent,
+            env.observation_space,  # type: ignore[arg-type]
+            env.action_space,  # type: ignore[arg-type]
+        )

@@ -9,63 +9,19 @@ from __future__ import annotations
 
 import collections
 import logging
-import multiprocessing
-import sys
 import threading
 import time
 import traceback
 from collections.abc import Sequence
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import Future
 from typing import Any
 
 from sumo_ayss.grid.jobs import NOT_RETRIED, JobSpec, run_job
 from sumo_ayss.grid.progress import GridProgress, JobStatus
+from sumo_ayss.grid.workers import spawn_pool, stop_workers
 from sumo_ayss.util.errors import DiskFullError
 
 logger = logging.getLogger("sumo_ayss.pipeline")
-
-
-def _worker_init() -> None:
-    """Worker initializer: die with the pipeline, and leave Ctrl-C to it.
-
-    On Linux a worker gets SIGKILLed when the pipeline process dies: without it a killed
-    pipeline leaves its workers running, and a rerun would race them for the same run
-    folders. A Ctrl-C reaches every process of the terminal's group; workers ignore it and
-    the pipeline stops them (:func:`_stop_workers`), so that no job starts afterwards.
-    It also runs before any job imports torch, so that torch's intra-op pool starts with one
-    BLAS/OpenMP thread (``run_job`` then applies ``train.torch_threads``).
-    """
-    import signal
-
-    from sumo_ayss.grid.threads import single_thread_env
-
-    single_thread_env()
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if sys.platform.startswith("linux"):
-        import ctypes
-
-        libc = ctypes.CDLL("libc.so.6", use_errno=True)
-        pr_set_pdeathsig = 1
-        libc.prctl(pr_set_pdeathsig, signal.SIGKILL)
-
-
-def _stop_workers(pool: ProcessPoolExecutor, grace_s: float = 3.0) -> None:
-    """Terminate the pool's worker processes now (SIGTERM, then SIGKILL after ``grace_s``).
-
-    Safe for the run folders: every result is written atomically and a rerun resumes from
-    the last checkpoint (:func:`sumo_ayss.training.trainer.train`).
-    """
-    processes = list(getattr(pool, "_processes", {}).values())  # CPython's worker table
-    for proc in processes:
-        if proc.is_alive():
-            proc.terminate()
-    deadline = time.monotonic() + grace_s
-    for proc in processes:
-        proc.join(max(0.0, deadline - time.monotonic()))
-        if proc.is_alive():
-            proc.kill()
-            proc.join(1.0)
-    pool.shutdown(wait=False, cancel_futures=True)
 
 
 class _Terminated(KeyboardInterrupt):
@@ -95,13 +51,12 @@ def run_grid_local(
     statuses = [JobStatus(j) for j in jobs]
     progress = GridProgress(statuses, workers, after)
     queue: collections.deque[JobStatus] = collections.deque(statuses)
-    ctx = multiprocessing.get_context("spawn")  # fresh interpreters: no inherited libsumo
     logger.info(
         "%d jobs on %d worker processes; each job logs to <run folder>/job.log",
         len(jobs),
         workers,
     )
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init)
+    pool = spawn_pool(workers)
     pending: dict[Future[dict[str, Any]], JobStatus] = {}
     in_main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _raise_terminated) if in_main else None
@@ -151,7 +106,7 @@ def run_grid_local(
         for fut, s in pending.items():
             fut.cancel()
             s.state = "interrupted"
-        _stop_workers(pool)
+        stop_workers(pool)
         logger.warning(
             "%s: %d running job(s) stopped, %d queued job(s) cancelled; rerun the "
             "same command to resume",

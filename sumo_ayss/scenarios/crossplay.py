@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -48,15 +48,20 @@ from sumo_ayss.records.table import Table, table_from_rows
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, DiagonalCheck
 from sumo_ayss.scenarios.preventability import DEFAULT_REFERENCE, label_crashes
 from sumo_ayss.scenarios.rollout import Policy, run_episodes
-from sumo_ayss.util.errors import ConfigError, DiagonalMismatchError
+from sumo_ayss.util.errors import AyssError, ConfigError, DiagonalMismatchError
+from sumo_ayss.vuts.controller_spec import controller_imports, controller_imports_allowed
 
 __all__ = [
     "DIAGONAL_COLUMNS",
     "CellCache",
+    "CellDone",
+    "CellRunner",
+    "CellTask",
     "Opponent",
     "check_diagonal",
     "check_one_world",
     "diagonal_check",
+    "drive_cell",
     "run_crossplay",
 ]
 
@@ -118,6 +123,7 @@ def run_crossplay(
     progress: Callable[[str], None] | None = None,
     reference: str | None = DEFAULT_REFERENCE,
     cells: CellCache | None = None,
+    runner: CellRunner | None = None,
 ) -> Table:
     """Every opponent against every VUT on ``n`` common scenarios.
 
@@ -133,80 +139,207 @@ def run_crossplay(
             block's env closed, on its SUMO seed); None: no labels (NaN).
         cells: Where each finished cell is kept as soon as it is done and read back
             instead of driven again (an opponent with an ``identity`` only); None: none.
+        runner: Drives the cells not kept on worker processes (:class:`CellRunner`, e.g.
+            :class:`sumo_ayss.grid.cells.CellPool`; the opponents' ``load`` must then
+            pickle); None: one after the other in this process. Each cell is its own fresh
+            simulation either way, so the table is the same, row for row; this process
+            alone writes ``cells``, as each cell comes back.
 
     Returns:
         The cross-play table, VUTs in the given order, then opponents, then scenarios.
     """
-    from sumo_ayss.envs import make_env
-
     if not envs or not opponents:
         raise ConfigError("cross-play needs at least one VUT and one opponent SPCP")
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise ConfigError(f"n: expected an integer >= 1, got {n!r}")
     check_one_world(envs)
-    rows: list[dict[str, object]] = []
-    # Each opponent is loaded once (0.48 s a load here under load, against 15 ms for a fresh
-    # SUMO): its greedy policy depends on the spaces only, the same for every VUT of the pool.
-    policies: dict[int, Policy] = {}
-    for vut, cfg in envs.items():
-        scenarios = with_followers(scenario_set(cfg, n, seed), cfg.follower, seed)
-        for k, opp in enumerate(opponents):
-            key = (vut, repr(cfg), opp.vut, opp.seed, opp.identity, n, seed, reference)
-            kept = cells.load(key) if cells is not None and opp.identity else None
-            if kept is not None:  # a finished cell of an interrupted run: the same rows
-                rows += kept
-                if progress is not None:
-                    progress(f"{vut} vs SPCP {opp.vut}/seed_{opp.seed}: kept from an earlier run")
-                continue
-            t0 = time.perf_counter()
-            start = len(rows)
-            env = make_env(cfg, sumo_seed=opp.seed)  # as the outcome stage: a fresh SUMO
-            try:
-                if k not in policies:
-                    policies[k] = opp.load(env)
-                episodes = run_episodes(env, policies[k], scenarios)
-            finally:
-                env.close()
-            labels = (
-                label_crashes(
-                    cfg,
-                    scenarios,
-                    [e.collided for e in episodes],
-                    [e.actions for e in episodes],
-                    sumo_seed=opp.seed,
-                    reference=reference,
-                )
-                if reference is not None
-                else np.full(len(episodes), np.nan)
-            )
-            for j, e in enumerate(episodes):
-                rows.append(
-                    {
-                        "vut": vut,
-                        "opponent_vut": opp.vut,
-                        "opponent_seed": opp.seed,
-                        "scenario": j,
-                        "episode_return": e.episode_return,
-                        "collided": e.collided,
-                        "final_headway_m": e.final_headway_m,
-                        "n_steps": e.n_steps,
-                        "near_miss_pay": e.near_miss_pay,
-                        "vut_mean_speed_mps": e.vut_mean_speed_mps,
-                        **e.measure_row(),
-                        "crash_preventable": float(labels[j]),
-                        **e.hazard_row(),
-                    }
-                )
-            if cells is not None and opp.identity:
-                cells.save(key, rows[start:])
+    trusted = controller_imports_allowed()  # the caller's trust, carried to a worker
+    tasks = [
+        CellTask(v, cfg, o, n, seed, reference, trusted)
+        for v, cfg in envs.items()
+        for o in opponents
+    ]
+    found: dict[int, list[dict[str, Any]]] = {}
+    for i, task in enumerate(tasks):
+        kept = cells.load(task.key) if cells is not None and task.opponent.identity else None
+        if kept is not None:  # a finished cell of an interrupted run: the same rows
+            found[i] = kept
             if progress is not None:
-                mean = float(np.mean([e.episode_return for e in episodes]))
-                crashes = sum(e.collided for e in episodes)
-                progress(
-                    f"{vut} vs SPCP {opp.vut}/seed_{opp.seed}: mean return {mean:.2f}, "
-                    f"{crashes}/{n} crashes ({time.perf_counter() - t0:.1f} s)"
-                )
-    return table_from_rows(CROSSPLAY_SCHEMA, rows)
+                progress(f"{task.name}: kept from an earlier run")
+    todo = [i for i in range(len(tasks)) if i not in found]
+    if runner is None:
+        done = _drive_here([tasks[i] for i in todo])
+    else:
+        done = runner.drive([tasks[i] for i in todo])
+    for j, rows, seconds in done:  # as each cell is done (in any order on a pool)
+        task = tasks[todo[j]]
+        found[todo[j]] = rows
+        if cells is not None and task.opponent.identity:
+            cells.save(task.key, rows)
+        if progress is not None:
+            mean = float(np.mean([r["episode_return"] for r in rows]))
+            crashes = sum(bool(r["collided"]) for r in rows)
+            progress(
+                f"{task.name}: mean return {mean:.2f}, {crashes}/{n} crashes ({seconds:.1f} s)"
+            )
+    return table_from_rows(CROSSPLAY_SCHEMA, [r for i in range(len(tasks)) for r in found[i]])
+
+
+@dataclass(frozen=True)
+class CellTask:
+    """One (VUT, opponent) cell of :func:`run_crossplay`: all that driving it needs, small
+    enough to send to a worker process (no rows, no scenarios: they are drawn where it runs).
+
+    Attributes:
+        vut: The VUT's name.
+        cfg: Its env config.
+        opponent: The SPCP driving against it.
+        n: Scenarios.
+        seed: Seed of the scenario set.
+        reference: The crash labeller (None: no labels).
+        trusted: Whether user controllers may be imported where it runs
+            (:func:`~sumo_ayss.vuts.controller_spec.controller_imports`).
+    """
+
+    vut: str
+    cfg: EnvConfig
+    opponent: Opponent
+    n: int
+    seed: int
+    reference: str | None
+    trusted: bool = True
+
+    @property
+    def key(self) -> tuple[Any, ...]:
+        """Everything the cell's rows depend on (its :class:`CellCache` key)."""
+        o = self.opponent
+        return (
+            self.vut,
+            repr(self.cfg),
+            o.vut,
+            o.seed,
+            o.identity,
+            self.n,
+            self.seed,
+            self.reference,
+        )
+
+    @property
+    def name(self) -> str:
+        """The cell, as progress lines and errors name it."""
+        return f"{self.vut} vs SPCP {self.opponent.vut}/seed_{self.opponent.seed}"
+
+
+#: A finished cell: its index among the tasks handed over, its rows, its seconds.
+CellDone = tuple[int, list[dict[str, Any]], float]
+
+
+class CellRunner(Protocol):
+    """Drives cross-play cells elsewhere (:class:`sumo_ayss.grid.cells.CellPool`: worker
+    processes), each with :func:`drive_cell`."""
+
+    def drive(self, tasks: Sequence[CellTask]) -> Iterator[CellDone]:
+        """Drive ``tasks``, yielding each as it is done (any order)."""
+        ...
+
+
+def _drive_here(tasks: Sequence[CellTask]) -> Iterator[CellDone]:
+    """The cells in this process, in order; each opponent loaded once (0.48 s a load here
+    under load, against 15 ms for a fresh SUMO): its greedy policy depends on the spaces
+    only, the same for every VUT of the pool."""
+    policies: dict[int, Policy] = {}  # by the opponent object, shared by its cells
+    scenarios: dict[str, list[Any]] = {}
+    for j, task in enumerate(tasks):
+        if task.vut not in scenarios:
+            scenarios[task.vut] = _scenarios(task)
+        t0 = time.perf_counter()
+        rows, policies[id(task.opponent)] = _drive(
+            task, scenarios[task.vut], policies.get(id(task.opponent))
+        )
+        yield j, rows, time.perf_counter() - t0
+
+
+def drive_cell(task: CellTask) -> tuple[list[dict[str, Any]], float]:
+    """One cell on its own (a worker process's task): its rows and seconds; the opponent is
+    loaded for it and dropped after (a worker holds one SPCP at a time)."""
+    scenarios = _scenarios(task)
+    t0 = time.perf_counter()
+    with controller_imports(task.trusted):
+        rows, _ = _drive(task, scenarios, None)
+    return rows, time.perf_counter() - t0
+
+
+def _scenarios(task: CellTask) -> list[Any]:
+    cfg = task.cfg
+    return with_followers(scenario_set(cfg, task.n, task.seed), cfg.follower, task.seed)
+
+
+def _drive(
+    task: CellTask, scenarios: Sequence[Any], policy: Policy | None
+) -> tuple[list[dict[str, Any]], Policy]:
+    """The cell's rows (and the opponent's policy, loaded when ``policy`` is None) on a fresh
+    SUMO seeded with the opponent's seed, as the outcome stage drives it.
+
+    Raises:
+        AyssError: the error of the cell (its type), its message prefixed with the cell.
+    """
+    from sumo_ayss.envs import make_env
+
+    cfg, opp = task.cfg, task.opponent
+    try:
+        env = make_env(cfg, sumo_seed=opp.seed)  # as the outcome stage: a fresh SUMO
+        try:
+            if policy is None:
+                policy = opp.load(env)
+            episodes = run_episodes(env, policy, scenarios)
+        finally:
+            env.close()
+        labels = (
+            label_crashes(
+                cfg,
+                scenarios,
+                [e.collided for e in episodes],
+                [e.actions for e in episodes],
+                sumo_seed=opp.seed,
+                reference=task.reference,
+            )
+            if task.reference is not None
+            else np.full(len(episodes), np.nan)
+        )
+    except AyssError as e:
+        named = _named(e, task.name)
+        if named is e:
+            raise
+        raise named from e
+    rows = [
+        {
+            "vut": task.vut,
+            "opponent_vut": opp.vut,
+            "opponent_seed": opp.seed,
+            "scenario": j,
+            "episode_return": e.episode_return,
+            "collided": e.collided,
+            "final_headway_m": e.final_headway_m,
+            "n_steps": e.n_steps,
+            "near_miss_pay": e.near_miss_pay,
+            "vut_mean_speed_mps": e.vut_mean_speed_mps,
+            **e.measure_row(),
+            "crash_preventable": float(labels[j]),
+            **e.hazard_row(),
+        }
+        for j, e in enumerate(episodes)
+    ]
+    return rows, policy
+
+
+def _named(error: AyssError, cell: str) -> AyssError:
+    """``error`` again, its message naming the cross-play cell (the same type; the error
+    itself where its type takes more than a message)."""
+    try:
+        named = type(error)(f"cross-play cell {cell}: {error}")
+    except TypeError:
+        return error
+    return named
 
 
 #: Columns of a cross-play row compared with the same episode of ``outcome.csv``.

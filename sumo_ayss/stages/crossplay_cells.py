@@ -17,7 +17,9 @@ changes its SPCPs). An opponent is matched by training seed and SPCP SHA-256.
 :func:`plan_cells` returns the kept rows (renamed to the request's names) and diagonal
 checks, and the opponents each VUT still has to meet; :func:`merged_rows` puts kept and
 new rows in the order one run over the whole request writes them, so the merged table
-equals a full rerun's.
+equals a full rerun's. :func:`kept_reference_rows` does the same for the reference drivers'
+table (``crossplay_reference.csv``); :func:`cell_groups` puts the VUTs that meet the same
+opponents into one drive.
 
 Imports neither SUMO nor torch.
 """
@@ -25,15 +27,26 @@ Imports neither SUMO nor torch.
 from __future__ import annotations
 
 import dataclasses
+from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
-from sumo_ayss.run_folder import CrossplayOpponent, CrossplayRecord, DiagonalCheck
+from sumo_ayss.run_folder import (
+    CROSSPLAY_SCHEMA,
+    CrossplayOpponent,
+    CrossplayRecord,
+    DiagonalCheck,
+    read_table,
+)
+from sumo_ayss.util.errors import TableError
 
 __all__ = [
     "CellPlan",
+    "cell_groups",
     "crossplay_inputs",
+    "kept_reference_rows",
     "merged_rows",
     "plan_cells",
     "same_scenarios",
@@ -166,3 +179,44 @@ def merged_rows(
             r["scenario"],
         ),
     )
+
+
+def kept_reference_rows(
+    path: Path,
+    references: Sequence[str],
+    n: int,
+    seed: int,
+    earlier: CrossplayRecord | None,
+    pool: tuple[CrossplayOpponent, ...],
+) -> list[dict[str, Any]]:
+    """The rows of ``crossplay_reference.csv`` whose reference is asked for and whose
+    opponent is, by ``earlier``'s SHA-256, an SPCP of ``pool`` (under its current name);
+    none without a usable file or record of this scenario set."""
+    if earlier is None or (earlier.n, earlier.seed) != (n, seed) or not path.is_file():
+        return []
+    try:
+        old = read_table(path, CROSSPLAY_SCHEMA)
+    except TableError:
+        return []
+    then = {(o.vut, o.seed): o.spcp_sha256 for o in earlier.opponents}
+    now = {(o.seed, o.spcp_sha256): o for o in pool}
+    kept = []
+    for row in old.rows():
+        sha = then.get((row["opponent_vut"], row["opponent_seed"]))
+        o = now.get((row["opponent_seed"], sha)) if sha is not None else None
+        if o is not None and row["vut"] in references:
+            kept.append({**row, "opponent_vut": o.vut})
+    per_cell = Counter((r["vut"], r["opponent_vut"], r["opponent_seed"]) for r in kept)
+    return [r for r in kept if per_cell[(r["vut"], r["opponent_vut"], r["opponent_seed"])] == n]
+
+
+def cell_groups(
+    to_drive: dict[str, tuple[CrossplayOpponent, ...]],
+) -> dict[tuple[CrossplayOpponent, ...], tuple[str, ...]]:
+    """The VUTs that meet the same opponents, together (one
+    :func:`~sumo_ayss.scenarios.crossplay.run_crossplay` each): ``{opponents: VUTs}``, in
+    the order of the VUTs."""
+    groups: dict[tuple[CrossplayOpponent, ...], list[str]] = {}
+    for vut, opps in to_drive.items():
+        groups.setdefault(opps, []).append(vut)
+    return {opps: tuple(vuts) for opps, vuts in groups.items()}

@@ -38,6 +38,7 @@ __all__ = [
     "ControllerSpec",
     "check_imports_allowed",
     "controller_imports",
+    "controller_imports_allowed",
     "identity_target",
     "registered_target",
 ]
@@ -356,6 +357,12 @@ def controller_imports(allowed: bool) -> Iterator[None]:
         yield
     finally:
         _CONTROLLER_IMPORTS.reset(token)
+
+
+def controller_imports_allowed() -> bool:
+    """Whether user controllers may be imported now (:func:`controller_imports`): what a
+    worker process is handed, so that it drives under the caller's trust."""
+    return _CONTROLLER_IMPORTS.get()
 
 
 def check_imports_allowed(where: str, what: str, note: str = "") -> None:

@@ -92,12 +92,12 @@ def test_pipeline_workers_start_torch_with_one_thread(monkeypatch: pytest.Monkey
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    from sumo_ayss.grid.local import _worker_init
+    from sumo_ayss.grid.workers import worker_init
 
     for name in THREAD_ENV_VARS:
         monkeypatch.delenv(name, raising=False)
     ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=_worker_init) as pool:
+    with ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=worker_init) as pool:
         assert pool.submit(_worker_threads).result(timeout=120) == ("1", 1)
 
 
