@@ -26,7 +26,7 @@ from sumo_ayss.run_folder.study import StudyFolder, read_order_check
 MODE = "crossplay"
 
 
-def _check(study: Path, case: str):  # noqa: ANN202 (an OrderCheck case or None)
+def _check(study: Path, case: str):
     path = StudyFolder(study).order_check_json
     if not path.is_file():
         return None
@@ -64,7 +64,7 @@ def _cost(root: Path, ladder: str) -> str:
     return f"{user + sys_:,.0f} / {wall / 60:.1f} min"
 
 
-def _short(c) -> str:  # noqa: ANN001
+def _short(c) -> str:
     sig = "yes" if c.ends_significant else "no"
     return f"{c.tau:.2f}, {c.ends_p:.3g} ({sig}), {c.significant_adjacent} of {c.adjacent}"
 

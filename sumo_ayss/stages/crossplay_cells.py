@@ -33,12 +33,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sumo_ayss.records.table import read_table
 from sumo_ayss.run_folder import (
     CROSSPLAY_SCHEMA,
     CrossplayOpponent,
     CrossplayRecord,
     DiagonalCheck,
-    read_table,
 )
 from sumo_ayss.util.errors import TableError
 
