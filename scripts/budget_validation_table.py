@@ -11,7 +11,8 @@ product's "ends significant") and the adjacent pairs significant under Holm (the
 family-wise rule: the ends are significant under it only when every adjacent pair is), and
 the CPU-seconds and wall time of the whole ``rank`` when ``<root>/<ladder>.time`` holds
 ``/usr/bin/time``'s line (``wall W s  user U  sys S ...``). Then the same ladder and case
-from the first ``--before`` root that has it (τ, ends p, adjacent pairs), for comparison.
+from the first ``--before`` root that has it (τ, ends p, adjacent pairs), for comparison; a
+``--before`` entry ``LADDER=STUDY`` names one ladder's study folder directly.
 """
 
 from __future__ import annotations
@@ -69,7 +70,19 @@ def _short(c) -> str:
     return f"{c.tau:.2f}, {c.ends_p:.3g} ({sig}), {c.significant_adjacent} of {c.adjacent}"
 
 
-def rows(root: Path, before: list[Path], ladders: list[str] | None) -> list[str]:
+def _earlier(before: list[str], ladder: str, case: str) -> str:
+    for entry in before:
+        name, _, path = entry.partition("=")
+        study = Path(path) if path else Path(name) / ladder
+        if path and name != ladder:
+            continue
+        c = _check(study, case)
+        if c is not None:
+            return _short(c)
+    return "—"
+
+
+def rows(root: Path, before: list[str], ladders: list[str] | None) -> list[str]:
     out = [
         "| ladder | case | seeds per VUT (looks: ends p) | ranking, safest first | τ | "
         "ends p (paired t) | adjacent significant (Holm) | CPU-s / wall, both cases | "
@@ -83,10 +96,7 @@ def rows(root: Path, before: list[Path], ladders: list[str] | None) -> list[str]
             c = _check(study, case)
             if c is None:
                 continue
-            earlier = next(
-                (_short(b) for b in (_check(r / ladder, case) for r in before) if b is not None),
-                "—",
-            )
+            earlier = _earlier(before, ladder, case)
             sig = "yes" if c.ends_significant else "no"
             out.append(
                 f"| {ladder} | {case} | {_seeds(study, case)} | {' > '.join(c.order)} | "
@@ -99,7 +109,7 @@ def rows(root: Path, before: list[Path], ladders: list[str] | None) -> list[str]
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("root", type=Path)
-    p.add_argument("--before", type=Path, nargs="*", default=[])
+    p.add_argument("--before", nargs="*", default=[], help="ROOT or LADDER=STUDY")
     p.add_argument("--ladders", nargs="*", default=None)
     a = p.parse_args()
     print("\n".join(rows(a.root, a.before, a.ladders)))
