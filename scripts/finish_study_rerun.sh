@@ -8,8 +8,10 @@
 #    (scripts/ayss_bins_from_csv.py: the evaluate stage's own reduction);
 # 2. copies over the files git holds for the study today (the same names, nothing new: no
 #    ayss.csv, checkpoints or policies), plus every run's ayss_bins.csv;
-# 3. takes the re-run's ranking.csv/.md (with its paper-mode rows, drawn from the samples)
+# 3. takes the re-run's ranking.csv/.md (with its paper-mode rows, drawn from the samples;
+#    the pipeline writes none, so they are first ranked there: rank --no-run on the re-run)
 #    and re-ranks as scripts/rerank_results.sh does (rank --no-run, paper rows carried over);
+#    a crashing or refusing rank stops the script (exit 1, an incomplete grid, is fine);
 # 4. regenerates the report as scripts/regenerate_reports.sh does (from the committed files:
 #    the AYSS figures and the paper section now read ayss_bins.csv).
 # Prints the files that are new to git.
@@ -17,6 +19,18 @@ set -euo pipefail
 src=$(cd "$1" && pwd); study=${2%/}; config=$3
 cd "$(dirname "$0")/.."
 PY="${PYTHON:-.venv/bin/python}"
+rank() {  # as scripts/rerank_results.sh: exit 1 (incomplete grid) passes, a crash does not
+  local err rc=0
+  err=$(mktemp)
+  $PY -m sumo_ayss.rank "$@" --no-run --no-live > /dev/null 2> "$err" || rc=$?
+  cat "$err" >&2
+  if [ "$rc" -gt 1 ] || grep -q -e '^Traceback' -e '^error:' "$err"; then
+    rm -f "$err"
+    echo "finish_study_rerun.sh: rank $* failed (exit $rc)" >&2
+    exit 1
+  fi
+  rm -f "$err"
+}
 for b in $(cd "$src" && find . -name ayss.csv | sort); do
   [ -f "$src/$(dirname "$b")/ayss_bins.csv" ] || $PY scripts/ayss_bins_from_csv.py "$src/$(dirname "$b")" > /dev/null
 done
@@ -28,10 +42,11 @@ for b in $(cd "$src" && find . -name ayss_bins.csv | sort); do
   mkdir -p "$study/$(dirname "$b")"
   cp "$src/$b" "$study/$b"
 done
+[ -f "$src/ranking.csv" ] || rank "$config" --out "$src"
 cp "$src/ranking.csv" "$src/ranking.md" "$study/"
 previous=$(mktemp)
 cp "$study/ranking.csv" "$previous"
-$PY -m sumo_ayss.rank "$config" --out "$study" --no-run --no-live > /dev/null || true
+rank "$config" --out "$study"
 $PY scripts/keep_paper_rows.py "$study" "$previous"
 rm -f "$previous"
 report=$study/report
