@@ -32,6 +32,7 @@ Pipeline YAML (every key optional)::
     budget: verdict             # a named budget: verdict (default) | paper | null (config.budget)
     total_timesteps: null       # override the budget's / every experiment's train.total_timesteps
     eval_every: null            # override the budget's / every experiment's train.eval_every
+    learning_rate: null         # override the budget's / every experiment's agent.learning_rate
     early_stop_patience: null   # every experiment's train.early_stop_patience (null: its own, off)
     early_stop_margin_se: null  # every experiment's train.early_stop_margin_se
     evaluate: {n_outcome: 200, n_ayss: 100000}  # n_ayss: shorthand for ayss.n_samples
@@ -430,6 +431,13 @@ def add_config_flags(parser: argparse.ArgumentParser) -> None:
     )
     group.add_argument("--n-ayss", type=int, default=None, help="AYSS Monte Carlo draws per SPCP")
     group.add_argument(
+        "--learning-rate",
+        type=float,
+        default=None,
+        help="the learner's Adam learning rate in every experiment (agent.learning_rate; "
+        "default: the budget's where it names one, else the experiment's)",
+    )
+    group.add_argument(
         "--early-stop-patience",
         type=int,
         default=None,
@@ -457,6 +465,7 @@ def config_from_args(args: argparse.Namespace) -> PipelineConfig:
         budget=args.budget,
         total_timesteps=args.total_timesteps,
         eval_every=args.eval_every,
+        learning_rate=args.learning_rate,
         n_outcome=args.n_outcome,
         n_ayss=args.n_ayss,
         max_seeds=args.max_seeds,

@@ -56,6 +56,10 @@ class Budget:
         max_seeds: Adaptive seeding's cap when the budget also chose the seeds: a case
             whose cross-play ranking has not settled gets one more seed per VUT at a time,
             up to this many (:mod:`sumo_ayss.grid.adaptive`); None: a fixed grid of ``seeds``.
+        learning_rate: The learner's Adam learning rate in every experiment
+            (``agent.learning_rate``) when the pipeline names none; None: each
+            experiment's own (the shipped configs: the paper's 1e-5, made for 100,000
+            transitions).
     """
 
     total_timesteps: int
@@ -64,10 +68,13 @@ class Budget:
     summary: str
     n_ayss: int | None = None
     max_seeds: int | None = None
+    learning_rate: float | None = None
 
     def describe(self) -> str:
         """``"20,000 transitions, a candidate every 5,000, 4 seeds per VUT: ..."``."""
         ayss = "" if self.n_ayss is None else f", {self.n_ayss:,} AYSS draws"
+        if self.learning_rate is not None:
+            ayss += f", learning rate {self.learning_rate:g}"
         seeds = f"{self.seeds} seeds per VUT"
         if self.max_seeds is not None and self.max_seeds > self.seeds:
             seeds = f"{self.seeds} seeds per VUT, up to {self.max_seeds} until the ranking settles"
@@ -95,6 +102,16 @@ BUDGETS: Mapping[str, Budget] = MappingProxyType(
             "significant, fewer adjacent pairs told apart (docs/performance.md)",
             n_ayss=20_000,
             max_seeds=7,
+        ),
+        "fast": Budget(
+            5_000,
+            5_000,
+            5,
+            "a quarter of the transitions at 5x the paper's learning rate, one more seed "
+            "(issue 40; docs/performance.md)",
+            n_ayss=20_000,
+            max_seeds=7,
+            learning_rate=5e-5,
         ),
         "paper": Budget(100_000, 10_000, 3, "the paper's protocol"),
     }

@@ -120,6 +120,9 @@ class PipelineConfig:
     """Transitions per run for every experiment; None: the budget's (or the experiment's)."""
     eval_every: int | None = None
     """Transitions between SPCP candidates; None: the budget's (or the experiment's)."""
+    learning_rate: float | None = None
+    """Every experiment's ``agent.learning_rate`` (Adam, > 0); None: the budget's where it
+    names one (``fast``), else the experiment's."""
     early_stop_patience: int | None = None
     """Every experiment's ``train.early_stop_patience`` (stop a run once its candidates stop
     moving, :mod:`sumo_ayss.analysis.early_stop`); None: the experiment's (off by default)."""
@@ -155,6 +158,8 @@ class PipelineConfig:
                 object.__setattr__(self, "total_timesteps", b.total_timesteps)
             if self.eval_every is None:
                 object.__setattr__(self, "eval_every", b.eval_every)
+            if self.learning_rate is None and b.learning_rate is not None:
+                object.__setattr__(self, "learning_rate", b.learning_rate)
             ev = self.evaluate
             if (
                 b.n_ayss is not None
@@ -193,6 +198,8 @@ class PipelineConfig:
                 f"({self.total_timesteps}): a run needs at least one SPCP candidate (a "
                 "smaller total_timesteps than the budget's needs a smaller eval_every too)",
             )
+        if self.learning_rate is not None:
+            check_number("learning_rate", self.learning_rate, low=0.0, low_open=True)
         check_int("early_stop_patience", self.early_stop_patience, 1, none_ok=True)
         if self.early_stop_margin_se is not None:
             check_number("early_stop_margin_se", self.early_stop_margin_se, 0.0)

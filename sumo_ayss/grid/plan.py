@@ -72,6 +72,9 @@ def case_experiment(cfg: PipelineConfig, case: str) -> ExperimentConfig:
     if cfg.early_stop_margin_se is not None:
         overrides["early_stop_margin_se"] = cfg.early_stop_margin_se
     exp = dataclasses.replace(exp, train=dataclasses.replace(exp.train, **overrides))
+    if cfg.learning_rate is not None:
+        agent = dataclasses.replace(exp.agent, learning_rate=cfg.learning_rate)
+        exp = dataclasses.replace(exp, agent=agent)
     if cfg.follower is not None:
         follower = dataclasses.replace(exp.env.follower, enabled=cfg.follower)
         exp = dataclasses.replace(exp, env=dataclasses.replace(exp.env, follower=follower))

@@ -65,7 +65,7 @@ def test_the_command_line_budget_replaces_the_yamls(tmp_path: Path) -> None:
 
 def test_an_unknown_budget_is_refused_with_the_allowed_names(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match=r"budget.*paper.*verdict|budget.*verdict.*paper"):
-        load_pipeline(_yaml(tmp_path, budget="fast"))
+        load_pipeline(_yaml(tmp_path, budget="fastest"))
 
 
 def test_an_empty_seed_list_is_still_refused(tmp_path: Path) -> None:
@@ -143,3 +143,31 @@ def test_the_quick_budget_trains_half_the_transitions_with_one_seed_more(tmp_pat
     assert cfg.max_seeds == 7 and cfg.added_seeds == (5, 6)
     assert cfg.evaluate.ayss.n_samples == 20_000
     assert _trained(_yaml(tmp_path))[0] == {20_000}  # the default is unchanged
+
+
+def _learning_rates(path: Path, **overrides: object) -> set[float]:
+    return {j.experiment.agent.learning_rate for j in plan_jobs(load_pipeline(path, **overrides))}
+
+
+def test_the_fast_budget_trains_a_quarter_of_the_transitions_at_a_larger_learning_rate(
+    tmp_path: Path,
+) -> None:
+    """``fast`` (issue 40): 5,000 transitions, one candidate, seeds 0-4 growing to 7, and
+    the learner's learning rate 5e-5 in every experiment; a pipeline's own learning rate
+    (YAML or ``--learning-rate``) wins, and no other budget touches the experiment's."""
+    path = _yaml(tmp_path, budget="fast")
+    assert _trained(path) == ({5_000}, {5_000}, (0, 1, 2, 3, 4))
+    assert load_pipeline(path).added_seeds == (5, 6)
+    assert _learning_rates(path) == {5e-5}
+    assert _learning_rates(path, learning_rate=2e-5) == {2e-5}
+    assert _learning_rates(_yaml(tmp_path, budget="fast", learning_rate=3e-5)) == {3e-5}
+    for other in ("verdict", "quick", "paper"):
+        assert _learning_rates(_yaml(tmp_path, budget=other)) == {1e-5}  # configs/cut_in.yaml
+    assert _learning_rates(_yaml(tmp_path, budget="paper"), learning_rate=4e-5) == {4e-5}
+    assert "learning rate 5e-05" in BUDGETS["fast"].describe()
+
+
+def test_a_bad_learning_rate_is_refused_by_name(tmp_path: Path) -> None:
+    for bad in (0.0, -1e-5):
+        with pytest.raises(ConfigError, match=r"learning_rate must be in \(0, inf\)"):
+            load_pipeline(_yaml(tmp_path, learning_rate=bad))

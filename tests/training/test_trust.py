@@ -77,14 +77,14 @@ def test_spcp_state_from_the_learning_curve(tmp_path: Path) -> None:
 def test_small_budget_report_says_so_first(tmp_path: Path) -> None:
     for vut in ("pi1", "pi2"):
         for seed in (0, 1):
-            _set_budget(make_run(tmp_path / "runs", "car_following", vut, seed), 5_000, 2_500)
+            _set_budget(make_run(tmp_path / "runs", "car_following", vut, seed), 2_500, 1_250)
     html = write_report([tmp_path / "runs"], tmp_path / "out", options=FAST)
     md = (tmp_path / "out" / "summary.md").read_text()
     first = md.split("## Verdicts")[0]
-    assert "Small training budget: 5,000 transitions per run" in first
-    assert "below the 10,000 of the smallest budget" in first  # 'quick' (issue 40)
+    assert "Small training budget: 2,500 transitions per run" in first
+    assert "below the 5,000 of the smallest budget" in first  # 'fast' (issue 40)
     assert "NOT to be trusted" in first
-    assert "| total_timesteps | eval_every |" in md and "| 5,000 | 2,500 |" in md
+    assert "| total_timesteps | eval_every |" in md and "| 2,500 | 1,250 |" in md
     assert "NOT to be trusted" in html.read_text()
     assert str(tmp_path) not in md  # run folders relative to the report
     assert "../runs/car_following/pi1/seed_0" in md
