@@ -39,7 +39,19 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
-__all__ = ["BUDGETS", "BUDGET_CHOICES", "BUDGET_HELP", "DEFAULT_BUDGET", "Budget"]
+__all__ = [
+    "BUDGETS",
+    "BUDGET_CHOICES",
+    "BUDGET_HELP",
+    "DEFAULT_BUDGET",
+    "PAPER_LEARNING_RATE",
+    "Budget",
+]
+
+PAPER_LEARNING_RATE = 1e-5
+"""The paper's Adam learning rate (made for 100,000 transitions): ``agent.learning_rate`` of
+the shipped case configs and of :class:`~sumo_ayss.agents.hparams.DQNHyperParams`; a budget
+that names no learning rate was validated with it."""
 
 
 @dataclass(frozen=True)
@@ -69,6 +81,11 @@ class Budget:
     n_ayss: int | None = None
     max_seeds: int | None = None
     learning_rate: float | None = None
+
+    @property
+    def validated_learning_rate(self) -> float:
+        """The learning rate the budget was validated with: its own, else the paper's."""
+        return PAPER_LEARNING_RATE if self.learning_rate is None else self.learning_rate
 
     def describe(self) -> str:
         """``"20,000 transitions, a candidate every 5,000, 4 seeds per VUT: ..."``."""

@@ -311,6 +311,7 @@ def read_run(path: str | Path) -> RunRecord:
             "" if config is None else config_key(config.as_dict()),
             rows,
             spcp.step if spcp is not None else None,
+            None if config is None else config.experiment.get("agent"),
         ),
         problems=tuple(r.problems),
     )

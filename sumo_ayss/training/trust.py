@@ -53,6 +53,7 @@ class Training:
         gap_se: (SPCP's mean evaluation reward − the last candidate's) / the SPCP's
             standard error (``std_return / sqrt(n_episodes)``); NaN if unknown.
         still_improving: True when the SPCP is the last candidate; None when unknown.
+        learning_rate: ``agent.learning_rate``, None if unknown.
     """
 
     total_timesteps: int | None = None
@@ -63,6 +64,7 @@ class Training:
     last_step: int | None = None
     gap_se: float = math.nan
     still_improving: bool | None = None
+    learning_rate: float | None = None
 
 
 def _int_or_none(value: Any) -> int | None:
@@ -70,18 +72,24 @@ def _int_or_none(value: Any) -> int | None:
 
 
 def training_of(
-    train: Any, key: str, rows: Sequence[Mapping[str, Any]], spcp_step: int | None
+    train: Any,
+    key: str,
+    rows: Sequence[Mapping[str, Any]],
+    spcp_step: int | None,
+    agent: Any = None,
 ) -> Training:
     """The :class:`Training` of a run (:func:`sumo_ayss.run_folder.read_run` computes it as
     it reads): its stored ``train`` section (None: unknown), its
     :func:`~sumo_ayss.config.identity.config_key` ("" if unknown), its ``eval.csv`` rows
-    sorted by step and its SPCP's step."""
+    sorted by step, its SPCP's step and its stored ``agent`` section (None: unknown)."""
     total = every = None
     if isinstance(train, Mapping):
         total = _int_or_none(train.get("total_timesteps"))
         every = _int_or_none(train.get("eval_every"))
+    lr = agent.get("learning_rate") if isinstance(agent, Mapping) else None
+    rate = float(lr) if isinstance(lr, int | float) and not isinstance(lr, bool) else None
     if not rows or spcp_step is None:
-        return Training(total, every, key, len(rows), spcp_step)
+        return Training(total, every, key, len(rows), spcp_step, learning_rate=rate)
     last = rows[-1]
     spcp = next((r for r in rows if int(r["step"]) == spcp_step), None)
     gap = math.nan
@@ -90,7 +98,9 @@ def training_of(
         diff = spcp["mean_return"] - last["mean_return"]
         gap = diff / se if se > 0 else (0.0 if diff == 0 else math.inf)
     improving = int(last["step"]) == spcp_step
-    return Training(total, every, key, len(rows), spcp_step, int(last["step"]), gap, improving)
+    return Training(
+        total, every, key, len(rows), spcp_step, int(last["step"]), gap, improving, rate
+    )
 
 
 def all_same(returns: NDArray[np.float64], no_signal: tuple[str, float] | None) -> str | None:
@@ -157,8 +167,23 @@ def mixing_problems(
 
 TRUSTED_TIMESTEPS = min(b.total_timesteps for b in BUDGETS.values())
 """Training transitions per run below which verdicts are flagged as not to be trusted: the
-smallest named budget's (``verdict``, 20,000), the least that ordered every validation ladder
-right with its seeds (docs/performance.md)."""
+smallest named budget's (``fast``, 5,000 at its learning rate), the least that ordered every
+validation ladder right with its seeds (docs/performance.md)."""
+
+
+def _rates_fit(b: Budget, rates: Iterable[float | None]) -> bool:
+    """Whether every known learning rate is the one ``b`` was validated with."""
+    return all(r is None or math.isclose(r, b.validated_learning_rate, rel_tol=1e-9) for r in rates)
+
+
+def _sized(total: int, seeds_per_vut: int) -> list[tuple[str, Budget]]:
+    """The named budgets whose transitions and seeds a protocol meets."""
+    return [
+        (name, b)
+        for name, b in BUDGETS.items()
+        if total >= b.total_timesteps and seeds_per_vut >= b.seeds
+    ]
+
 
 NOISE_SE = 2.0
 """The last candidate counts as "within noise" of the SPCP when its mean evaluation reward
@@ -188,16 +213,14 @@ def validated_budget(
     runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None
 ) -> tuple[str, Budget] | None:
     """The largest named budget (:data:`~sumo_ayss.config.budget.BUDGETS`) whose transitions
-    and seeds ``runs`` meet (every run's budget known), or None."""
+    and seeds ``runs`` meet (every run's budget known) at the learning rate it was validated
+    with (where a run's is known), or None."""
     totals = [t.total_timesteps for _, t in runs]
     if not totals or seeds_per_vut is None or any(t is None for t in totals):
         return None
     total = min(t for t in totals if t is not None)
-    met = [
-        (name, b)
-        for name, b in BUDGETS.items()
-        if total >= b.total_timesteps and seeds_per_vut >= b.seeds
-    ]
+    rates = [t.learning_rate for _, t in runs]
+    met = [(name, b) for name, b in _sized(total, seeds_per_vut) if _rates_fit(b, rates)]
     return max(met, key=lambda nb: nb[1].total_timesteps) if met else None
 
 
@@ -227,9 +250,18 @@ def trust_warnings(
         )
     elif budgets_known and seeds_per_vut is not None:
         total = min(budgets_known)
-        if not any(
-            total >= b.total_timesteps and seeds_per_vut >= b.seeds for b in BUDGETS.values()
-        ):
+        sized = _sized(total, seeds_per_vut)
+        rates = sorted({t.learning_rate for _, t in runs if t.learning_rate is not None})
+        if sized and not any(_rates_fit(b, rates) for _, b in sized):
+            validated = "; ".join(f"{b.validated_learning_rate:g} ({name})" for name, b in sized)
+            out.append(
+                f"Learning rate {', '.join(f'{r:g}' for r in rates)} at {total:,} transitions "
+                f"per run with {seeds_per_vut} seeds per VUT: the budgets validated on ladders "
+                f"at this many transitions and seeds trained at {validated}. In a short run the "
+                "learning rate sets how strong the opponents get; no ladder validated this "
+                "protocol's ranking."
+            )
+        if not sized:
             validated = "; ".join(
                 f"{b.seeds} at {b.total_timesteps:,} ({name})" for name, b in BUDGETS.items()
             )
@@ -265,6 +297,13 @@ def budget_note(runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None)
         return None
     name, b = found
     total = min(t.total_timesteps or 0 for _, t in runs)
+    rate = f", learning rate {b.learning_rate:g}" if b.learning_rate is not None else ""
+    curve = (
+        ", and the verdict curve found the same order at every budget it tried, from 10,000 "
+        "to 100,000 transitions"
+        if b.total_timesteps >= 10_000
+        else " on fresh seeds with the known ends significant"
+    )
     improving = sum(1 for _, t in runs if t.still_improving)
     last = (
         f"{improving} of {len(runs)} SPCPs were the last candidate of their training (listed "
@@ -279,11 +318,10 @@ def budget_note(runs: Sequence[tuple[str, Training]], seeds_per_vut: int | None)
     )
     return (
         f"Budget: {total:,} transitions per run and {seeds_per_vut} or more seeds per VUT, at "
-        f"least the '{name}' budget ({b.total_timesteps:,} transitions, {b.seeds} seeds). "
+        f"least the '{name}' budget ({b.total_timesteps:,} transitions, {b.seeds} seeds{rate}). "
         "Validated at this budget: the cross-play ranking of the validation ladders (braking, "
         "ACC time gap, minGap, time headway; reaction time in cut-in) came out in their known "
-        "order, and the verdict curve found the same order at every budget it tried, from "
-        "10,000 to 100,000 transitions (docs/performance.md). Not validated: that each SPCP "
+        f"order{curve} (docs/performance.md). Not validated: that each SPCP "
         "has converged ("
         f"{last}); VUT kinds unlike the ladders' (the reaction-time ladder's car-following "
         f"order is inverted at every budget){paper}."

@@ -7,8 +7,9 @@ from pathlib import Path
 import pytest
 import yaml
 
+from sumo_ayss.agents.hparams import DQNHyperParams
 from sumo_ayss.config import load_pipeline
-from sumo_ayss.config.budget import BUDGETS, DEFAULT_BUDGET
+from sumo_ayss.config.budget import BUDGETS, DEFAULT_BUDGET, PAPER_LEARNING_RATE
 from sumo_ayss.pipeline import plan_jobs
 from sumo_ayss.util.errors import ConfigError
 from sumo_ayss.util.paths import PROJECT_ROOT
@@ -171,3 +172,13 @@ def test_a_bad_learning_rate_is_refused_by_name(tmp_path: Path) -> None:
     for bad in (0.0, -1e-5):
         with pytest.raises(ConfigError, match=r"learning_rate must be in \(0, inf\)"):
             load_pipeline(_yaml(tmp_path, learning_rate=bad))
+
+
+def test_the_papers_learning_rate_is_the_shipped_configs() -> None:
+    """A budget without a learning rate was validated with the shipped configs' (trust)."""
+    assert DQNHyperParams().learning_rate == PAPER_LEARNING_RATE
+    for case in ("car_following", "cut_in", "lead_and_cut_in"):
+        data = yaml.safe_load((PROJECT_ROOT / "configs" / f"{case}.yaml").read_text())
+        assert data["agent"]["learning_rate"] == PAPER_LEARNING_RATE
+    assert BUDGETS["verdict"].validated_learning_rate == PAPER_LEARNING_RATE
+    assert BUDGETS["fast"].validated_learning_rate == 5e-5

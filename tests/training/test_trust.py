@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import pytest
 
+from sumo_ayss.config.budget import BUDGETS
 from sumo_ayss.report import write_report
 from sumo_ayss.run_folder import (
     RunConfig,
@@ -19,10 +21,12 @@ from sumo_ayss.run_folder import (
 from sumo_ayss.training.selection import Selection
 from sumo_ayss.training.trust import (
     Training,
+    budget_note,
     fewest_seeds,
     mixing_problems,
     training_status,
     trust_warnings,
+    validated_budget,
 )
 from sumo_ayss.util.errors import ConfigError
 from tests.report.test_report import FAST, make_run
@@ -183,3 +187,40 @@ def test_runs_that_must_not_be_pooled_are_named() -> None:
     other = Training(total_timesteps=2000, eval_every=500, config_key="k")
     budgets = mixing_problems([*ok, ("car_following", "pi3", 0, "pi3/0", other)])
     assert len(budgets) == 1 and "different training budgets" in budgets[0]
+
+
+def test_a_budget_counts_only_at_the_learning_rate_it_was_validated_with() -> None:
+    """'fast' was validated at 5e-5: 5,000 transitions at the paper's 1e-5 is another
+    protocol, named as such; a run whose learning rate is unknown is not held against it."""
+    fast = Training(5_000, 5_000, "k", 1, 5_000, 5_000, 0.0, True, 5e-5)
+    assert trust_warnings([("a", fast)], seeds_per_vut=5) == []
+    found = validated_budget([("a", fast)], 5)
+    assert found is not None and found[0] == "fast"
+    note = budget_note([("a", fast)], 5)
+    assert note is not None and "learning rate 5e-05" in note and "fresh seeds" in note
+    assert "10,000 to 100,000" not in note
+    slow = dataclasses.replace(fast, learning_rate=1e-5)
+    warnings = trust_warnings([("a", slow)], seeds_per_vut=5)
+    assert warnings[0].startswith("Learning rate 1e-05 at 5,000 transitions per run")
+    assert "trained at 5e-05 (fast)" in warnings[0]
+    assert "more training could change them" in warnings[-1]
+    assert validated_budget([("a", slow)], 5) is None and budget_note([("a", slow)], 5) is None
+    unknown = dataclasses.replace(fast, learning_rate=None)
+    assert trust_warnings([("a", unknown)], seeds_per_vut=5) == []
+    t20 = Training(20_000, 5_000, "k", 4, 20_000, 20_000, 0.0, False, 5e-5)
+    assert trust_warnings([("a", t20)], seeds_per_vut=4)[0].startswith("Learning rate 5e-05")
+    assert validated_budget([("a", t20)], 5) == ("fast", BUDGETS["fast"])  # 5 seeds: fast's
+    t20_paper = dataclasses.replace(t20, learning_rate=1e-5)
+    assert validated_budget([("a", t20_paper)], 4) == ("verdict", BUDGETS["verdict"])
+
+
+def test_a_run_folder_records_its_learning_rate(tmp_path: Path) -> None:
+    run = make_run(tmp_path, "car_following", "pi1", 0, files=("config", "eval", "spcp"))
+    assert read_run(run).training.learning_rate is None  # its config.yaml names none
+    folder = RunFolder(run)
+    config = read_run_config(folder.config)
+    agent = {**config.experiment["agent"], "learning_rate": 5e-5}
+    write_run_config(
+        folder.config, RunConfig(config.vut, config.seed, {**config.experiment, "agent": agent})
+    )
+    assert read_run(run).training.learning_rate == 5e-5
