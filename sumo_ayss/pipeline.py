@@ -51,7 +51,8 @@ import functools
 import logging
 import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, NamedTuple, Protocol
 
@@ -273,10 +274,10 @@ def _run_locked(
         statuses, runs = run_adaptive(
             cfg, statuses, runs, run_jobs, run_crossplay_stage, plan_seed, load_runs
         )
-    write_discriminability(cfg)
     drawing = " and drawing the figures" if write_report is not None else ""
-    logger.info("report: analysing %d run folders%s", len(runs), drawing)
-    analyses = analyse_cases(case_runs(runs), cfg.report)  # once per case: the report's and rank's
+    with discriminability_beside(cfg):  # it reads the config only; the report reads its files
+        logger.info("report: analysing %d run folders%s", len(runs), drawing)
+        analyses = analyse_cases(case_runs(runs), cfg.report)  # once per case: report's, rank's
     report = (
         None
         if write_report is None
@@ -376,32 +377,60 @@ def _crossplay_progress(case: str, line: str) -> None:
     logger.info("cross-play %s: %s", case, line)
 
 
-def write_discriminability(cfg: PipelineConfig) -> None:
+@contextmanager
+def discriminability_beside(cfg: PipelineConfig) -> Iterator[None]:
+    """:func:`write_discriminability` in a worker process while the body runs (the report's
+    analysis: about 25 s of one core on a 3-VUT ladder, beside discriminability's 27 s of
+    SUMO; docs/performance.md, "Session 13"); done when the body is. With one worker,
+    in this process before the body. Its failures are logged here, never fatal."""
+    if len(cfg.grid.vuts) < 2:
+        yield
+        return
+    logger.info(
+        "discriminability of %s: one-step responses of %d VUTs over the AYSS box "
+        "(seconds per VUT; skipped when up to date)",
+        ", ".join(cfg.grid.cases),
+        len(cfg.grid.vuts),
+    )
+    if cfg.n_workers <= 1:
+        failures = write_discriminability(cfg)
+        yield
+    else:
+        from sumo_ayss.grid.workers import spawn_pool
+
+        pool = spawn_pool(1)
+        try:
+            future = pool.submit(write_discriminability, cfg)
+            yield
+            failures = future.result()
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+    for line in failures:
+        logger.warning("%s", line)
+
+
+def write_discriminability(cfg: PipelineConfig) -> list[str]:
     """``<out>/<case>/discriminability.json`` (+ .csv, .png) for every case with >= 2 VUTs.
 
     Where the grid's VUTs' one-step responses differ over the AYSS box
     (:mod:`sumo_ayss.discriminability`, default grid, some seconds per VUT); the report shows
-    it. Skipped when an up-to-date record exists; a failure is logged, never fatal.
+    it. Skipped when an up-to-date record exists. Returns the failures, one line per case
+    (never fatal: the report says so); a full disk raises.
     """
     if len(cfg.grid.vuts) < 2:
-        return
+        return []
     from sumo_ayss import discriminability
-    from sumo_ayss.util.errors import AyssError, DiskFullError
 
+    failures = []
     for case in cfg.grid.cases:
-        logger.info(
-            "discriminability of %s: one-step responses of %d VUTs over the AYSS box "
-            "(seconds per VUT; skipped when up to date)",
-            case,
-            len(cfg.grid.vuts),
-        )
         try:
             env = discriminability.pipeline_env(cfg, case)
             discriminability.ensure(env, cfg.grid.vuts, StudyFolder(cfg.out).case(case).path)
         except DiskFullError:
             raise
         except (AyssError, ImportError, OSError) as e:  # never fatal: the report says so
-            logger.warning("discriminability of %s not computed: %s", case, e)
+            failures.append(f"discriminability of {case} not computed: {e}")
+    return failures
 
 
 def add_config_flags(parser: argparse.ArgumentParser) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import os
@@ -18,7 +19,7 @@ import yaml
 
 from sumo_ayss.commands.pipeline import run_pipeline
 from sumo_ayss.config import PROJECT_ROOT, AyssConfig, ExperimentConfig
-from sumo_ayss.pipeline import load_pipeline, plan_jobs
+from sumo_ayss.pipeline import discriminability_beside, load_pipeline, plan_jobs
 from sumo_ayss.records.table import read_table
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA
 from sumo_ayss.util.errors import ConfigError
@@ -61,6 +62,17 @@ def test_bad_grid_is_refused_before_any_job(tmp_path: Path, grid: dict, match: s
     with pytest.raises(ConfigError, match=match):
         plan_jobs(load_pipeline(path))
     assert not (tmp_path / "runs").exists()
+
+
+@pytest.mark.sumo
+def test_discriminability_is_written_by_a_worker_beside_the_analysis(tmp_path: Path) -> None:
+    """With two workers it runs in a worker process while the body (the report's analysis)
+    runs here, and is on disk when the body is done."""
+    cfg = dataclasses.replace(load_pipeline(write_configs(tmp_path, [0])), workers=2)
+    record = cfg.out / "car_following" / "discriminability.json"
+    with discriminability_beside(cfg):
+        assert not record.exists()  # the worker has just been spawned
+    assert json.loads(record.read_text())["vuts"] == ["pi1", "pi2"]
 
 
 @pytest.mark.sumo

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from contextlib import nullcontext
 from pathlib import Path
 
 import pytest
@@ -108,7 +109,7 @@ def test_rank_after_the_pipeline_reads_and_analyses_each_case_once(tmp_path, mon
         "run_grid_local",
         lambda jobs, *a, **k: [JobStatus(spec=j, state="done") for j in jobs],
     )
-    monkeypatch.setattr(pipeline_mod, "write_discriminability", lambda cfg: None)
+    monkeypatch.setattr(pipeline_mod, "discriminability_beside", lambda cfg: nullcontext())
     # The folders above are made by hand with the default experiment, not the grid's budget.
     monkeypatch.setattr("sumo_ayss.grid.study.check_same_study", lambda cfg, jobs: None)
     counts: dict[str, list[str]] = {"ayss": [], "crossplay": [], "bootstrap": [], "case": []}
