@@ -12,10 +12,10 @@ of machine load hits every kind alike), on the same scenes:
 * ``--ladder N``: CPU seconds (this process and its children) and wall seconds of a 3-VUT
   ACC ladder (T = 0.6, 1.2, 2.0 s) through the pipeline, N transitions per run, one seed,
   per kind (python, C FMU, process);
-* ``--verdict``: the same ladder at the default ``verdict`` budget (20,000 transitions, 4
-  seeds per VUT, adaptive up to 6), car-following, per kind: CPU and wall seconds to the
-  verdict, and the verdict itself (the order against T = 2.0 > 1.2 > 0.6, Kendall τ, whether
-  the ends differ significantly). ``--keep DIR`` keeps the run folders.
+* ``--verdict``: the same ladder at the default budget (``verdict`` until session 13:
+  20,000 transitions, 4 seeds per VUT, adaptive up to 6), car-following, per kind: CPU and
+  wall seconds to the verdict, and the verdict itself (the order against T = 2.0 > 1.2 >
+  0.6, Kendall τ, whether the ends differ significantly). ``--keep DIR`` keeps the run folders.
 
     python benchmarks/vut_kinds.py [--steps 20000] [--repeats 3] [--states 5000] [--ladder 0]
     python benchmarks/vut_kinds.py --verdict [--kinds python,fmu2,process] [--keep DIR]
@@ -156,8 +156,8 @@ def bench_ladder(
 ) -> tuple[float, float, str]:
     """(CPU s, wall s, ranking) of a 3-VUT ACC ladder through the pipeline.
 
-    ``steps`` None runs the default (``verdict``) budget with its own seeds and adaptive
-    seeding, and reads the verdict from ``order_check.json``.
+    ``steps`` None runs the default budget (``fast`` since session 13) with its own seeds and
+    adaptive seeding, and reads the verdict from ``order_check.json``.
     """
     import json
 
@@ -222,7 +222,7 @@ def main() -> None:
     parser.add_argument("--states", type=int, default=5_000)
     parser.add_argument("--ladder", type=int, default=0, help="transitions per ladder run")
     parser.add_argument(
-        "--verdict", action="store_true", help="only the ladder, at the default verdict budget"
+        "--verdict", action="store_true", help="only the ladder, at the default budget"
     )
     parser.add_argument(
         "--kinds", default=",".join(LADDER_KINDS), help=f"ladder kinds, of {list(LADDER_KINDS)}"

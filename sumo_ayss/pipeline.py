@@ -29,7 +29,7 @@ Pipeline YAML (every key optional)::
     grid: {cases: [car_following, cut_in], vuts: [pi1, pi2], seeds: [0, 1, 2, 3]}  # budget
     experiments: {car_following: car_following.yaml, cut_in: cut_in.yaml}  # per case
     out: ../runs/paper          # relative to the YAML file
-    budget: verdict             # a named budget: verdict (default) | paper | null (config.budget)
+    budget: fast                # a named budget: fast (default) | verdict | quick | paper | null
     total_timesteps: null       # override the budget's / every experiment's train.total_timesteps
     eval_every: null            # override the budget's / every experiment's train.eval_every
     learning_rate: null         # override the budget's / every experiment's agent.learning_rate
@@ -479,7 +479,7 @@ def add_config_flags(parser: argparse.ArgumentParser) -> None:
         type=int,
         default=None,
         help="adaptive seeding: add seeds to a case whose ranking has not settled, up to this "
-        "many per VUT (default: the budget's when it chose the seeds, verdict 6; else fixed)",
+        "many per VUT (default: the budget's when it chose the seeds, fast 7; else fixed)",
     )
 
 

@@ -4,25 +4,34 @@ A pipeline's ``budget`` names one of :data:`BUDGETS`; the pipeline's own ``total
 ``eval_every`` and ``grid.seeds``, where given, win over it, and ``budget: null`` leaves
 every experiment's ``train`` section as its file says (the behaviour before budgets).
 
-* ``verdict`` (the default): 20,000 transitions per run, a candidate every 5,000, four
-  training seeds per VUT to start with and **adaptive seeding** up to six (a case whose
-  cross-play ranking has not settled gets one more seed per VUT at a time,
-  :mod:`sumo_ayss.grid.adaptive`), 20,000 AYSS draws. Chosen from the verdict's learning curve
-  (docs/performance.md, ``scripts/verdict_curve.py``): on the braking and ACC ladders (six
-  seeds each, every 4-seed subset) the cross-play ranking had Kendall τ = 1 with significant
-  ends in both cases at 20,000 transitions with four seeds, at under a third of the
-  CPU-seconds of three seeds at 100,000 (the paper's budget). Real runs on fresh seeds
-  ordered every ladder right (τ = 1) with significant ends on all but one ladder-case with
-  four seeds (minGap, car-following: p 0.11); adaptive seeding settled it at five (p 0.037).
-  The AYSS draws feed only the paper's reading (``report.mode: paper``), not the cross-play
-  verdict; that reading wants the paper budget.
+* ``fast`` (the default, since session 13): 5,000 transitions per run, one SPCP candidate (at
+  the end), five seeds per VUT to start with and **adaptive seeding** up to seven (a case
+  whose cross-play ranking has not settled gets one more seed per VUT at a time,
+  :mod:`sumo_ayss.grid.adaptive`), 20,000 AYSS draws, and the learner's learning rate 5e-5,
+  five times the paper's (whose 1e-5 was made for 100,000 transitions; a pipeline's own
+  ``learning_rate`` wins). Chosen from the frontier (issue 40): on the braking ladder the
+  learning rate moved the cheapest point at which every seed subset ranked right with
+  Holm-significant ends from 10k × 7 to 5k × 5. Real 5k runs on fresh seeds ordered every
+  committed ladder right (τ = 1 where the known order is recovered) with the known ends
+  significant (minGap car-following at 7 seeds, careful-human cut-in at 6), telling apart
+  23 of 30 adjacent pairs under Holm (``verdict`` on other fresh seeds: 26; ``quick``: 21);
+  a 3-VUT ladder, both cases, in 4.4 min on this 2-core machine (docs/performance.md,
+  results/budget_validation/fast/). The AYSS draws feed only the paper's reading
+  (``report.mode: paper``), not the cross-play verdict; that reading wants the paper budget.
+* ``verdict``: 20,000 transitions per run, a candidate every 5,000, four seeds per VUT,
+  adaptive up to six, 20,000 AYSS draws, the paper's learning rate (the default before
+  session 13). Chosen from the verdict's learning curve (docs/performance.md,
+  ``scripts/verdict_curve.py``): on the braking and ACC ladders (six seeds each, every 4-seed
+  subset) the cross-play ranking had Kendall τ = 1 with significant ends in both cases, at
+  under a third of the CPU-seconds of three seeds at 100,000 (the paper's budget). Real runs
+  on fresh seeds ordered every ladder right (τ = 1) with significant ends (minGap
+  car-following after a fifth seed). Slower than ``fast``; its leaderboards tell a few more
+  neighbours apart.
 * ``quick``: 10,000 transitions per run, a candidate every 5,000, five seeds per VUT to start
-  with, adaptive up to seven, 20,000 AYSS draws: about 0.6 of ``verdict``'s training
-  transitions. Chosen from the frontier (issue 40): on fresh seeds it ordered every ladder as
-  ``verdict`` does (τ = 1 where the known order is recovered, the known ends significant),
-  but its leaderboard tells fewer adjacent VUTs apart (braking and minGap car-following: none
-  under Holm, where ``verdict`` tells all): faster, weaker claims; not the default
-  (docs/performance.md, results/budget_validation/).
+  with, adaptive up to seven, 20,000 AYSS draws, the paper's learning rate: about 0.6 of
+  ``verdict``'s training transitions (issue 40, session 12). On fresh seeds it ordered every
+  ladder as ``verdict`` does, but its leaderboard tells fewer adjacent VUTs apart (braking
+  and minGap car-following: none under Holm); ``fast`` is cheaper and tells more apart.
 * ``paper``: the paper's protocol, 100,000 transitions, a candidate every 10,000, three
   seeds: what every committed study before budgets ran.
 
@@ -103,11 +112,21 @@ class Budget:
 
 BUDGETS: Mapping[str, Budget] = MappingProxyType(
     {
+        "fast": Budget(
+            5_000,
+            5_000,
+            5,
+            "every validation ladder ordered right with the ends significant on fresh seeds, "
+            "a 3-VUT ladder in under 5 minutes on 2 cores (docs/performance.md)",
+            n_ayss=20_000,
+            max_seeds=7,
+            learning_rate=5e-5,
+        ),
         "verdict": Budget(
             20_000,
             5_000,
             4,
-            "the least compute that ordered every validation ladder right (docs/performance.md)",
+            "the default before session 13: slower than fast, tells a few more neighbours apart",
             n_ayss=20_000,
             max_seeds=6,
         ),
@@ -115,27 +134,17 @@ BUDGETS: Mapping[str, Budget] = MappingProxyType(
             10_000,
             5_000,
             5,
-            "half the transitions, one more seed: every ladder ordered right with the ends "
-            "significant, fewer adjacent pairs told apart (docs/performance.md)",
+            "half of verdict's transitions, one more seed: every ladder ordered right with the "
+            "ends significant, fewer adjacent pairs told apart (docs/performance.md)",
             n_ayss=20_000,
             max_seeds=7,
-        ),
-        "fast": Budget(
-            5_000,
-            5_000,
-            5,
-            "a quarter of the transitions at 5x the paper's learning rate, one more seed "
-            "(issue 40; docs/performance.md)",
-            n_ayss=20_000,
-            max_seeds=7,
-            learning_rate=5e-5,
         ),
         "paper": Budget(100_000, 10_000, 3, "the paper's protocol"),
     }
 )
 """Budget name -> :class:`Budget`."""
 
-DEFAULT_BUDGET = "verdict"
+DEFAULT_BUDGET = "fast"
 """The budget of a pipeline that names none."""
 
 BUDGET_HELP = (

@@ -112,10 +112,10 @@ class PipelineConfig:
     """Experiment YAML per case; default: ``configs/<case>.yaml`` of every registered case."""
     out: Path = Path("runs") / "paper"
     budget: str | None = DEFAULT_BUDGET
-    """A named budget (:data:`~sumo_ayss.config.budget.BUDGETS`: ``verdict``, the default, or
-    ``paper``) that sets ``total_timesteps``, ``eval_every``, ``grid.seeds`` and the AYSS
-    draws where they are not given; None: every experiment's ``train`` section as its file
-    says."""
+    """A named budget (:data:`~sumo_ayss.config.budget.BUDGETS`: ``fast``, the default,
+    ``verdict``, ``quick`` or ``paper``) that sets ``total_timesteps``, ``eval_every``,
+    ``grid.seeds``, the AYSS draws and (``fast``) the learning rate where they are not
+    given; None: every experiment's ``train`` section as its file says."""
     total_timesteps: int | None = None
     """Transitions per run for every experiment; None: the budget's (or the experiment's)."""
     eval_every: int | None = None
@@ -132,7 +132,7 @@ class PipelineConfig:
     """Adaptive seeding: a case whose cross-play ranking has not settled after ``grid.seeds``
     gets one more seed per VUT at a time (the next integer after the last seed), up to this
     many seeds per VUT (:mod:`sumo_ayss.grid.adaptive`). None: the budget's cap when the budget
-    also chose the seeds (``verdict``: 6), else ``len(grid.seeds)``, a fixed grid."""
+    also chose the seeds (``fast``: 7), else ``len(grid.seeds)``, a fixed grid."""
     evaluate: EvaluateConfig = field(default_factory=EvaluateConfig)
     vuts: Mapping[str, VehicleType] = field(default_factory=dict)
     """Extra VUTs (catalog syntax, as in ``env.vuts``) added to every case's experiment, so

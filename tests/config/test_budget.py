@@ -36,7 +36,10 @@ def test_a_pipeline_that_names_no_budget_trains_the_default_one(tmp_path: Path) 
     b = BUDGETS[DEFAULT_BUDGET]
     total, every, seeds = _trained(_yaml(tmp_path))
     assert (total, every, seeds) == ({b.total_timesteps}, {b.eval_every}, tuple(range(b.seeds)))
-    assert DEFAULT_BUDGET == "verdict" and b.total_timesteps < BUDGETS["paper"].total_timesteps
+    assert DEFAULT_BUDGET == "fast" and b.total_timesteps < BUDGETS["paper"].total_timesteps
+    assert {
+        j.experiment.agent.learning_rate for j in plan_jobs(load_pipeline(_yaml(tmp_path)))
+    } == {5e-5}
 
 
 def test_the_paper_budget_is_the_papers_protocol(tmp_path: Path) -> None:
@@ -102,7 +105,7 @@ def test_committed_studies_still_train_what_they_ran(config: str) -> None:
 
 
 def test_the_verdict_budget_draws_fewer_ayss_samples_unless_told(tmp_path: Path) -> None:
-    verdict = load_pipeline(_yaml(tmp_path))
+    verdict = load_pipeline(_yaml(tmp_path, budget="verdict"))
     assert verdict.evaluate.ayss.n_samples == BUDGETS["verdict"].n_ayss == 20_000
     assert load_pipeline(_yaml(tmp_path, budget="paper")).evaluate.ayss.n_samples == 100_000
     told = load_pipeline(_yaml(tmp_path, evaluate={"n_ayss": 5000}))
@@ -114,7 +117,7 @@ def test_the_verdict_budget_draws_fewer_ayss_samples_unless_told(tmp_path: Path)
 def test_adaptive_seeding_cap_comes_with_the_budgets_seeds_only(tmp_path: Path) -> None:
     """The verdict budget's seeds may grow to its cap; named seeds make a fixed grid unless
     max_seeds is given; a cap below the seeds is refused by name."""
-    path = _yaml(tmp_path)
+    path = _yaml(tmp_path, budget="verdict")
     cfg = load_pipeline(path)
     assert cfg.seeds == (0, 1, 2, 3) and cfg.max_seeds == BUDGETS["verdict"].max_seeds == 6
     assert cfg.added_seeds == (4, 5)
@@ -143,7 +146,7 @@ def test_the_quick_budget_trains_half_the_transitions_with_one_seed_more(tmp_pat
     cfg = load_pipeline(path)
     assert cfg.max_seeds == 7 and cfg.added_seeds == (5, 6)
     assert cfg.evaluate.ayss.n_samples == 20_000
-    assert _trained(_yaml(tmp_path))[0] == {20_000}  # the default is unchanged
+    assert _trained(_yaml(tmp_path))[0] == {5_000}  # the default: fast
 
 
 def _learning_rates(path: Path, **overrides: object) -> set[float]:
