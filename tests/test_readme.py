@@ -141,7 +141,8 @@ def test_controller_pipeline_block_adds_to_the_shipped_experiment(tmp_path: Path
     shipped = load_experiment(PROJECT_ROOT / "configs" / "car_following.yaml")
     acc = [j for j in jobs if j.vut == "acc_tg2"]
     assert len(acc) == 3
-    # The experiment's training settings, the pipeline's budget (transitions, cadence) aside.
+    # The experiment's training settings, the pipeline's budget (transitions, cadence and,
+    # at `fast`, the learning rate) aside.
     expected = dataclasses.replace(
         shipped.train,
         progress_bar=False,
@@ -151,7 +152,8 @@ def test_controller_pipeline_block_adds_to_the_shipped_experiment(tmp_path: Path
     for job in acc:
         assert job.experiment.env.vut_type.controller is not None
         assert job.experiment.train == expected
-        assert job.experiment.agent == shipped.agent
+        lr = cfg.learning_rate or shipped.agent.learning_rate
+        assert job.experiment.agent == dataclasses.replace(shipped.agent, learning_rate=lr)
     assert shipped.train.n_envs > 1  # the snippet alone would have given 1
 
 
@@ -212,10 +214,13 @@ def test_replay_export_example_reads_a_run_the_quick_start_makes() -> None:
 def test_readme_states_the_demos_own_budget() -> None:
     """The demo's seeds and transitions as README states them are demo.yaml's (issue 35:
     it said the demo was marked untrusted and that experiments use 100,000 transitions)."""
-    demo = yaml.safe_load((PROJECT_ROOT / "configs" / "demo.yaml").read_text())
+    from sumo_ayss.config.pipeline import load_pipeline
+
+    demo = load_pipeline(PROJECT_ROOT / "configs" / "demo.yaml")  # its budget resolved
     intro = README.split("## Glossary")[0]
-    seeds = len(demo["grid"]["seeds"])
     flat = " ".join(intro.split())
-    assert f"trains {demo['total_timesteps']:,} transitions per run with {seeds} seeds" in flat
+    assert (
+        f"trains {demo.total_timesteps:,} transitions per run with {len(demo.seeds)} seeds" in flat
+    )
     assert "the experiments use 100,000" not in " ".join(README.split())
     assert "not to be trusted" not in intro
