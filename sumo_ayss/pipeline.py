@@ -396,15 +396,22 @@ def discriminability_beside(cfg: PipelineConfig) -> Iterator[None]:
         failures = write_discriminability(cfg)
         yield
     else:
-        from sumo_ayss.grid.workers import spawn_pool
+        from concurrent.futures.process import BrokenProcessPool
+
+        from sumo_ayss.grid.workers import spawn_pool, stop_workers
 
         pool = spawn_pool(1)
         try:
             future = pool.submit(write_discriminability, cfg)
             yield
-            failures = future.result()
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+            try:
+                failures = future.result()
+            except BrokenProcessPool as e:  # the worker died: as any failure, not fatal
+                failures = [f"discriminability not computed: its worker process died ({e})"]
+        except BaseException:
+            stop_workers(pool)  # an error or Ctrl-C in the body: do not wait for it
+            raise
+        pool.shutdown(wait=True)
     for line in failures:
         logger.warning("%s", line)
 
