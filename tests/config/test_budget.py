@@ -185,3 +185,14 @@ def test_the_papers_learning_rate_is_the_shipped_configs() -> None:
         assert data["agent"]["learning_rate"] == PAPER_LEARNING_RATE
     assert BUDGETS["verdict"].validated_learning_rate == PAPER_LEARNING_RATE
     assert BUDGETS["fast"].validated_learning_rate == 5e-5
+
+
+def test_every_committed_pipeline_config_names_its_budget() -> None:
+    """A study's config says what it trained: a change of the default budget (``verdict`` ->
+    ``fast``, session 13) must not change what rerunning a committed study does."""
+    unnamed = [
+        str(path.relative_to(PROJECT_ROOT))
+        for path in sorted((PROJECT_ROOT / "configs").rglob("*.yaml"))
+        if "grid" in (data := yaml.safe_load(path.read_text()) or {}) and "budget" not in data
+    ]
+    assert unnamed == []
