@@ -27,7 +27,8 @@ import dataclasses
 import logging
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -49,9 +50,14 @@ from sumo_ayss.config import (
     load_pipeline,
     read_yaml,
 )
-from sumo_ayss.run_folder import CaseFolder, read_discriminability_json, write_discriminability
+from sumo_ayss.run_folder import (
+    CaseFolder,
+    StudyFolder,
+    read_discriminability_json,
+    write_discriminability,
+)
 from sumo_ayss.stages import DiscriminabilityStage, is_done
-from sumo_ayss.util.errors import AyssError, ConfigError
+from sumo_ayss.util.errors import AyssError, ConfigError, DiskFullError
 
 logger = logging.getLogger(__name__)
 
@@ -246,6 +252,70 @@ def ensure(
     _, meta = compute(env, vuts, **kwargs)
     write_outputs(meta, out_dir)
     return meta
+
+
+# ------------------------------------------------------------------ in the pipeline
+
+
+@contextmanager
+def discriminability_beside(cfg: PipelineConfig) -> Iterator[None]:
+    """:func:`write_for_pipeline` in a worker process while the body runs (the report's
+    analysis: about 25 s of one core on a 3-VUT ladder, beside discriminability's 27 s of
+    SUMO; docs/performance.md, "session 13"); done when the body is. With one worker,
+    in this process before the body. Its failures are logged here, never fatal."""
+    if len(cfg.grid.vuts) < 2:
+        yield
+        return
+    logger.info(
+        "discriminability of %s: one-step responses of %d VUTs over the AYSS box "
+        "(seconds per VUT; skipped when up to date)",
+        ", ".join(cfg.grid.cases),
+        len(cfg.grid.vuts),
+    )
+    if cfg.n_workers <= 1:
+        failures = write_for_pipeline(cfg)
+        yield
+    else:
+        from concurrent.futures.process import BrokenProcessPool
+
+        from sumo_ayss.grid.workers import spawn_pool, stop_workers
+
+        pool = spawn_pool(1)
+        try:
+            future = pool.submit(write_for_pipeline, cfg)
+            yield
+            try:
+                failures = future.result()
+            except BrokenProcessPool as e:  # the worker died: as any failure, not fatal
+                failures = [f"discriminability not computed: its worker process died ({e})"]
+        except BaseException:
+            stop_workers(pool)  # an error or Ctrl-C in the body: do not wait for it
+            raise
+        pool.shutdown(wait=True)
+    for line in failures:
+        logger.warning("%s", line)
+
+
+def write_for_pipeline(cfg: PipelineConfig) -> list[str]:
+    """``<out>/<case>/discriminability.json`` (+ .csv, .png) for every case with >= 2 VUTs.
+
+    Where the grid's VUTs' one-step responses differ over the AYSS box
+    (:mod:`sumo_ayss.discriminability`, default grid, some seconds per VUT); the report shows
+    it. Skipped when an up-to-date record exists. Returns the failures, one line per case
+    (never fatal: the report says so); a full disk raises.
+    """
+    if len(cfg.grid.vuts) < 2:
+        return []
+    failures = []
+    for case in cfg.grid.cases:
+        try:
+            env = pipeline_env(cfg, case)
+            ensure(env, cfg.grid.vuts, StudyFolder(cfg.out).case(case).path)
+        except DiskFullError:
+            raise
+        except (AyssError, ImportError, OSError) as e:  # never fatal: the report says so
+            failures.append(f"discriminability of {case} not computed: {e}")
+    return failures
 
 
 # --------------------------------------------------------------------------- CLI

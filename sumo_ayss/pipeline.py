@@ -51,8 +51,7 @@ import functools
 import logging
 import os
 import sys
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, NamedTuple, Protocol
 
@@ -63,6 +62,7 @@ from sumo_ayss.config import (
     to_dict,
 )
 from sumo_ayss.config.budget import BUDGET_CHOICES, BUDGET_HELP
+from sumo_ayss.discriminability import discriminability_beside
 from sumo_ayss.grid.folder_lock import output_lock
 from sumo_ayss.grid.jobs import JobSpec
 from sumo_ayss.grid.local import run_grid_local
@@ -375,69 +375,6 @@ def _crossplay_cases(
 
 def _crossplay_progress(case: str, line: str) -> None:
     logger.info("cross-play %s: %s", case, line)
-
-
-@contextmanager
-def discriminability_beside(cfg: PipelineConfig) -> Iterator[None]:
-    """:func:`write_discriminability` in a worker process while the body runs (the report's
-    analysis: about 25 s of one core on a 3-VUT ladder, beside discriminability's 27 s of
-    SUMO; docs/performance.md, "Session 13"); done when the body is. With one worker,
-    in this process before the body. Its failures are logged here, never fatal."""
-    if len(cfg.grid.vuts) < 2:
-        yield
-        return
-    logger.info(
-        "discriminability of %s: one-step responses of %d VUTs over the AYSS box "
-        "(seconds per VUT; skipped when up to date)",
-        ", ".join(cfg.grid.cases),
-        len(cfg.grid.vuts),
-    )
-    if cfg.n_workers <= 1:
-        failures = write_discriminability(cfg)
-        yield
-    else:
-        from concurrent.futures.process import BrokenProcessPool
-
-        from sumo_ayss.grid.workers import spawn_pool, stop_workers
-
-        pool = spawn_pool(1)
-        try:
-            future = pool.submit(write_discriminability, cfg)
-            yield
-            try:
-                failures = future.result()
-            except BrokenProcessPool as e:  # the worker died: as any failure, not fatal
-                failures = [f"discriminability not computed: its worker process died ({e})"]
-        except BaseException:
-            stop_workers(pool)  # an error or Ctrl-C in the body: do not wait for it
-            raise
-        pool.shutdown(wait=True)
-    for line in failures:
-        logger.warning("%s", line)
-
-
-def write_discriminability(cfg: PipelineConfig) -> list[str]:
-    """``<out>/<case>/discriminability.json`` (+ .csv, .png) for every case with >= 2 VUTs.
-
-    Where the grid's VUTs' one-step responses differ over the AYSS box
-    (:mod:`sumo_ayss.discriminability`, default grid, some seconds per VUT); the report shows
-    it. Skipped when an up-to-date record exists. Returns the failures, one line per case
-    (never fatal: the report says so); a full disk raises.
-    """
-    if len(cfg.grid.vuts) < 2:
-        return []
-    from sumo_ayss import discriminability
-
-    failures = []
-    for case in cfg.grid.cases:
-        try:
-            env = discriminability.pipeline_env(cfg, case)
-            discriminability.ensure(env, cfg.grid.vuts, StudyFolder(cfg.out).case(case).path)
-        except DiskFullError:
-            raise
-        except (AyssError, ImportError, OSError) as e:  # never fatal: the report says so
-            failures.append(f"discriminability of {case} not computed: {e}")
-    return failures
 
 
 def add_config_flags(parser: argparse.ArgumentParser) -> None:

@@ -19,7 +19,8 @@ import yaml
 
 from sumo_ayss.commands.pipeline import run_pipeline
 from sumo_ayss.config import PROJECT_ROOT, AyssConfig, ExperimentConfig
-from sumo_ayss.pipeline import discriminability_beside, load_pipeline, plan_jobs
+from sumo_ayss.discriminability import discriminability_beside
+from sumo_ayss.pipeline import load_pipeline, plan_jobs
 from sumo_ayss.records.table import read_table
 from sumo_ayss.run_folder import CROSSPLAY_SCHEMA, OUTCOME_SCHEMA
 from sumo_ayss.util.errors import ConfigError
