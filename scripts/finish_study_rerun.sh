@@ -19,18 +19,7 @@ set -euo pipefail
 src=$(cd "$1" && pwd); study=${2%/}; config=$3
 cd "$(dirname "$0")/.."
 PY="${PYTHON:-.venv/bin/python}"
-rank() {  # as scripts/rerank_results.sh: exit 1 (incomplete grid) passes, a crash does not
-  local err rc=0
-  err=$(mktemp)
-  $PY -m sumo_ayss.rank "$@" --no-run --no-live > /dev/null 2> "$err" || rc=$?
-  cat "$err" >&2
-  if [ "$rc" -gt 1 ] || grep -q -e '^Traceback' -e '^error:' "$err"; then
-    rm -f "$err"
-    echo "finish_study_rerun.sh: rank $* failed (exit $rc)" >&2
-    exit 1
-  fi
-  rm -f "$err"
-}
+rank() { scripts/rank_no_run.sh "$@" || exit 1; }  # exit 1 (incomplete grid) passes
 for b in $(cd "$src" && find . -name ayss.csv | sort); do
   [ -f "$src/$(dirname "$b")/ayss_bins.csv" ] || $PY scripts/ayss_bins_from_csv.py "$src/$(dirname "$b")" > /dev/null
 done

@@ -4,22 +4,9 @@
 # Writes each study's ranking.csv, ranking.md and, with a known order, order_check.json.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-R="${PYTHON:-.venv/bin/python} -m sumo_ayss.rank"
-# Exit status 1 with the ranking written is an incomplete grid (fine here); a traceback, an
-# "error:" line (rank refused its input) or any other status stops the script: a crashing
-# rank must not pass for a byte-identical re-rank (its old files would stay in place).
-rank() {
-  local err rc=0
-  err=$(mktemp)
-  $R "$@" --no-run --no-live > /dev/null 2> "$err" || rc=$?
-  cat "$err" >&2
-  if [ "$rc" -gt 1 ] || grep -q -e '^Traceback' -e '^error:' "$err"; then
-    rm -f "$err"
-    echo "rerank_results.sh: rank $* failed (exit $rc)" >&2
-    exit 1
-  fi
-  rm -f "$err"
-}
+# Each study through scripts/rank_no_run.sh: an incomplete grid passes, a crash or a refusal
+# stops this script.
+rank() { scripts/rank_no_run.sh "$@" || exit 1; }
 rank configs/ladders/min_gap.yaml --out results/ladders/min_gap_a
 rank configs/ladders/min_gap.yaml --seeds 100 101 102 --out results/ladders/min_gap_b
 rank configs/ladders/time_headway.yaml --out results/ladders/time_headway_a

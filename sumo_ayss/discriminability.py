@@ -273,25 +273,26 @@ def discriminability_beside(cfg: PipelineConfig) -> Iterator[None]:
         len(cfg.grid.vuts),
     )
     if cfg.n_workers <= 1:
-        failures = write_for_pipeline(cfg)
+        for line in write_for_pipeline(cfg):
+            logger.warning("%s", line)
         yield
-    else:
-        from concurrent.futures.process import BrokenProcessPool
+        return
+    from concurrent.futures.process import BrokenProcessPool
 
-        from sumo_ayss.grid.workers import spawn_pool, stop_workers
+    from sumo_ayss.grid.workers import spawn_pool, stop_workers
 
-        pool = spawn_pool(1)
+    pool = spawn_pool(1)
+    try:
+        future = pool.submit(write_for_pipeline, cfg)
+        yield
         try:
-            future = pool.submit(write_for_pipeline, cfg)
-            yield
-            try:
-                failures = future.result()
-            except BrokenProcessPool as e:  # the worker died: as any failure, not fatal
-                failures = [f"discriminability not computed: its worker process died ({e})"]
-        except BaseException:
-            stop_workers(pool)  # an error or Ctrl-C in the body: do not wait for it
-            raise
-        pool.shutdown(wait=True)
+            failures = future.result()
+        except BrokenProcessPool as e:  # the worker died: as any failure, not fatal
+            failures = [f"discriminability not computed: its worker process died ({e})"]
+    except BaseException:
+        stop_workers(pool)  # an error or Ctrl-C in the body: do not wait for it
+        raise
+    pool.shutdown(wait=True)
     for line in failures:
         logger.warning("%s", line)
 

@@ -81,6 +81,23 @@ def test_discriminability_is_written_by_a_worker_beside_the_analysis(tmp_path: P
 
 
 @pytest.mark.sumo
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_discriminability_failure_is_logged_not_raised(
+    tmp_path: Path, workers: int, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Its folder cannot be written (the study's out is a file): the body still runs, the
+    failure is a warning naming the case, in this process or from the worker."""
+    cfg = dataclasses.replace(load_pipeline(write_configs(tmp_path, [0])), workers=workers)
+    cfg.out.parent.mkdir(parents=True, exist_ok=True)
+    cfg.out.write_text("not a folder")
+    ran = []
+    with caplog.at_level(logging.WARNING), discriminability_beside(cfg):
+        ran.append(True)
+    assert ran == [True]
+    assert "discriminability of car_following not computed" in caplog.text
+
+
+@pytest.mark.sumo
 def test_failing_job_is_retried_then_reported_others_complete(tmp_path: Path) -> None:
     cfg = load_pipeline(write_configs(tmp_path, [0]))
     broken = cfg.out / "car_following" / "pi2" / "seed_0"

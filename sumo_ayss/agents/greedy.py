@@ -19,6 +19,11 @@ from sumo_ayss.agents.policies import DuelingQNetwork
 #: the memory), so in-place updates of the network (an optimizer step) are seen.
 _Layer = tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]] | None
 
+HOST_MAX_BATCH = 4
+"""The most observations per call that the NumPy forward takes (an episode's one at a time);
+a larger batch (a vec env's evaluation, Monte Carlo) runs through torch, as fast from 8
+observations on (0.22 ms each at 8, one thread; ``benchmarks/greedy_forward.py``)."""
+
 
 class GreedyPolicy:
     """``obs (N, d) float32 -> actions (N,) int64``: argmax of the online Q network.
@@ -30,9 +35,9 @@ class GreedyPolicy:
     On the CPU, a network of :class:`~sumo_ayss.agents.policies.DuelingQNetwork`'s usual
     layout (flattened observations, ``Linear``/``ReLU`` MLPs, float32) runs in NumPy on views
     of its weights for up to :data:`HOST_MAX_BATCH` observations: an episode asks for one at
-    a time, and there torch's per-operator overhead makes a forward 0.12-0.24 ms against
-    NumPy's 0.05-0.06 ms (one thread, 256-wide layers; ``benchmarks/greedy_forward.py``),
-    about a quarter of a cross-play cell's time. The result is the same
+    a time, and there torch's per-operator overhead makes a forward 0.14-0.22 ms against
+    NumPy's 0.06-0.11 ms (one thread, 256-wide layers; ``benchmarks/greedy_forward.py``),
+    which halved a cross-play cell (1.8 s -> 0.95 s, 200 episodes). The result is the same
     function of the weights in float32; the last bit of a Q-value may differ from torch's
     (another summation order), which decides an argmax only on an exact near-tie. Any other
     network, or one on a GPU, runs through torch.
@@ -62,11 +67,6 @@ class GreedyPolicy:
         return actions
 
 
-HOST_MAX_BATCH = 4
-"""The most observations per call that the NumPy forward takes (an episode's one at a time);
-a larger batch (a vec env's evaluation, Monte Carlo) runs through torch, which is faster there
-(0.21 ms against 0.27 ms at 8 observations, one thread)."""
-
 #: ``(feature net, value net or None, advantage net or Q head)`` on the host.
 _HostNet = tuple[list[_Layer], list[_Layer] | None, list[_Layer]]
 
@@ -81,13 +81,11 @@ def _host_layers(q_net: object) -> _HostNet | None:
     if any(p.dtype != th.float32 or p.device.type != "cpu" for p in q_net.parameters()):
         return None
     feature = _mlp_layers(q_net.feature_net)
-    if q_net.dueling:
-        value, head = _mlp_layers(q_net.value_net), _mlp_layers(q_net.advantage_net)
-    else:
-        value, head = [], _mlp_layers(q_net.q_head)
-    if feature is None or value is None or head is None:
+    head = _mlp_layers(q_net.advantage_net if q_net.dueling else q_net.q_head)
+    value = _mlp_layers(q_net.value_net) if q_net.dueling else None
+    if feature is None or head is None or (q_net.dueling and value is None):
         return None
-    return feature, (value if q_net.dueling else None), head
+    return feature, value, head
 
 
 def _mlp_layers(mlp: nn.Sequential) -> list[_Layer] | None:

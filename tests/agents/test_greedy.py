@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 import torch as th
@@ -63,7 +65,7 @@ def test_another_layout_runs_through_torch() -> None:
     policy, env = _policy(True)
     # not Linear/ReLU: the NumPy forward does not know it
     policy.q_net.feature_net[1] = nn.Tanh()  # type: ignore[operator, assignment]
-    other = GreedyPolicy(type("M", (), {"q_net": policy.q_net, "device": th.device("cpu")})())
+    other = GreedyPolicy(SimpleNamespace(q_net=policy.q_net, device=th.device("cpu")))  # type: ignore[arg-type]
     assert other._host is None
     x = np.full((1, 4), 10.0, dtype=np.float32)
     np.testing.assert_array_equal(other.q_values(x), _torch_q(other, x))

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from sumo_ayss.analysis.measure_ranking import measure_rankings, r157_rows
+from sumo_ayss.analysis.measure_ranking import _median, measure_rankings, r157_rows
 
 # two VUTs, two opponents (o1, o2), two episodes each
 VUT = ["a"] * 4 + ["b"] * 4
@@ -66,3 +66,17 @@ def test_a_float_tie_is_a_tie() -> None:
     cols = {"vut_max_braking_mps2": [5.999999999999997] * 4 + [6.000000000000003] * 4}
     (m,) = measure_rankings(VUT, OPP, cols, vuts=["a", "b"], primary_order=["a", "b"], n_boot=50)
     assert m.ties and [row.rank for row in m.rows] == [1, 1] and math.isnan(m.tau)
+
+
+def test_the_median_is_the_inverted_cdf_order_statistic_with_infinities() -> None:
+    """The bootstrap's median (np.partition) is np.quantile's ``inverted_cdf`` median to the
+    bit, at every size, odd and even, with infinite values (a measure's ∞: no conflict) and
+    ties; an even size takes the lower middle, never an average."""
+    rng = np.random.default_rng(7)
+    for n in range(1, 41):
+        for _ in range(25):
+            x = rng.normal(size=n).round(1)  # ties
+            x[rng.random(n) < 0.3] = np.inf
+            assert _median(x) == np.quantile(x, 0.5, method="inverted_cdf")
+    assert _median(np.array([1.0, 2.0, 3.0, 4.0])) == 2.0
+    assert _median(np.array([1.0, np.inf])) == 1.0 and _median(np.array([np.inf])) == np.inf
